@@ -1,0 +1,58 @@
+"""puzzlebox shared vocabulary: puzzle specs, component kinds, lock semantics, the generator and
+the symbolic observation / ``World`` protocol that the agent and the robot pipeline both speak."""
+
+from models.errors import (
+    GeneratorError,
+    ModelsError,
+    ReachabilityUndecided,
+    SpecError,
+    SpecProblem,
+    UnknownKindError,
+)
+from models.kinds import ALLOWED_NEIGHBOURS, KIND_NAMES, PUZZLE_KINDS, KindTemplate, get_kind, kind_code
+from models.lock_table import LockTable
+from models.observation import ComponentObservation, SceneObservation
+from models.spec import (
+    SPEC_FORMAT,
+    Box,
+    Component,
+    Goal,
+    LockRule,
+    PuzzleSpec,
+    load_spec,
+    save_spec,
+    spec_from_dict,
+    spec_from_json,
+)
+from models.validation import validate_data
+from models.world import World
+
+__all__ = [
+    "ALLOWED_NEIGHBOURS",
+    "KIND_NAMES",
+    "PUZZLE_KINDS",
+    "SPEC_FORMAT",
+    "Box",
+    "Component",
+    "ComponentObservation",
+    "GeneratorError",
+    "Goal",
+    "KindTemplate",
+    "LockRule",
+    "LockTable",
+    "ModelsError",
+    "PuzzleSpec",
+    "ReachabilityUndecided",
+    "SceneObservation",
+    "SpecError",
+    "SpecProblem",
+    "UnknownKindError",
+    "World",
+    "get_kind",
+    "kind_code",
+    "load_spec",
+    "save_spec",
+    "spec_from_dict",
+    "spec_from_json",
+    "validate_data",
+]

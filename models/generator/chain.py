@@ -1,0 +1,113 @@
+"""Chains: the paper's puzzle family generalised to any kind sequence and length.
+
+Chain rules for k = 0..N-2 (PAPER_NOTES.md): ``L[k, 0, k+1, 0]`` (k closed keeps k+1 closed) and
+``L[k+1, 1, k, 1]`` (k+1 open keeps k open). The goal is the last component open; the optimal
+solution opens the components in chain order (N actions).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from models.errors import GeneratorError
+from models.generator.layout import Layout, LayoutConfig
+from models.kinds import ALLOWED_NEIGHBOURS, PUZZLE_KINDS, may_neighbour
+from models.spec import Box, Component, Goal, LockRule, PuzzleSpec
+
+MAX_LAYOUT_ATTEMPTS = 200
+
+
+@dataclass(frozen=True)
+class BoxConfig:
+    """The box a generated puzzle sits in."""
+
+    height: float = 0.08
+    """Box height [m]."""
+    pose: tuple[float, float, float] | None = (0.45, 0.0, 0.0)
+    """Box centre on the table in the robot base frame ``[x, y, yaw]`` [m, m, rad]; None = twin default."""
+    lid_size: tuple[float, float] | None = None
+    """Lid (length, width) [m]; None = the smallest that holds the layout with its margin."""
+    layout: LayoutConfig = field(default_factory=LayoutConfig)
+
+
+def check_chain_kinds(kinds: Sequence[str]) -> None:
+    """Raise :class:`GeneratorError` unless ``kinds`` is a chain the paper's rules allow."""
+    if len(kinds) < 2:
+        raise GeneratorError(f"a chain needs at least 2 components, got {len(kinds)}")
+    unknown = [k for k in kinds if k not in PUZZLE_KINDS]
+    if unknown:
+        raise GeneratorError(f"unknown kinds {unknown}; known kinds: {sorted(PUZZLE_KINDS)}")
+    for k in range(len(kinds) - 1):
+        if not may_neighbour(kinds[k], kinds[k + 1]):
+            allowed = sorted("-".join(sorted(p)) for p in ALLOWED_NEIGHBOURS)
+            raise GeneratorError(
+                f"kinds {kinds[k]!r} and {kinds[k + 1]!r} at positions {k} and {k + 1} cannot lock each "
+                f"other; neighbours must be one of {allowed}"
+            )
+
+
+def chain_layout(kinds: Sequence[str], rng: np.random.Generator, layout_config: LayoutConfig) -> Layout:
+    """Place a chain, each component attached to its predecessor; retries a layout that boxes itself in."""
+    for _ in range(MAX_LAYOUT_ATTEMPTS):
+        layout = Layout(layout_config)
+        layout.place_first(kinds[0])
+        if all(layout.attach(k - 1, kinds[k], rng) for k in range(1, len(kinds))):
+            layout.turn_lengthwise()
+            return layout
+    raise GeneratorError(f"no layout found for the chain {list(kinds)} in {MAX_LAYOUT_ATTEMPTS} attempts")
+
+
+def chain_rules(length: int) -> list[tuple[int, int, int, int]]:
+    """The paper's chain rules ``(locker, locker_state, locked, locked_state)`` by chain position."""
+    rules = []
+    for k in range(length - 1):
+        rules += [(k, 0, k + 1, 0), (k + 1, 1, k, 1)]
+    return rules
+
+
+def assemble(
+    name: str,
+    kinds: Sequence[str],
+    layout: Layout,
+    locks_by_index: Sequence[tuple[int, int, int, int]],
+    goal: int,
+    box: BoxConfig,
+) -> PuzzleSpec:
+    """Turn a layout and index-based lock rules into a spec (names ``<kind>-<index>``, markers = index)."""
+    names = [f"{kind}-{i}" for i, kind in enumerate(kinds)]
+    lid = box.lid_size if box.lid_size is not None else layout.lid_size()
+    components = tuple(
+        Component(name=names[i], kind=kinds[i], pose=pose, marker=i)
+        for i, pose in enumerate(layout.poses_in_lid())
+    )
+    locks = tuple(LockRule(names[a], sa, names[b], sb) for a, sa, b, sb in locks_by_index)
+    return PuzzleSpec(
+        name=name,
+        components=components,
+        locks=locks,
+        goal=Goal(names[goal], 1),
+        box=Box(size=(lid[0], lid[1], box.height), pose=box.pose),
+    )
+
+
+def generate_chain(
+    kinds: Sequence[str], seed: int, name: str | None = None, box: BoxConfig | None = None
+) -> PuzzleSpec:
+    """A chain puzzle of the given kinds; a pure function of its arguments.
+
+    Args:
+        kinds: kind of each component in chain order, e.g. ``["door", "slide", "wheel"]``.
+        seed: seeds the layout's turns.
+        name: spec name; default ``chain-<kinds>-s<seed>``.
+        box: the box; default :class:`BoxConfig` (lid sized to the layout).
+    """
+    kinds = list(kinds)
+    check_chain_kinds(kinds)
+    box = box or BoxConfig()
+    layout = chain_layout(kinds, np.random.default_rng(seed), box.layout)
+    rules = chain_rules(len(kinds))
+    name = name or f"chain-{'-'.join(kinds)}-s{seed}"
+    return assemble(name, kinds, layout, rules, goal=len(kinds) - 1, box=box)

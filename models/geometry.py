@@ -1,0 +1,73 @@
+"""Planar geometry helpers: SE(2) poses and convex-polygon tests used for footprints on the lid.
+
+Poses are ``(x, y, yaw)`` [m, m, rad]; ``compose(T_a_b, T_b_c) = T_a_c``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def wrap_angle(angle: float) -> float:
+    """Wrap an angle [rad] into [-pi, pi)."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def compose(
+    T_a_b: tuple[float, float, float], T_b_c: tuple[float, float, float]
+) -> tuple[float, float, float]:
+    """Compose two SE(2) poses: the pose of frame c in frame a."""
+    xa, ya, ta = T_a_b
+    xb, yb, tb = T_b_c
+    c, s = math.cos(ta), math.sin(ta)
+    return (xa + c * xb - s * yb, ya + s * xb + c * yb, wrap_angle(ta + tb))
+
+
+def inverse(T_a_b: tuple[float, float, float]) -> tuple[float, float, float]:
+    """Inverse of an SE(2) pose: ``T_b_a``."""
+    x, y, t = T_a_b
+    c, s = math.cos(t), math.sin(t)
+    return (-c * x - s * y, s * x - c * y, wrap_angle(-t))
+
+
+def transform_points(T_a_b: tuple[float, float, float], points_in_b: np.ndarray) -> np.ndarray:
+    """Express points given in frame b (shape ``(n, 2)`` [m]) in frame a."""
+    x, y, t = T_a_b
+    c, s = math.cos(t), math.sin(t)
+    rotation = np.array([[c, -s], [s, c]])
+    return points_in_b @ rotation.T + np.array([x, y])
+
+
+def _axes(polygon: np.ndarray) -> np.ndarray:
+    edges = np.roll(polygon, -1, axis=0) - polygon
+    normals = np.stack([-edges[:, 1], edges[:, 0]], axis=1)
+    return normals / np.linalg.norm(normals, axis=1, keepdims=True)
+
+
+def polygon_gap(a: np.ndarray, b: np.ndarray) -> float:
+    """Separation of two convex polygons along their best separating axis [m].
+
+    Positive: the polygons are apart by at least this much (a lower bound on their distance, exact
+    for the axis-aligned rectangles and near-circles used here). Zero or negative: they touch or
+    overlap (the magnitude is the smallest penetration along the polygons' edge normals).
+    """
+    best = -math.inf
+    for axis in np.concatenate([_axes(a), _axes(b)]):
+        pa, pb = a @ axis, b @ axis
+        gap = max(pb.min() - pa.max(), pa.min() - pb.max())
+        best = max(best, gap)
+    return float(best)
+
+
+def rectangle(x_min: float, x_max: float, y_min: float, y_max: float) -> np.ndarray:
+    """Counter-clockwise corners of an axis-aligned rectangle, shape ``(4, 2)`` [m]."""
+    return np.array([[x_min, y_min], [x_max, y_min], [x_max, y_max], [x_min, y_max]], dtype=float)
+
+
+def circle_polygon(radius: float, sides: int = 16) -> np.ndarray:
+    """A regular polygon that contains the circle of ``radius`` [m] (circumscribed), ``(sides, 2)``."""
+    outer = radius / math.cos(math.pi / sides)
+    angles = (np.arange(sides) + 0.5) * 2.0 * math.pi / sides
+    return outer * np.stack([np.cos(angles), np.sin(angles)], axis=1)
