@@ -15,9 +15,7 @@ def wrap_angle(angle: float) -> float:
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
-def compose(
-    T_a_b: tuple[float, float, float], T_b_c: tuple[float, float, float]
-) -> tuple[float, float, float]:
+def compose(T_a_b: tuple[float, float, float], T_b_c: tuple[float, float, float]) -> tuple[float, float, float]:
     """Compose two SE(2) poses: the pose of frame c in frame a."""
     xa, ya, ta = T_a_b
     xb, yb, tb = T_b_c

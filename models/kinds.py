@@ -101,9 +101,7 @@ PUZZLE_KINDS: dict[str, KindTemplate] = {k.name: k for k in (DOOR, SLIDE, WHEEL)
 KIND_NAMES: tuple[str, ...] = ("door", "slide", "wheel")
 """Every kind the project knows, in a fixed order: the integer code of a kind is its index here."""
 
-ALLOWED_NEIGHBOURS: frozenset[frozenset[str]] = frozenset(
-    {frozenset({"door", "slide"}), frozenset({"slide", "wheel"})}
-)
+ALLOWED_NEIGHBOURS: frozenset[frozenset[str]] = frozenset({frozenset({"door", "slide"}), frozenset({"slide", "wheel"})})
 """Kind pairs that may lock each other (the paper: doors and wheels never interact, nor do two
 components of the same kind)."""
 

@@ -103,8 +103,7 @@ class PuzzleSpec:
                 box["pose"] = _rounded(self.box.pose)
             out["box"] = box
         out["components"] = [
-            {"name": c.name, "kind": c.kind, "pose": _rounded(c.pose), "marker": c.marker}
-            for c in self.components
+            {"name": c.name, "kind": c.kind, "pose": _rounded(c.pose), "marker": c.marker} for c in self.components
         ]
         out["locks"] = [
             {
@@ -148,15 +147,10 @@ def _encode(obj: Any, depth: int) -> str:
         if depth > 0 and all(_is_flat(v) for v in obj.values()):
             return (
                 "{"
-                + ", ".join(
-                    f"{json.dumps(str(k), ensure_ascii=False)}: {_encode(v, depth)}" for k, v in obj.items()
-                )
+                + ", ".join(f"{json.dumps(str(k), ensure_ascii=False)}: {_encode(v, depth)}" for k, v in obj.items())
                 + "}"
             )
-        items = [
-            f"{inner}{json.dumps(str(k), ensure_ascii=False)}: {_encode(v, depth + 1)}"
-            for k, v in obj.items()
-        ]
+        items = [f"{inner}{json.dumps(str(k), ensure_ascii=False)}: {_encode(v, depth + 1)}" for k, v in obj.items()]
         return "{\n" + ",\n".join(items) + "\n" + pad + "}"
     if isinstance(obj, list | tuple):
         if all(not isinstance(v, dict | list | tuple) for v in obj):
@@ -222,8 +216,7 @@ def _build(data: dict[str, Any]) -> PuzzleSpec:
             )
         )
     locks = tuple(
-        LockRule(r["locker"], int(r["locker_state"]), r["locked"], int(r["locked_state"]))
-        for r in data["locks"]
+        LockRule(r["locker"], int(r["locker_state"]), r["locked"], int(r["locked_state"])) for r in data["locks"]
     )
     goal = Goal(data["goal"]["component"], int(data["goal"].get("state", 1)))
     box = None

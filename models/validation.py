@@ -169,9 +169,7 @@ def _check_geometry(data: dict[str, Any], components: dict[str, dict[str, Any]])
     size = box.get("size")
     size_ok = _number_list(size, (3,)) and all(v > 0 for v in size)
     if not size_ok:
-        problems.append(
-            SpecProblem("box.size", "must be 3 positive numbers: lid length, lid width, height [m]")
-        )
+        problems.append(SpecProblem("box.size", "must be 3 positive numbers: lid length, lid width, height [m]"))
     if box.get("pose") is not None and not _number_list(box["pose"], (3,)):
         problems.append(SpecProblem("box.pose", "must be 3 finite numbers: x, y, yaw [m, m, rad]"))
     if not size_ok:
@@ -201,9 +199,7 @@ def _check_geometry(data: dict[str, Any], components: dict[str, dict[str, Any]])
         for b in ordered[a_i + 1 :]:
             gap = polygon_gap(footprints[a], footprints[b])
             if gap < -OVERLAP_TOLERANCE:
-                problems.append(
-                    SpecProblem(f"component {a!r}", f"overlaps component {b!r} by {-gap * 1000:.1f} mm")
-                )
+                problems.append(SpecProblem(f"component {a!r}", f"overlaps component {b!r} by {-gap * 1000:.1f} mm"))
     return problems
 
 

@@ -80,8 +80,7 @@ def assemble(
     names = [f"{kind}-{i}" for i, kind in enumerate(kinds)]
     lid = box.lid_size if box.lid_size is not None else layout.lid_size()
     components = tuple(
-        Component(name=names[i], kind=kinds[i], pose=pose, marker=i)
-        for i, pose in enumerate(layout.poses_in_lid())
+        Component(name=names[i], kind=kinds[i], pose=pose, marker=i) for i, pose in enumerate(layout.poses_in_lid())
     )
     locks = tuple(LockRule(names[a], sa, names[b], sb) for a, sa, b, sb in locks_by_index)
     return PuzzleSpec(

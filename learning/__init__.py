@@ -1,0 +1,28 @@
+"""puzzlebox learning: symbolic environments, agents, the trial loop (and later memory and
+baselines). Imports only ``models`` — never ``twin`` or ``skills`` (DESIGN.md, "Layers")."""
+
+from learning.agents import AGENT_FACTORIES, Agent, OracleAgent, RandomAgent, make_agent
+from learning.errors import ConfigError, InvalidAction, LearningError, UnknownAgent
+from learning.puzzle_env import FaultConfig, PuzzleEnv, PuzzleEnvConfig
+from learning.symbolic_world import SymbolicWorld
+from learning.trial import ActionRecord, RunResult, run_episode, summarise
+
+__all__ = [
+    "AGENT_FACTORIES",
+    "ActionRecord",
+    "Agent",
+    "ConfigError",
+    "FaultConfig",
+    "InvalidAction",
+    "LearningError",
+    "OracleAgent",
+    "PuzzleEnv",
+    "PuzzleEnvConfig",
+    "RandomAgent",
+    "RunResult",
+    "SymbolicWorld",
+    "UnknownAgent",
+    "make_agent",
+    "run_episode",
+    "summarise",
+]

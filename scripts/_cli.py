@@ -1,0 +1,38 @@
+"""Helpers shared by the command-line scripts: run metadata and atomic JSON output."""
+
+from __future__ import annotations
+
+import json
+import platform
+import sys
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+from models.spec import dumps_compact
+
+
+def versions() -> dict[str, str]:
+    """Versions of Python and the packages a result depends on (written beside every result)."""
+    out = {"python": platform.python_version()}
+    for package in ("puzzlebox", "numpy", "scipy", "gymnasium", "mujoco"):
+        try:
+            out[package] = metadata.version(package)
+        except metadata.PackageNotFoundError:
+            out[package] = "not installed"
+    return out
+
+
+def write_json(path: Path, data: Any) -> Path:
+    """Write JSON atomically (a crash never leaves a half-written file)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(dumps_compact(data) if isinstance(data, dict) else json.dumps(data, indent=2))
+    tmp.replace(path)
+    return path
+
+
+def fail(message: str, code: int = 2) -> None:
+    """Print ``error: message`` on stderr and exit (no traceback for a user's mistake)."""
+    print(f"error: {message}", file=sys.stderr)
+    raise SystemExit(code)

@@ -1,0 +1,3 @@
+"""puzzlebox skills layer (see DESIGN.md, "Layers")."""
+
+__all__: list[str] = []

@@ -1,0 +1,3 @@
+"""puzzlebox twin layer (see DESIGN.md, "Layers")."""
+
+__all__: list[str] = []
