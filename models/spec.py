@@ -127,6 +127,12 @@ def _rounded(values: tuple[float, ...]) -> list[float]:
     return [round(float(v), _DECIMALS) + 0.0 for v in values]
 
 
+def file_precision(values: tuple[float, ...]) -> tuple[float, ...]:
+    """``values`` as a spec file stores them (micrometres / microradians), so that a generated spec
+    equals the spec read back from its file."""
+    return tuple(_rounded(values))
+
+
 def dumps_compact(obj: Any) -> str:
     """JSON with 2-space indentation but lists of scalars kept on one line (poses read as rows)."""
     return _encode(obj, 0) + "\n"

@@ -15,7 +15,7 @@ import numpy as np
 from models.errors import GeneratorError
 from models.generator.layout import Layout, LayoutConfig
 from models.kinds import ALLOWED_NEIGHBOURS, PUZZLE_KINDS, may_neighbour
-from models.spec import Box, Component, Goal, LockRule, PuzzleSpec
+from models.spec import Box, Component, Goal, LockRule, PuzzleSpec, file_precision
 
 MAX_LAYOUT_ATTEMPTS = 200
 
@@ -80,7 +80,8 @@ def assemble(
     names = [f"{kind}-{i}" for i, kind in enumerate(kinds)]
     lid = box.lid_size if box.lid_size is not None else layout.lid_size()
     components = tuple(
-        Component(name=names[i], kind=kinds[i], pose=pose, marker=i) for i, pose in enumerate(layout.poses_in_lid())
+        Component(name=names[i], kind=kinds[i], pose=file_precision(pose), marker=i)
+        for i, pose in enumerate(layout.poses_in_lid())
     )
     locks = tuple(LockRule(names[a], sa, names[b], sb) for a, sa, b, sb in locks_by_index)
     return PuzzleSpec(
@@ -88,7 +89,10 @@ def assemble(
         components=components,
         locks=locks,
         goal=Goal(names[goal], 1),
-        box=Box(size=(lid[0], lid[1], box.height), pose=box.pose),
+        box=Box(
+            size=file_precision((lid[0], lid[1], box.height)),  # type: ignore[arg-type]
+            pose=file_precision(box.pose) if box.pose is not None else None,  # type: ignore[arg-type]
+        ),
     )
 
 

@@ -1,0 +1,43 @@
+"""Shared fixtures: the SPEC.md example as a dict, and a writer for spec files."""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+SPEC_EXAMPLE: dict[str, Any] = {
+    "format": "puzzlebox-spec/1",
+    "name": "paper-test-0",
+    "box": {"size": [0.40, 0.30, 0.08], "pose": [0.45, 0.0, 0.0]},
+    "components": [
+        {"name": "door-1", "kind": "door", "pose": [-0.12, 0.05, 0.0], "marker": 0},
+        {"name": "slide-1", "kind": "slide", "pose": [-0.02, 0.05, 1.5708], "marker": 1},
+    ],
+    "locks": [
+        {"locker": "door-1", "locker_state": 0, "locked": "slide-1", "locked_state": 0},
+        {"locker": "slide-1", "locker_state": 1, "locked": "door-1", "locked_state": 1},
+    ],
+    "goal": {"component": "slide-1", "state": 1},
+}
+
+
+@pytest.fixture
+def spec_dict() -> dict[str, Any]:
+    """A fresh deep copy of the SPEC.md example (valid)."""
+    return copy.deepcopy(SPEC_EXAMPLE)
+
+
+@pytest.fixture
+def write_spec(tmp_path: Path):
+    """Write a dict (or raw text) to a file in tmp_path and return its path."""
+
+    def write(data: Any, name: str = "spec.json") -> Path:
+        path = tmp_path / name
+        path.write_text(data if isinstance(data, str) else json.dumps(data))
+        return path
+
+    return write

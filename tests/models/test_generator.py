@@ -1,0 +1,132 @@
+import json
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from models import GeneratorError, LockTable, get_kind, validate_data
+from models.generator import (
+    TEST_INDICES,
+    TRAIN_INDICES,
+    LayoutConfig,
+    RandomGraphConfig,
+    generate_chain,
+    generate_random,
+    paper_family,
+    paper_sequences,
+)
+from models.geometry import polygon_gap
+from models.kinds import may_neighbour
+
+NEIGHBOUR_GAP = LayoutConfig().neighbour_gap
+
+
+def footprint(spec, name):
+    component = spec.components[spec.index_of(name)]
+    return get_kind(component.kind).footprint_in_lid(component.pose)
+
+
+def assert_lockers_sit_next_to_what_they_lock(spec):
+    for rule in spec.locks:
+        gap = polygon_gap(footprint(spec, rule.locker), footprint(spec, rule.locked))
+        assert gap <= NEIGHBOUR_GAP + 1e-9, (rule, gap)
+        kinds = (spec.components[spec.index_of(rule.locker)].kind, spec.components[spec.index_of(rule.locked)].kind)
+        assert may_neighbour(*kinds), rule
+
+
+def test_paper_family_has_exactly_the_twelve_sequences():
+    sequences = paper_sequences()
+    assert len(sequences) == len(set(sequences)) == 12
+    assert sequences == sorted(sequences, key=lambda s: [("door", "slide", "wheel").index(k) for k in s])
+    for seq in sequences:
+        assert all(may_neighbour(a, b) for a, b in zip(seq, seq[1:], strict=False))
+
+
+def test_paper_split_is_the_releases_nine_and_three():
+    assert TRAIN_INDICES == (0, 1, 2, 4, 5, 7, 8, 10, 11) and TEST_INDICES == (3, 6, 9)
+    test = paper_family("test")
+    assert [s.name for s in test] == ["paper-test-0", "paper-test-1", "paper-test-2"]
+    assert [s.kinds for s in test] == [
+        ("door", "slide", "wheel", "slide", "wheel"),
+        ("slide", "wheel", "slide", "door", "slide"),
+        ("wheel", "slide", "door", "slide", "wheel"),
+    ]
+    train = paper_family("train")
+    assert [s.name for s in train] == [f"paper-train-{k}" for k in range(9)]
+    assert not {s.kinds for s in train} & {s.kinds for s in test}  # test sequences unseen in training
+    assert {s.name for s in paper_family("all")} == {s.name for s in train + test}
+
+
+def test_paper_boxes_are_valid_chains_solved_in_five_actions_on_one_lid():
+    specs = paper_family("all")
+    assert len({s.box.size for s in specs}) == 1
+    for spec in specs:
+        assert validate_data(spec.to_dict()) == []
+        table = LockTable.from_spec(spec)
+        assert table.shortest_solution() == [0, 1, 2, 3, 4]  # chain order
+        assert spec.goal.component == spec.components[-1].name
+        assert len(spec.locks) == 8
+        assert_lockers_sit_next_to_what_they_lock(spec)
+
+
+def test_paper_lid_is_reachable_tabletop_size():
+    length, width, height = paper_family("test")[0].box.size
+    assert length <= 0.45 and width <= 0.40 and height > 0
+
+
+def test_generators_write_byte_identical_json_for_the_same_call():
+    assert [s.to_json() for s in paper_family("all")] == [s.to_json() for s in paper_family("all")]
+    kinds = ["wheel", "slide", "door", "slide"]
+    assert generate_chain(kinds, seed=7).to_json() == generate_chain(kinds, seed=7).to_json()
+    config = RandomGraphConfig(12, multi_locker=True)
+    assert generate_random(config, seed=5).to_json() == generate_random(config, seed=5).to_json()
+
+
+def test_different_seeds_give_different_layouts():
+    config = RandomGraphConfig(10)
+    layouts = {json.dumps([c.pose for c in generate_random(config, seed=s).components]) for s in range(6)}
+    assert len(layouts) > 1
+
+
+@settings(max_examples=40, deadline=None)
+@given(length=st.integers(2, 9), start=st.sampled_from(["door", "slide", "wheel"]), seed=st.integers(0, 2**31))
+def test_chains_of_any_allowed_kinds_are_valid_and_solved_in_chain_order(length, start, seed):
+    rng = np.random.default_rng(seed)
+    kinds = [start]
+    while len(kinds) < length:
+        kinds.append("slide" if kinds[-1] != "slide" else ["door", "wheel"][int(rng.integers(2))])
+    spec = generate_chain(kinds, seed=seed)
+    assert validate_data(spec.to_dict()) == []
+    assert LockTable.from_spec(spec).shortest_solution() == list(range(length))
+    assert_lockers_sit_next_to_what_they_lock(spec)
+
+
+@settings(max_examples=60, deadline=None)
+@given(n=st.integers(4, 16), multi=st.booleans(), seed=st.integers(0, 2**31))
+def test_random_graphs_are_valid_solvable_and_local(n, multi, seed):
+    spec = generate_random(RandomGraphConfig(n, multi_locker=multi), seed=seed)
+    assert len(spec.components) == n
+    assert validate_data(spec.to_dict()) == []  # includes: goal reachable from all-closed
+    assert_lockers_sit_next_to_what_they_lock(spec)
+    lockers_per_closed = [
+        sum(1 for r in spec.locks if r.locked == c.name and r.locked_state == 0) for c in spec.components
+    ]
+    if multi:
+        assert max(lockers_per_closed) >= 2
+
+
+@pytest.mark.parametrize(
+    "kinds", [["door", "wheel"], ["door", "door"], ["slide", "slide", "door"], ["door"], ["door", "lever"]]
+)
+def test_chain_with_forbidden_neighbours_or_kinds_is_a_clear_error(kinds):
+    with pytest.raises(GeneratorError) as info:
+        generate_chain(kinds, seed=0)
+    message = str(info.value)
+    assert "door-slide" in message or "at least 2" in message or "known kinds" in message
+
+
+@pytest.mark.parametrize("config", [RandomGraphConfig(1), RandomGraphConfig(41), RandomGraphConfig(3, True)])
+def test_random_graph_rejects_impossible_sizes(config):
+    with pytest.raises(GeneratorError):
+        generate_random(config, seed=0)

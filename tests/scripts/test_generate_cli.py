@@ -1,0 +1,96 @@
+"""The generate.py verbs behave as DESIGN.md's command-line contract states, malformed input included."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def generate(*args):
+    return subprocess.run(
+        [sys.executable, str(ROOT / "scripts" / "generate.py"), *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+
+
+def test_paper_writes_one_valid_spec_per_variant_of_the_split(tmp_path):
+    result = generate("paper", "--split", "test", "--out", tmp_path)
+    assert result.returncode == 0, result.stderr
+    names = sorted(p.name for p in tmp_path.glob("*.json"))
+    assert names == ["paper-test-0.json", "paper-test-1.json", "paper-test-2.json"]
+    check = generate("validate", *sorted(tmp_path.glob("*.json")))
+    assert check.returncode == 0 and check.stdout.count(": valid (") == 3
+
+
+def test_paper_all_writes_twelve_and_is_byte_identical_twice(tmp_path):
+    assert generate("paper", "--split", "all", "--out", tmp_path / "a").returncode == 0
+    assert generate("paper", "--split", "all", "--out", tmp_path / "b").returncode == 0
+    a, b = sorted((tmp_path / "a").glob("*.json")), sorted((tmp_path / "b").glob("*.json"))
+    assert len(a) == 12
+    assert [p.read_bytes() for p in a] == [p.read_bytes() for p in b]
+
+
+def test_chain_and_random_write_valid_reproducible_files(tmp_path):
+    assert (
+        generate("chain", "--kinds", "door,slide,wheel,slide", "--seed", 3, "--out", tmp_path / "c1.json").returncode
+        == 0
+    )
+    assert (
+        generate("chain", "--kinds", "door,slide,wheel,slide", "--seed", 3, "--out", tmp_path / "c2.json").returncode
+        == 0
+    )
+    assert (tmp_path / "c1.json").read_bytes() == (tmp_path / "c2.json").read_bytes()
+    result = generate("random", "--components", 7, "--seed", 1, "--multi-locker", "--out", tmp_path / "r.json")
+    assert result.returncode == 0, result.stderr
+    assert len(json.loads((tmp_path / "r.json").read_text())["components"]) == 7
+    assert generate("validate", tmp_path / "c1.json", tmp_path / "r.json").returncode == 0
+
+
+def test_chain_with_forbidden_neighbours_fails_cleanly(tmp_path):
+    result = generate("chain", "--kinds", "door,wheel", "--seed", 0, "--out", tmp_path / "x.json")
+    assert result.returncode == 2
+    assert "Traceback" not in result.stderr and "door-slide" in result.stderr
+    assert not (tmp_path / "x.json").exists()
+
+
+MALFORMED = {
+    "not_json.json": "{this is not json",
+    "empty.json": "",
+    "wrong_format.json": json.dumps({"format": "other/9"}),
+    "list.json": "[1, 2, 3]",
+}
+
+
+@pytest.mark.parametrize("name", sorted(MALFORMED))
+def test_validate_reports_malformed_files_one_line_per_problem_without_traceback(tmp_path, name):
+    path = tmp_path / name
+    path.write_text(MALFORMED[name])
+    result = generate("validate", path)
+    assert result.returncode == 1
+    assert "Traceback" not in result.stderr + result.stdout
+    lines = result.stdout.strip().splitlines()
+    assert lines and all(line.startswith(f"{path}: ") for line in lines)
+
+
+def test_validate_lists_every_problem_and_still_checks_the_other_files(tmp_path, spec_dict, write_spec):
+    good = write_spec(spec_dict, "good.json")
+    spec_dict["components"][0]["kind"] = "drawer"
+    spec_dict["locks"][0]["locked"] = "ghost"
+    bad = write_spec(spec_dict, "bad.json")
+    result = generate("validate", bad, good, tmp_path / "missing.json")
+    assert result.returncode == 1
+    bad_lines = [line for line in result.stdout.splitlines() if line.startswith(str(bad))]
+    assert len(bad_lines) == 2
+    assert f"{good}: valid" in result.stdout
+    assert f"{tmp_path / 'missing.json'}: file: cannot read" in result.stdout
+
+
+def test_unknown_verb_is_a_usage_error():
+    result = generate("teleport")
+    assert result.returncode == 2 and "invalid choice" in result.stderr
