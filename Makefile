@@ -26,7 +26,7 @@ test: lint
 	$(BIN)/python -m pytest -q
 
 demo: $(STAMP)
-	$(BIN)/python scripts/generate.py paper --split all --out runs/demo/specs
+	$(BIN)/python scripts/generate.py paper --split all --out runs/demo/specs --plot
 	$(BIN)/python scripts/generate.py validate runs/demo/specs/*.json
 	$(BIN)/python scripts/trial.py --specs runs/demo/specs/paper-test-*.json --sim symbolic --agent oracle \
 		--runs 5 --seed 0 --max-actions 30 --out runs/demo/oracle

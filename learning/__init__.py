@@ -1,11 +1,16 @@
 """puzzlebox learning: symbolic environments, agents, the trial loop (and later memory and
 baselines). Imports only ``models`` — never ``twin`` or ``skills`` (DESIGN.md, "Layers")."""
 
+import gymnasium
+
 from learning.agents import AGENT_FACTORIES, Agent, OracleAgent, RandomAgent, make_agent
 from learning.errors import ConfigError, InvalidAction, LearningError, UnknownAgent
 from learning.puzzle_env import FaultConfig, PuzzleEnv, PuzzleEnvConfig
 from learning.symbolic_world import SymbolicWorld
 from learning.trial import ActionRecord, RunResult, run_episode, summarise
+
+gymnasium.register(id="puzzlebox/Puzzle-v0", entry_point="learning.puzzle_env:PuzzleEnv")
+"""``gymnasium.make("puzzlebox/Puzzle-v0", spec=..., config=...)`` builds a :class:`PuzzleEnv`."""
 
 __all__ = [
     "AGENT_FACTORIES",

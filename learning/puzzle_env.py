@@ -18,7 +18,6 @@ from gymnasium import spaces
 
 from learning.errors import ConfigError, InvalidAction
 from models import KIND_NAMES, PUZZLE_KINDS, LockTable, PuzzleSpec, kind_code
-from models.geometry import compose, wrap_angle
 
 
 @dataclass(frozen=True)
@@ -82,7 +81,7 @@ class PuzzleEnv(gym.Env[dict[str, Any], np.int64]):
             raise ConfigError(f"render_mode must be None or 'ansi', got {render_mode!r}")
         self.render_mode = render_mode
         self.table = LockTable.from_spec(spec)
-        self._true_poses = _world_poses(spec)
+        self._true_poses = spec.poses_in_world()
         self._true_kinds = np.array([kind_code(c.kind) for c in spec.components], dtype=np.int64)
         self.action_space = spaces.Discrete(n)
         self.observation_space = spaces.Dict(
@@ -184,15 +183,3 @@ def _pose_space(shape: tuple[int, ...]) -> spaces.Box:
     per_pose = np.array([POSITION_BOUND] * (dim - 1 if dim == 3 else 3) + [np.pi] * (1 if dim == 3 else 3))
     high = np.tile(per_pose, (n, 1))
     return spaces.Box(-high, high, dtype=np.float64)
-
-
-def _world_poses(spec: PuzzleSpec) -> np.ndarray:
-    """Component poses in the world frame: the box pose composed with each lid-frame pose."""
-    box_pose = spec.box.pose if spec.box is not None and spec.box.pose is not None else (0.0, 0.0, 0.0)
-    poses = []
-    for c in spec.components:
-        if len(c.pose) == 3:
-            poses.append(compose(box_pose, c.pose))  # type: ignore[arg-type]
-        else:  # 3-D domains: their poses are already in the world frame of their scene
-            poses.append(tuple(c.pose[:5]) + (wrap_angle(c.pose[5]),))
-    return np.array(poses, dtype=np.float64)

@@ -11,7 +11,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from models.errors import SpecError, SpecProblem
+from models.geometry import compose, wrap_angle
 
 SPEC_FORMAT = "puzzlebox-spec/1"
 """The only value of the ``format`` field this version reads and writes."""
@@ -93,6 +96,19 @@ class PuzzleSpec:
             if c.name == name:
                 return i
         raise KeyError(f"no component named {name!r}. Components: {list(self.component_names)}")
+
+    def poses_in_world(self) -> np.ndarray:
+        """Component poses in the world (robot base) frame, ``(N, D)``: each planar lid-frame pose
+        composed with ``box.pose`` (identity when absent) and its yaw wrapped to [-pi, pi);
+        6-D poses of 3-D domains are taken as given."""
+        box_pose = self.box.pose if self.box is not None and self.box.pose is not None else (0.0, 0.0, 0.0)
+        poses = []
+        for c in self.components:
+            if len(c.pose) == 3:
+                poses.append(compose(box_pose, c.pose))  # type: ignore[arg-type]
+            else:
+                poses.append((*c.pose[:5], wrap_angle(c.pose[5])))
+        return np.array(poses, dtype=np.float64)
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON object of SPEC.md, keys in the documented order."""

@@ -5,6 +5,8 @@
     python scripts/generate.py random --components N --seed S [--multi-locker] --out FILE
     python scripts/generate.py validate FILE...     # exit 1 and one line per problem if any is invalid
 
+``--plot`` on paper/chain/random also writes a top view of each layout (PNG beside the JSON).
+
 Every generated file is a pure function of the arguments: the same command writes the same bytes.
 """
 
@@ -16,27 +18,31 @@ from pathlib import Path
 
 from _cli import fail
 
-from models import LockTable, ModelsError, SpecError, load_spec, save_spec
+from models import LockTable, ModelsError, PuzzleSpec, SpecError, load_spec, save_spec
 from models.generator import RandomGraphConfig, generate_chain, generate_random, paper_family
 
 
+def _write(spec: PuzzleSpec, path: Path, plot: bool) -> None:
+    print(f"wrote {save_spec(spec, path)}  ({'-'.join(spec.kinds)})")
+    if plot:
+        from _spec_plot import plot_spec  # matplotlib only when asked
+
+        print(f"wrote {plot_spec(spec, path.with_suffix('.png'))}")
+
+
 def _paper(args: argparse.Namespace) -> None:
-    specs = paper_family(args.split, seed=args.seed)
-    for spec in specs:
-        path = save_spec(spec, Path(args.out) / f"{spec.name}.json")
-        print(f"wrote {path}  ({'-'.join(spec.kinds)})")
+    for spec in paper_family(args.split, seed=args.seed):
+        _write(spec, Path(args.out) / f"{spec.name}.json", args.plot)
 
 
 def _chain(args: argparse.Namespace) -> None:
     kinds = [k.strip() for k in args.kinds.split(",") if k.strip()]
-    spec = generate_chain(kinds, seed=args.seed, name=args.name)
-    print(f"wrote {save_spec(spec, args.out)}")
+    _write(generate_chain(kinds, seed=args.seed, name=args.name), Path(args.out), args.plot)
 
 
 def _random(args: argparse.Namespace) -> None:
     config = RandomGraphConfig(num_components=args.components, multi_locker=args.multi_locker)
-    spec = generate_random(config, seed=args.seed, name=args.name)
-    print(f"wrote {save_spec(spec, args.out)}")
+    _write(generate_random(config, seed=args.seed, name=args.name), Path(args.out), args.plot)
 
 
 def _validate(args: argparse.Namespace) -> int:
@@ -64,6 +70,7 @@ def main(argv: list[str] | None = None) -> int:
     paper.add_argument("--split", choices=("train", "test", "all"), required=True)
     paper.add_argument("--out", required=True, help="directory; one DIR/<name>.json per variant")
     paper.add_argument("--seed", type=int, default=0, help="layout seed (default 0: the reference boxes)")
+    paper.add_argument("--plot", action="store_true", help="also write a top-view PNG beside each JSON")
     paper.set_defaults(run=_paper)
 
     chain = verbs.add_parser("chain", help="a chain of any kinds (door-slide and slide-wheel neighbours)")
@@ -71,6 +78,7 @@ def main(argv: list[str] | None = None) -> int:
     chain.add_argument("--seed", type=int, required=True)
     chain.add_argument("--out", required=True, help="output JSON file")
     chain.add_argument("--name", default=None, help="spec name (default: derived from kinds and seed)")
+    chain.add_argument("--plot", action="store_true", help="also write a top-view PNG beside each JSON")
     chain.set_defaults(run=_chain)
 
     rand = verbs.add_parser("random", help="a random solvable lock graph of N components")
@@ -79,6 +87,7 @@ def main(argv: list[str] | None = None) -> int:
     rand.add_argument("--multi-locker", action="store_true", help="some components get two lockers")
     rand.add_argument("--out", required=True, help="output JSON file")
     rand.add_argument("--name", default=None, help="spec name (default: derived from N and seed)")
+    rand.add_argument("--plot", action="store_true", help="also write a top-view PNG beside each JSON")
     rand.set_defaults(run=_random)
 
     validate = verbs.add_parser("validate", help="check spec files; exit 1 if any is invalid")

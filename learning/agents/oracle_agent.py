@@ -11,7 +11,6 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from learning.errors import LearningError
-from learning.puzzle_env import _world_poses
 from models import LockTable, PuzzleSpec, SceneObservation
 
 KIND_MISMATCH_COST = 1.0
@@ -32,7 +31,7 @@ class OracleAgent:
                 f"oracle for {self.spec.name!r} knows {len(self.spec.components)} components, "
                 f"the world shows {len(observation)}"
             )
-        true_xy = _world_poses(self.spec)[:, :2]
+        true_xy = self.spec.poses_in_world()[:, :2]
         seen_xy = observation.poses[:, :2]
         cost = np.linalg.norm(seen_xy[:, None, :] - true_xy[None, :, :], axis=2)
         true_kinds = np.array(self.spec.kinds)

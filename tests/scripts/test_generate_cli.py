@@ -52,6 +52,13 @@ def test_chain_and_random_write_valid_reproducible_files(tmp_path):
     assert generate("validate", tmp_path / "c1.json", tmp_path / "r.json").returncode == 0
 
 
+def test_plot_writes_a_top_view_png_beside_the_json(tmp_path):
+    result = generate("random", "--components", 6, "--seed", 0, "--out", tmp_path / "r.json", "--plot")
+    assert result.returncode == 0, result.stderr
+    png = (tmp_path / "r.png").read_bytes()
+    assert png.startswith(b"\x89PNG") and len(png) > 10_000
+
+
 def test_chain_with_forbidden_neighbours_fails_cleanly(tmp_path):
     result = generate("chain", "--kinds", "door,wheel", "--seed", 0, "--out", tmp_path / "x.json")
     assert result.returncode == 2
