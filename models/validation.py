@@ -22,8 +22,17 @@ INSIDE_TOLERANCE = 1e-6
 """A footprint may reach the lid edge up to this much beyond it [m] (rounding in files)."""
 
 
+MAX_MAGNITUDE = 1000.0
+"""Largest magnitude accepted for any pose or size entry [m or rad]: beyond it geometry overflows."""
+
+
 def _is_number(value: Any) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+    return (
+        isinstance(value, int | float)
+        and not isinstance(value, bool)
+        and math.isfinite(value)
+        and abs(value) <= MAX_MAGNITUDE
+    )
 
 
 def _is_state(value: Any) -> bool:
@@ -85,10 +94,10 @@ def validate_data(data: Any) -> list[SpecProblem]:
         elif kind not in KIND_NAMES:
             problem(f"{where}.kind", f"unknown kind {kind!r}; known kinds: {list(KIND_NAMES)}")
             ok = False
-        pose_lengths = (3,) if kind in PUZZLE_KINDS else (3, 6)
+        pose_lengths = (3,) if isinstance(kind, str) and kind in PUZZLE_KINDS else (3, 6)
         if not _number_list(comp.get("pose"), pose_lengths):
             shape = " or ".join(str(n) for n in pose_lengths)
-            problem(f"{where}.pose", f"must be a list of {shape} finite numbers [m, rad]")
+            problem(f"{where}.pose", f"must be a list of {shape} finite numbers within +-{MAX_MAGNITUDE:g} [m, rad]")
             ok = False
         marker = comp.get("marker")
         if marker is not None:

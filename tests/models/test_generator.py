@@ -91,12 +91,13 @@ def test_different_seeds_give_different_layouts():
 
 @settings(max_examples=40, deadline=None)
 @given(length=st.integers(2, 9), start=st.sampled_from(["door", "slide", "wheel"]), seed=st.integers(0, 2**31))
-def test_chains_of_any_allowed_kinds_are_valid_and_solved_in_chain_order(length, start, seed):
+def test_chains_of_any_allowed_kinds_are_deterministic_valid_and_solved_in_order(length, start, seed):
     rng = np.random.default_rng(seed)
     kinds = [start]
     while len(kinds) < length:
         kinds.append("slide" if kinds[-1] != "slide" else ["door", "wheel"][int(rng.integers(2))])
     spec = generate_chain(kinds, seed=seed)
+    assert generate_chain(kinds, seed=seed).to_json() == spec.to_json()
     assert validate_data(spec.to_dict()) == []
     assert LockTable.from_spec(spec).shortest_solution() == list(range(length))
     assert_lockers_sit_next_to_what_they_lock(spec)
@@ -104,8 +105,9 @@ def test_chains_of_any_allowed_kinds_are_valid_and_solved_in_chain_order(length,
 
 @settings(max_examples=60, deadline=None)
 @given(n=st.integers(4, 16), multi=st.booleans(), seed=st.integers(0, 2**31))
-def test_random_graphs_are_valid_solvable_and_local(n, multi, seed):
+def test_random_graphs_are_deterministic_valid_solvable_and_local(n, multi, seed):
     spec = generate_random(RandomGraphConfig(n, multi_locker=multi), seed=seed)
+    assert generate_random(RandomGraphConfig(n, multi_locker=multi), seed=seed).to_json() == spec.to_json()
     assert len(spec.components) == n
     assert validate_data(spec.to_dict()) == []  # includes: goal reachable from all-closed
     assert_lockers_sit_next_to_what_they_lock(spec)
