@@ -61,14 +61,6 @@ class LockTable:
             blocked |= locker_ok & locked_ok
         return ~blocked
 
-    def movable_mask(self, state: int) -> int:
-        """Bitmask of the components that can toggle in ``state``."""
-        mask = 0
-        for j in range(self.num_components):
-            if self.can_move(state, j):
-                mask |= 1 << j
-        return mask
-
     def is_goal(self, state: int) -> bool:
         return ((state >> self.goal) & 1) == self.goal_state
 
@@ -107,7 +99,9 @@ class LockTable:
             frontier = np.concatenate(next_states) if next_states else frontier[:0]
         return None
 
-    def _unwind(self, parent: np.ndarray, state: int, start: int) -> list[int]:
+    @staticmethod
+    def _unwind(parent: np.ndarray | dict[int, int], state: int, start: int) -> list[int]:
+        """The toggles from ``start`` to ``state`` along the search's parent links."""
         path = []
         while state != start:
             prev = int(parent[state])
@@ -126,12 +120,7 @@ class LockTable:
                     continue
                 parent[nxt] = state
                 if self.is_goal(nxt):
-                    path = []
-                    while nxt != start:
-                        prev = parent[nxt]
-                        path.append((prev ^ nxt).bit_length() - 1)
-                        nxt = prev
-                    return path[::-1]
+                    return self._unwind(parent, nxt, start)
                 if len(parent) > SPARSE_SEARCH_MAX_STATES:
                     raise ReachabilityUndecided(
                         f"searched {SPARSE_SEARCH_MAX_STATES} states of a {self.num_components}-component "

@@ -188,7 +188,7 @@ def spec_from_dict(data: Any, source: str | None = None) -> PuzzleSpec:
     problems = validate_data(data)
     if problems:
         raise SpecError(problems, source)
-    return _build(data)
+    return build_from_valid_data(data)
 
 
 def spec_from_json(text: str, source: str | None = None) -> PuzzleSpec:
@@ -221,8 +221,9 @@ def save_spec(spec: PuzzleSpec, path: str | Path) -> Path:
     return path
 
 
-def _build(data: dict[str, Any]) -> PuzzleSpec:
-    """Build a spec from data that passed validation; assigns missing marker ids."""
+def build_from_valid_data(data: dict[str, Any]) -> PuzzleSpec:
+    """Build a spec from data that passed :func:`~models.validation.validate_data` (no checks here);
+    assigns missing marker ids."""
     raw_components = data["components"]
     used = {c["marker"] for c in raw_components if c.get("marker") is not None}
     free = (i for i in range(len(raw_components) + len(used) + 1) if i not in used)

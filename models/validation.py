@@ -12,7 +12,8 @@ from typing import Any
 from models.errors import ReachabilityUndecided, SpecProblem
 from models.geometry import polygon_gap
 from models.kinds import KIND_NAMES, PUZZLE_KINDS, get_kind
-from models.spec import SPEC_FORMAT
+from models.lock_table import LockTable
+from models.spec import SPEC_FORMAT, build_from_valid_data
 
 MAX_COMPONENTS = 62
 """Symbolic states are 64-bit bitmasks; more components than this cannot be represented."""
@@ -213,10 +214,7 @@ def _check_geometry(data: dict[str, Any], components: dict[str, dict[str, Any]])
 
 
 def _check_reachable(data: dict[str, Any]) -> list[SpecProblem]:
-    from models.lock_table import LockTable
-    from models.spec import _build
-
-    spec = _build(data)
+    spec = build_from_valid_data(data)
     try:
         path = LockTable.from_spec(spec).shortest_solution()
     except ReachabilityUndecided as err:
