@@ -3,7 +3,7 @@ baselines). Imports only ``models`` — never ``twin`` or ``skills`` (DESIGN.md,
 
 import gymnasium
 
-from learning.agents import AGENT_FACTORIES, Agent, OracleAgent, RandomAgent, make_agent
+from learning.agents import AGENT_NAMES, Agent, DualAgent, MemoryAgent, OracleAgent, RandomAgent, make_agent
 from learning.errors import ConfigError, InvalidAction, LearningError, UnknownAgent
 from learning.puzzle_env import FaultConfig, PuzzleEnv, PuzzleEnvConfig
 from learning.symbolic_world import SymbolicWorld
@@ -13,13 +13,15 @@ gymnasium.register(id="puzzlebox/Puzzle-v0", entry_point="learning.puzzle_env:Pu
 """``gymnasium.make("puzzlebox/Puzzle-v0", spec=..., config=...)`` builds a :class:`PuzzleEnv`."""
 
 __all__ = [
-    "AGENT_FACTORIES",
+    "AGENT_NAMES",
     "ActionRecord",
     "Agent",
     "ConfigError",
+    "DualAgent",
     "FaultConfig",
     "InvalidAction",
     "LearningError",
+    "MemoryAgent",
     "OracleAgent",
     "PuzzleEnv",
     "PuzzleEnvConfig",

@@ -20,3 +20,7 @@ class UnknownAgent(LearningError, KeyError):
 
 class ConfigError(LearningError, ValueError):
     """A configuration value out of its documented range."""
+
+
+class MemoryFileError(LearningError):
+    """A memory file that cannot be used: missing, truncated, corrupted, foreign or of another schema."""

@@ -15,7 +15,7 @@ from pathlib import Path
 from _cli import fail, versions, write_json
 from tqdm import tqdm
 
-from learning import AGENT_FACTORIES, LearningError, SymbolicWorld, make_agent, run_episode, summarise
+from learning import AGENT_NAMES, LearningError, SymbolicWorld, make_agent, run_episode, summarise
 from models import SpecError, load_spec
 
 SIMS = ("symbolic", "twin")
@@ -30,14 +30,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, required=True, help="seed of run 0; run r uses seed + r")
     parser.add_argument("--max-actions", type=int, required=True, help="action budget per run")
     parser.add_argument("--out", required=True, help="output directory")
-    parser.add_argument("--agent", default="oracle", help=f"one of {sorted(AGENT_FACTORIES)}")
+    parser.add_argument("--agent", default="oracle", help=f"one of {sorted(AGENT_NAMES)}")
     parser.add_argument("--video", action="store_true", help="record rollout videos (twin only)")
     args = parser.parse_args(argv)
 
     if args.runs < 1 or args.max_actions < 1:
         fail("--runs and --max-actions must be >= 1")
-    if args.agent not in AGENT_FACTORIES:
-        fail(f"unknown agent {args.agent!r}. Available agents: {sorted(AGENT_FACTORIES)}")
+    if args.agent not in AGENT_NAMES:
+        fail(f"unknown agent {args.agent!r}. Available agents: {sorted(AGENT_NAMES)}")
     if args.sim != "symbolic":
         fail(f"--sim {args.sim} is not available yet; available: ['symbolic']")
     if args.memory is not None:

@@ -1,8 +1,9 @@
 """Agents that solve puzzles through a ``World``, and a factory by name."""
 
 from learning.agents.base import Agent
-from learning.agents.factory import AGENT_FACTORIES, make_agent
+from learning.agents.dual_agent import DualAgent, MemoryAgent
+from learning.agents.factory import AGENT_NAMES, make_agent
 from learning.agents.oracle_agent import OracleAgent
 from learning.agents.random_agent import RandomAgent
 
-__all__ = ["AGENT_FACTORIES", "Agent", "OracleAgent", "RandomAgent", "make_agent"]
+__all__ = ["AGENT_NAMES", "Agent", "DualAgent", "MemoryAgent", "OracleAgent", "RandomAgent", "make_agent"]

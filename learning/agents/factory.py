@@ -2,25 +2,31 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 from learning.agents.base import Agent
+from learning.agents.dual_agent import DualAgent, MemoryAgent
 from learning.agents.oracle_agent import OracleAgent
 from learning.agents.random_agent import RandomAgent
-from learning.errors import UnknownAgent
+from learning.errors import ConfigError, UnknownAgent
+from learning.memory.store import MemoryStore
 from models import PuzzleSpec
 
-AGENT_FACTORIES: dict[str, Callable[[PuzzleSpec], Agent]] = {
-    "random": lambda spec: RandomAgent(),
-    "oracle": OracleAgent,  # knows the spec's locks: the optimal floor on actions
-}
-"""Factories taking the spec to solve (only the oracle reads it)."""
+AGENT_NAMES = ("memory", "dual", "random", "oracle")
+"""``memory``: dual controller + memory prior (needs a memory); ``dual``: no memory; ``random``;
+``oracle``: knows the spec's locks and plays a shortest plan (the floor on actions)."""
 
 
-def make_agent(name: str, spec: PuzzleSpec) -> Agent:
+def make_agent(name: str, spec: PuzzleSpec, memory: MemoryStore | None = None) -> Agent:
     """A fresh agent for one puzzle; :class:`UnknownAgent` lists the names that exist."""
-    try:
-        factory = AGENT_FACTORIES[name]
-    except KeyError:
-        raise UnknownAgent(f"unknown agent {name!r}. Available agents: {sorted(AGENT_FACTORIES)}") from None
-    return factory(spec)
+    if name == "memory":
+        if memory is None:
+            raise ConfigError("agent 'memory' needs a memory (train one with scripts/train.py, pass --memory)")
+        return MemoryAgent(memory)
+    if memory is not None:
+        raise ConfigError(f"agent {name!r} takes no memory; --memory is for the memory agent")
+    if name == "dual":
+        return DualAgent()
+    if name == "random":
+        return RandomAgent()
+    if name == "oracle":
+        return OracleAgent(spec)
+    raise UnknownAgent(f"unknown agent {name!r}. Available agents: {list(AGENT_NAMES)}")

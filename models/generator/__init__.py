@@ -11,6 +11,7 @@ from models.generator.paper import (
     TRAIN_INDICES,
     paper_family,
     paper_sequences,
+    paper_variant,
     paper_variant_name,
 )
 from models.generator.random_graph import MAX_RANDOM_COMPONENTS, RandomGraphConfig, generate_random
@@ -27,5 +28,6 @@ __all__ = [
     "generate_random",
     "paper_family",
     "paper_sequences",
+    "paper_variant",
     "paper_variant_name",
 ]

@@ -45,6 +45,19 @@ def paper_variant_name(index: int) -> str:
     return f"paper-train-{TRAIN_INDICES.index(index)}"
 
 
+def paper_variant(index: int, seed: int, box: BoxConfig | None = None) -> PuzzleSpec:
+    """One paper variant (0..11) with a layout drawn from ``seed`` — for protocols that sample a new
+    layout per trial, as the paper does. The lid is sized to this layout alone unless ``box`` says."""
+    sequences = paper_sequences()
+    if not 0 <= index < len(sequences):
+        raise ValueError(f"paper variant index must be in 0..{len(sequences) - 1}, got {index}")
+    box = box or BoxConfig()
+    layout = chain_layout(sequences[index], np.random.default_rng([seed, index]), box.layout)
+    return assemble(
+        paper_variant_name(index), sequences[index], layout, chain_rules(PAPER_LENGTH), PAPER_LENGTH - 1, box
+    )
+
+
 def paper_family(split: Split = "all", seed: int = 0, box: BoxConfig | None = None) -> list[PuzzleSpec]:
     """The paper's boxes of a split, as specs; a pure function of (split, seed, box).
 

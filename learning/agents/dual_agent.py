@@ -1,0 +1,103 @@
+"""Agents built on the dual controller: ``dual`` (uninformed prior) and ``memory`` (prior from memory)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from learning.belief import Belief, default_prior
+from learning.dual_controller import Decision, DualControllerConfig, decide, max_entropy_for
+from learning.memory.keys import relative_pose_keys
+from learning.memory.prior import MemoryConfig, episode_record, recall_prior
+from learning.memory.store import MemoryStore
+from models import SceneObservation
+
+
+class DualAgent:
+    """The paper's dual controller starting every task from the uninformed prior."""
+
+    name = "dual"
+
+    def __init__(self, config: DualControllerConfig | None = None) -> None:
+        self.config = config or DualControllerConfig()
+        self.belief: Belief | None = None
+        self.decisions: list[Decision] = []
+        self._rng = np.random.default_rng(0)
+        self._states = np.zeros(0, dtype=np.int64)
+        self._h_max = 1.0
+
+    def initial_prior(self, observation: SceneObservation) -> np.ndarray:
+        return default_prior(len(observation), self.config.belief.prior_independent)
+
+    def begin_episode(self, observation: SceneObservation, rng: np.random.Generator) -> None:
+        self.belief = Belief(self.initial_prior(observation), self.config.belief)
+        self._h_max = max_entropy_for(len(observation), self.config)
+        self._rng = rng
+        self.decisions = []
+
+    def choose(self, observation: SceneObservation) -> int:
+        assert self.belief is not None, "begin_episode() first"
+        self._states = observation.states.copy()
+        decision = decide(
+            self.belief,
+            self._states,
+            observation.goal_index,
+            observation.goal_state,
+            self._rng,
+            self.config,
+            self._h_max,
+        )
+        self.decisions.append(decision)
+        return decision.action
+
+    def record(self, index: int, moved: bool, observation: SceneObservation) -> None:
+        assert self.belief is not None
+        self.belief.update(self._states, index, moved)  # the state in which the try was made
+
+    def end_episode(self, solved: bool) -> None:
+        pass
+
+
+class MemoryAgent(DualAgent):
+    """The dual controller with its prior recalled from a memory of past graphs (the paper's method).
+
+    With ``learn=True`` every finished episode's learned graph is added to the memory (training);
+    evaluation leaves the memory untouched.
+    """
+
+    name = "memory"
+
+    def __init__(
+        self,
+        store: MemoryStore,
+        config: DualControllerConfig | None = None,
+        memory_config: MemoryConfig | None = None,
+        learn: bool = False,
+    ) -> None:
+        super().__init__(config)
+        self.store = store
+        self.memory_config = memory_config or MemoryConfig()
+        self.learn = learn
+        self.episode_label = ""
+        self._observation: SceneObservation | None = None
+
+    def initial_prior(self, observation: SceneObservation) -> np.ndarray:
+        self._observation = observation
+        return recall_prior(
+            self.store, observation.kinds, observation.poses, self.memory_config, self.config.belief.prior_independent
+        )
+
+    def end_episode(self, solved: bool) -> None:
+        if not self.learn or self.belief is None or self._observation is None:
+            return
+        observation = self._observation
+        pair_values, independence = episode_record(self.belief.probs)
+        keys = relative_pose_keys(observation.poses, self.store.position_scale)
+        self.store.add_episode(
+            observation.kinds,
+            keys,
+            pair_values,
+            independence,
+            spec=self.episode_label,
+            solved=solved,
+            num_actions=len(self.decisions),
+        )

@@ -1,0 +1,167 @@
+"""Belief over the lock dependency graph (the paper's Methods, "Exploration Policy").
+
+For every component ``n`` and each of its states ``s``, a categorical ``Z[n, s]`` over hypotheses:
+"independent" (index 0) or "held in ``s`` by component ``m`` while ``m`` is in state ``s'``"
+(index ``1 + 2*m + s'``) — the paper's at-most-one-locker assumption. Hypotheses with ``m == n``
+have probability zero. The blocks are independent, so the whole belief is the product of the
+``2N`` categoricals.
+
+A try of ``n`` in joint state ``x`` is informative about ``Z[n, x_n]`` only. Under hypothesis ``h``
+the component is *held* iff ``h`` is a locker hypothesis ``(m, s')`` with ``x_m == s'``. The
+likelihood is noise-aware: ``P(no move | free) = jam_probability`` (epsilon) and
+``P(move | held) = false_move_probability`` (delta), so one false failure does not eliminate the
+truth; both zero give the paper's exact elimination.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from learning.errors import ConfigError
+
+
+@dataclass(frozen=True)
+class BeliefConfig:
+    """Prior and observation model of the belief."""
+
+    prior_independent: float = 0.7
+    """Prior probability that a component, in a state, is held by nothing (the authors' release: 0.7)."""
+    jam_probability: float = 0.0
+    """epsilon: probability that a free component fails to move when tried (a jam or a missed grasp)."""
+    false_move_probability: float = 0.0
+    """delta: probability that a held component is observed to move anyway (a misread outcome)."""
+
+    def __post_init__(self) -> None:
+        for name in ("prior_independent", "jam_probability", "false_move_probability"):
+            value = getattr(self, name)
+            if not 0.0 <= value <= 1.0:
+                raise ConfigError(f"{name} must be in [0, 1], got {value}")
+        if self.jam_probability + self.false_move_probability >= 1.0:
+            raise ConfigError("jam_probability + false_move_probability must be < 1 (outcomes must inform)")
+
+
+def hypothesis_count(num_components: int) -> int:
+    """Hypotheses per block: independent + (locker m, locker state s') for every m (m == n masked)."""
+    return 1 + 2 * num_components
+
+
+def default_prior(num_components: int, prior_independent: float = 0.7) -> np.ndarray:
+    """The no-memory prior, ``(N, 2, 1 + 2N)``: ``prior_independent`` on "independent", the rest
+    spread evenly over the ``2(N-1)`` locker hypotheses."""
+    n = num_components
+    probs = np.zeros((n, 2, hypothesis_count(n)))
+    probs[:, :, 0] = prior_independent if n > 1 else 1.0
+    if n > 1:
+        share = (1.0 - prior_independent) / (2 * (n - 1))
+        probs[:, :, 1:] = share
+        for c in range(n):
+            probs[c, :, 1 + 2 * c : 3 + 2 * c] = 0.0
+    return probs
+
+
+def block_entropy(p: np.ndarray) -> np.ndarray:
+    """Shannon entropy [nats] over the last axis."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        terms = np.where(p > 0.0, -p * np.log(p), 0.0)
+    return terms.sum(axis=-1)
+
+
+class Belief:
+    """The agent's belief over who holds whom (see the module docstring).
+
+    Attributes:
+        probs: ``(N, 2, 1 + 2N)`` probabilities; ``probs[n, s]`` sums to one.
+    """
+
+    def __init__(self, probs: np.ndarray, config: BeliefConfig | None = None) -> None:
+        probs = np.array(probs, dtype=np.float64)
+        n = probs.shape[0]
+        if probs.shape != (n, 2, hypothesis_count(n)):
+            raise ConfigError(f"belief must have shape (N, 2, 1 + 2N), got {probs.shape}")
+        for c in range(n):
+            probs[c, :, 1 + 2 * c : 3 + 2 * c] = 0.0  # nothing holds itself
+        totals = probs.sum(axis=-1, keepdims=True)
+        if np.any(totals <= 0.0) or np.any(probs < 0.0) or not np.all(np.isfinite(probs)):
+            raise ConfigError("every belief block needs non-negative, finite mass")
+        self.probs = probs / totals
+        self.config = config or BeliefConfig()
+
+    @classmethod
+    def uninformed(cls, num_components: int, config: BeliefConfig | None = None) -> Belief:
+        config = config or BeliefConfig()
+        return cls(default_prior(num_components, config.prior_independent), config)
+
+    @property
+    def num_components(self) -> int:
+        return self.probs.shape[0]
+
+    def copy(self) -> Belief:
+        return Belief(self.probs.copy(), self.config)
+
+    def held_mask(self, states: np.ndarray, component: int) -> np.ndarray:
+        """Boolean ``(1 + 2N,)``: which hypotheses of ``Z[component, states[component]]`` hold it in
+        joint state ``states``."""
+        states = np.asarray(states)
+        held = np.zeros(hypothesis_count(self.num_components), dtype=bool)
+        held[1 + 2 * np.arange(self.num_components) + states] = True
+        held[1 + 2 * component + states[component]] = False
+        return held
+
+    def probability_free(self, states: np.ndarray, component: int) -> float:
+        """Marginal probability that ``component`` is not held in joint state ``states``."""
+        block = self.probs[component, int(states[component])]
+        return float(1.0 - block[self.held_mask(states, component)].sum())
+
+    def probability_moves(self, states: np.ndarray, component: int) -> float:
+        """Probability of *observing* a move when trying ``component`` (noise included)."""
+        free = self.probability_free(states, component)
+        return free * (1.0 - self.config.jam_probability) + (1.0 - free) * self.config.false_move_probability
+
+    def posterior_block(self, states: np.ndarray, component: int, moved: bool) -> np.ndarray:
+        """The updated block ``Z[component, states[component]]`` after observing ``moved``.
+
+        If the observation has zero probability under every hypothesis (possible only without noise,
+        e.g. a puzzle with two lockers), the block falls back to the prior of an uninformed agent
+        rather than dividing by zero: the agent keeps acting instead of crashing.
+        """
+        block = self.probs[component, int(states[component])]
+        held = self.held_mask(states, component)
+        eps, delta = self.config.jam_probability, self.config.false_move_probability
+        if moved:
+            likelihood = np.where(held, delta, 1.0 - eps)
+        else:
+            likelihood = np.where(held, 1.0 - delta, eps)
+        posterior = block * likelihood
+        total = posterior.sum()
+        if total <= 0.0:
+            posterior = default_prior(self.num_components, self.config.prior_independent)[component, 0]
+            return posterior / posterior.sum()
+        return posterior / total
+
+    def update(self, states: np.ndarray, component: int, moved: bool) -> None:
+        """Bayes update after trying ``component`` in joint state ``states`` (the state *before* the try)."""
+        self.probs[component, int(states[component])] = self.posterior_block(states, component, moved)
+
+    def entropy(self) -> float:
+        """Total entropy of the belief [nats]: the sum over the 2N independent blocks."""
+        return float(block_entropy(self.probs).sum())
+
+    def free_probabilities(self, states_bits: np.ndarray) -> np.ndarray:
+        """``(S, N)`` marginal probability that each component is free in each of ``S`` joint states.
+
+        ``states_bits`` is ``(S, N)`` of 0/1. Vectorised: for planning over many states at once.
+        """
+        bits = np.asarray(states_bits, dtype=np.int64)
+        n = self.num_components
+        # locker_probs[c, s_c, m, s_m] = P(Z[c, s_c] = (m, s_m))
+        locker_probs = self.probs[:, :, 1:].reshape(n, 2, n, 2)
+        free = np.empty(bits.shape, dtype=np.float64)
+        columns = np.arange(n)
+        for c in range(n):
+            # held probability = sum_m P(Z[c, x_c] = (m, x_m))
+            table = locker_probs[c]  # (2, n, 2)
+            held = table[bits[:, c][:, None], columns[None, :], bits].sum(axis=1)
+            free[:, c] = 1.0 - held
+        return np.clip(free, 0.0, 1.0)

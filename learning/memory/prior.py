@@ -1,0 +1,110 @@
+"""A belief prior recalled from memory: k nearest neighbours per pair, averaged, with uniform mass.
+
+For a new task, every block ``Z[j, s_j]`` gets weight ``w_indep`` = the mean stored independence of
+``kind_j`` in ``s_j`` and, for every other component i and state s_i, ``w[i, s_i]`` = the mean of the
+k nearest stored blocks in bucket ``(kind_i, kind_j)`` around j's pose in i's frame (kernel-weighted,
+with the uninformed prior as a pseudo-neighbour: see :class:`MemoryConfig`). The weights are
+normalised, then ``uniform_mass`` is added to every possible hypothesis and the block renormalised, so
+a bad prior can still be unlearned. A bucket the memory has never filled falls back to the
+uninformed prior's value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from learning.belief import block_entropy, default_prior, hypothesis_count
+from learning.memory.keys import relative_pose_keys
+from learning.memory.store import MemoryStore
+
+
+@dataclass(frozen=True)
+class MemoryConfig:
+    """How memories become priors."""
+
+    k: int = 5
+    """Nearest neighbours averaged per pair (the authors' release: 5)."""
+    bandwidth: float | None = 1.0
+    """Gaussian kernel width in key units (``position_scale`` metres, or ~1 rad): neighbours are
+    weighted by ``exp(-d^2 / 2 bandwidth^2)`` and the uninformed prior counts as ``prior_weight``
+    of a neighbour, so a pose the memory has never seen near recalls the uninformed prior rather
+    than unrelated memories. None: the paper's plain average of the k nearest."""
+    prior_weight: float = 0.2
+    """Pseudo-count of the uninformed prior in the kernel average (only with a bandwidth)."""
+    weight_by_confidence: bool = True
+    """Weigh each recalled block by how resolved it was when stored (1 - entropy / max entropy), so
+    blocks an episode actually pinned down outweigh blocks it left vague. False: the paper's equal
+    weights."""
+ow recalled values become a block. ``normalise`` (the paper): weights = [mean independence of
+    the kind, recalled locker values], normalised. ``odds``: each recalled locker value q is the
+    chance that this pair holds, weighed as odds q / (1 - q) against 1 for "nothing holds it" — so
+    many weak memories do not add up to a strong one."""
+    uniform_mass: float = 0.01
+    """Added to every hypothesis before renormalising (the authors' release: 0.01)."""
+    position_scale: float = 0.02
+    """Length weighing like one unit of sin/cos in keys [m] (used when creating a memory)."""
+
+
+def recall_prior(
+    store: MemoryStore,
+    kinds: tuple[str, ...],
+    poses: np.ndarray,
+    config: MemoryConfig,
+    prior_independent: float = 0.7,
+) -> np.ndarray:
+    """The ``(N, 2, 1 + 2N)`` prior for a task with these kinds and poses (any common frame)."""
+    n = len(kinds)
+    fallback = default_prior(n, prior_independent)
+    if store.num_episodes == 0 or n < 2:
+        return fallback
+    keys = relative_pose_keys(poses, store.position_scale)
+    weights = np.zeros((n, 2, hypothesis_count(n)))
+    for j in range(n):
+        independence = store.independence_values(kinds[j])
+        weights[j, :, 0] = independence.mean(axis=0) if independence is not None else fallback[j, :, 0]
+        for i in range(n):
+            if i == j:
+                continue
+            bucket = store.pair_bucket(kinds[i], kinds[j])
+            if bucket is None:
+                weights[j, :, 1 + 2 * i : 3 + 2 * i] = fallback[j, :, 1 + 2 * i : 3 + 2 * i]
+                continue
+            distances = np.linalg.norm(bucket.keys - keys[i, j], axis=1)
+            nearest = np.argsort(distances, kind="stable")[: config.k]
+            values = bucket.values[nearest, :4].reshape(-1, 2, 2)  # (k, s_j, s_i)
+            # per neighbour and row s_j: kernel x confidence (ones for the paper's plain average)
+            neighbour_weights = np.ones((len(nearest), 2))
+            if config.bandwidth is not None:
+                neighbour_weights *= np.exp(-0.5 * (distances[nearest] / config.bandwidth) ** 2)[:, None]
+            if config.weight_by_confidence:
+                neighbour_weights *= bucket.values[nearest, 4:6]
+            uninformed = fallback[j, :, 1 + 2 * i : 3 + 2 * i]  # (s_j, s_i)
+            prior_weight = config.prior_weight if config.bandwidth is not None or config.weight_by_confidence else 0.0
+            total = neighbour_weights.sum(axis=0)[:, None] + prior_weight  # (s_j, 1)
+            block = (np.einsum("kr,krs->rs", neighbour_weights, values) + prior_weight * uninformed) / total
+            weights[j, :, 1 + 2 * i : 3 + 2 * i] = block
+    possible = fallback > 0.0
+    totals = weights.sum(axis=-1, keepdims=True)
+    probs = np.where(totals > 0.0, weights / np.where(totals > 0.0, totals, 1.0), fallback)
+    probs = np.where(possible, probs + config.uniform_mass, 0.0)
+    return probs / probs.sum(axis=-1, keepdims=True)
+
+
+def episode_record(probs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """What an episode's learned belief contributes to memory.
+
+    Returns:
+        pair_values: ``(N, N, 6)``, ``[i, j]`` = ``P(Z[j, s_j] = (i, s_i))`` for ``(s_j, s_i)`` in
+            (0,0), (0,1), (1,0), (1,1), then the confidence of blocks ``Z[j, 0]`` and ``Z[j, 1]``
+            (1 - entropy / log of the number of hypotheses: 1 = resolved, 0 = uniform).
+        independence: ``(N, 2)``, ``P(Z[j, s] = independent)``.
+    """
+    n = probs.shape[0]
+    lockers = probs[:, :, 1:].reshape(n, 2, n, 2)  # [j, s_j, i, s_i]
+    pair_values = lockers.transpose(2, 0, 1, 3).reshape(n, n, 4)  # [i, j, (s_j, s_i)]
+    possible = max(2 * n - 1, 2)  # hypotheses per block: independent + 2(N-1) lockers
+    confidence = np.clip(1.0 - block_entropy(probs) / np.log(possible), 0.0, 1.0)  # (j, s_j)
+    confidence_ij = np.broadcast_to(confidence[None, :, :], (n, n, 2))
+    return np.concatenate([pair_values, confidence_ij], axis=-1), probs[:, :, 0].copy()

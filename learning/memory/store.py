@@ -1,0 +1,232 @@
+"""The memory of learned dependency graphs, persisted in SQLite.
+
+After an episode, every ordered pair (i, j) contributes its learned belief block — the probabilities
+that i, in each of its states, holds j in each of j's states — to the bucket of its kinds
+``(kind_i, kind_j)``, keyed by j's pose in i's frame; every component contributes its probability of
+being independent (per state) to the bucket of its kind. Everything lives in memory for fast
+nearest-neighbour look-ups and, when a path is given, in an SQLite file: one transaction per
+episode, so a crash loses at most the episode in progress.
+
+A file that is not a puzzlebox memory (not SQLite, another application's database, a newer schema)
+or that is damaged (truncated, failed integrity check, malformed rows) raises
+:class:`~learning.errors.MemoryFileError`; it is never read as an empty memory.
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+import time
+from collections import defaultdict
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from learning.errors import MemoryFileError
+
+MEMORY_FORMAT = "puzzlebox-memory"
+PAIR_VALUE_SIZE = 6
+"""Per stored pair: 4 probabilities [s_j, s_i] and the confidence of j's two blocks."""
+SCHEMA_VERSION = 1
+
+_SCHEMA = """
+CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE episodes (
+    id INTEGER PRIMARY KEY, spec TEXT NOT NULL, solved INTEGER NOT NULL,
+    num_actions INTEGER NOT NULL, created REAL NOT NULL);
+CREATE TABLE pair_entries (
+    episode INTEGER NOT NULL REFERENCES episodes(id), kind_i TEXT NOT NULL, kind_j TEXT NOT NULL,
+    key BLOB NOT NULL, value BLOB NOT NULL);
+CREATE TABLE independence_entries (
+    episode INTEGER NOT NULL REFERENCES episodes(id), kind TEXT NOT NULL, value BLOB NOT NULL);
+"""
+
+
+@dataclass(frozen=True)
+class Bucket:
+    """Entries of one bucket: ``keys`` ``(M, K)`` and ``values`` ``(M, V)``."""
+
+    keys: np.ndarray
+    values: np.ndarray
+
+
+class MemoryStore:
+    """Buckets of past belief blocks; see the module docstring.
+
+    Pair values are 6 numbers: ``P(i in s_i holds j in s_j)`` for ``(s_j, s_i)`` = (0,0), (0,1),
+    (1,0), (1,1), then the confidence (1 - normalised entropy) of j's blocks for s_j = 0 and 1;
+    independence values are ``[P(indep | s=0), P(indep | s=1)]``.
+    """
+
+    def __init__(self, path: str | Path | None = None, position_scale: float = 0.02) -> None:
+        """Open (or create) a memory. ``path=None`` keeps it in RAM only.
+
+        Args:
+            path: SQLite file; created with ``position_scale`` when absent.
+            position_scale: length that weighs like one unit of sin/cos in keys [m]. An existing file
+                keeps the scale it was created with.
+        """
+        self.path = Path(path) if path is not None else None
+        self.position_scale = position_scale
+        self._pairs: dict[tuple[str, str], list[tuple[np.ndarray, np.ndarray]]] = defaultdict(list)
+        self._independence: dict[str, list[np.ndarray]] = defaultdict(list)
+        self._cache: dict[tuple[str, ...], Bucket] = {}
+        self.num_episodes = 0
+        self._conn: sqlite3.Connection | None = None
+        if self.path is not None:
+            self._open_file(self.path)
+
+    @classmethod
+    def open_existing(cls, path: str | Path) -> MemoryStore:
+        """Open a memory that must already exist (for evaluation)."""
+        if not Path(path).is_file():
+            raise MemoryFileError(f"no memory file at {path}; train one with scripts/train.py")
+        return cls(path)
+
+    # -- persistence -------------------------------------------------------------------------------
+    def _open_file(self, path: Path) -> None:
+        exists = path.exists() and path.stat().st_size > 0
+        if not exists:
+            path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            conn = sqlite3.connect(path)
+            if exists:
+                self._check(conn, path)
+                self._load(conn, path)
+            else:
+                with conn:
+                    conn.executescript(_SCHEMA)
+                    conn.executemany(
+                        "INSERT INTO meta VALUES (?, ?)",
+                        [
+                            ("format", MEMORY_FORMAT),
+                            ("schema_version", str(SCHEMA_VERSION)),
+                            ("position_scale", repr(self.position_scale)),
+                        ],
+                    )
+        except sqlite3.DatabaseError as err:
+            raise MemoryFileError(f"{path} is not a readable puzzlebox memory: {err}") from None
+        self._conn = conn
+
+    def _check(self, conn: sqlite3.Connection, path: Path) -> None:
+        status = conn.execute("PRAGMA integrity_check").fetchone()[0]
+        if status != "ok":
+            raise MemoryFileError(f"{path} is corrupted (SQLite integrity check: {status})")
+        tables = {row[0] for row in conn.execute("SELECT name FROM sqlite_master WHERE type='table'")}
+        if "meta" not in tables:
+            raise MemoryFileError(f"{path} is an SQLite file but not a puzzlebox memory (tables: {sorted(tables)})")
+        meta = dict(conn.execute("SELECT key, value FROM meta").fetchall())
+        if meta.get("format") != MEMORY_FORMAT:
+            raise MemoryFileError(f"{path} is not a puzzlebox memory (format {meta.get('format')!r})")
+        if meta.get("schema_version") != str(SCHEMA_VERSION):
+            raise MemoryFileError(
+                f"{path} has memory schema {meta.get('schema_version')}; this version reads {SCHEMA_VERSION}"
+            )
+        self.position_scale = float(meta["position_scale"])
+
+    def _load(self, conn: sqlite3.Connection, path: Path) -> None:
+        self.num_episodes = conn.execute("SELECT COUNT(*) FROM episodes").fetchone()[0]
+        for kind_i, kind_j, key, value in conn.execute(
+            "SELECT kind_i, kind_j, key, value FROM pair_entries ORDER BY rowid"
+        ):
+            key_arr, value_arr = _decode(key, path), _decode(value, path)
+            if value_arr.size != PAIR_VALUE_SIZE or key_arr.size not in (4, 9):
+                raise MemoryFileError(
+                    f"{path} has a malformed pair entry ({key_arr.size} key, {value_arr.size} values)"
+                )
+            self._pairs[(kind_i, kind_j)].append((key_arr, value_arr))
+        for kind, value in conn.execute("SELECT kind, value FROM independence_entries ORDER BY rowid"):
+            value_arr = _decode(value, path)
+            if value_arr.size != 2:
+                raise MemoryFileError(f"{path} has a malformed independence entry")
+            self._independence[kind].append(value_arr)
+
+    def close(self) -> None:
+        if self._conn is not None:
+            self._conn.close()
+            self._conn = None
+
+    # -- writing -----------------------------------------------------------------------------------
+    def add_episode(
+        self,
+        kinds: tuple[str, ...],
+        keys: np.ndarray,
+        pair_values: np.ndarray,
+        independence: np.ndarray,
+        spec: str = "",
+        solved: bool = True,
+        num_actions: int = 0,
+    ) -> None:
+        """Store one episode's learned graph.
+
+        Args:
+            kinds: kind of each component ``(N,)``.
+            keys: ``(N, N, K)`` relative-pose keys (``[i, j]``: j seen from i).
+            pair_values: ``(N, N, 6)`` — ``[i, j]`` the block of "i holds j" (see the class docstring).
+            independence: ``(N, 2)`` probability that each component is independent, per state.
+        """
+        n = len(kinds)
+        pairs = [
+            (kinds[i], kinds[j], keys[i, j].astype(np.float64), pair_values[i, j].astype(np.float64))
+            for i in range(n)
+            for j in range(n)
+            if i != j
+        ]
+        singles = [(kinds[j], independence[j].astype(np.float64)) for j in range(n)]
+        if self._conn is not None:
+            with self._conn:  # one transaction: the episode is stored whole or not at all
+                cursor = self._conn.execute(
+                    "INSERT INTO episodes (spec, solved, num_actions, created) VALUES (?, ?, ?, ?)",
+                    (spec, int(solved), num_actions, time.time()),
+                )
+                episode = cursor.lastrowid
+                self._conn.executemany(
+                    "INSERT INTO pair_entries VALUES (?, ?, ?, ?, ?)",
+                    [(episode, ki, kj, k.tobytes(), v.tobytes()) for ki, kj, k, v in pairs],
+                )
+                self._conn.executemany(
+                    "INSERT INTO independence_entries VALUES (?, ?, ?)",
+                    [(episode, kind, v.tobytes()) for kind, v in singles],
+                )
+        for ki, kj, k, v in pairs:
+            self._pairs[(ki, kj)].append((k, v))
+        for kind, v in singles:
+            self._independence[kind].append(v)
+        self._cache.clear()
+        self.num_episodes += 1
+
+    # -- reading -----------------------------------------------------------------------------------
+    def pair_bucket(self, kind_i: str, kind_j: str) -> Bucket | None:
+        entries = self._pairs.get((kind_i, kind_j))
+        if not entries:
+            return None
+        cache_key = ("pair", kind_i, kind_j)
+        if cache_key not in self._cache:
+            self._cache[cache_key] = Bucket(np.stack([k for k, _ in entries]), np.stack([v for _, v in entries]))
+        return self._cache[cache_key]
+
+    def independence_values(self, kind: str) -> np.ndarray | None:
+        """``(M, 2)`` stored independence probabilities of a kind, or None if never seen."""
+        entries = self._independence.get(kind)
+        return np.stack(entries) if entries else None
+
+    def summary(self) -> dict[str, object]:
+        return {
+            "episodes": self.num_episodes,
+            "pair_buckets": {f"{a}->{b}": len(v) for (a, b), v in sorted(self._pairs.items())},
+            "independence_buckets": {k: len(v) for k, v in sorted(self._independence.items())},
+            "position_scale": self.position_scale,
+        }
+
+    def __repr__(self) -> str:
+        return f"MemoryStore({json.dumps(self.summary())})"
+
+
+def _decode(blob: object, path: Path) -> np.ndarray:
+    if not isinstance(blob, bytes) or len(blob) % 8:
+        raise MemoryFileError(f"{path} has a malformed entry (not a float64 array)")
+    values = np.frombuffer(blob, dtype=np.float64)
+    if not np.all(np.isfinite(values)):
+        raise MemoryFileError(f"{path} has a non-finite entry")
+    return values.copy()
