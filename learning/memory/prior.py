@@ -32,15 +32,11 @@ class MemoryConfig:
     of a neighbour, so a pose the memory has never seen near recalls the uninformed prior rather
     than unrelated memories. None: the paper's plain average of the k nearest."""
     prior_weight: float = 0.2
-    """Pseudo-count of the uninformed prior in the kernel average (only with a bandwidth)."""
+    """Pseudo-count of the uninformed prior in the weighted average (with a bandwidth or confidence)."""
     weight_by_confidence: bool = True
     """Weigh each recalled block by how resolved it was when stored (1 - entropy / max entropy), so
     blocks an episode actually pinned down outweigh blocks it left vague. False: the paper's equal
     weights."""
-ow recalled values become a block. ``normalise`` (the paper): weights = [mean independence of
-    the kind, recalled locker values], normalised. ``odds``: each recalled locker value q is the
-    chance that this pair holds, weighed as odds q / (1 - q) against 1 for "nothing holds it" — so
-    many weak memories do not add up to a strong one."""
     uniform_mass: float = 0.01
     """Added to every hypothesis before renormalising (the authors' release: 0.01)."""
     position_scale: float = 0.02
