@@ -1,0 +1,87 @@
+"""Speed figures, measured in one run on this machine (ratios matter more than absolutes here).
+
+    python scripts/bench.py --out FILE
+
+- agent decision latency: median and 90th percentile milliseconds per dual-controller decision on
+  random lock graphs of N = 5, 10, 16 components (beliefs as they evolve during real episodes);
+- symbolic environment: steps per second of ``PuzzleEnv.step`` with random actions.
+Single-threaded numpy is enforced for the agent figures (one core).
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")  # one core, before numpy loads
+
+import argparse  # noqa: E402
+import platform  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+from _cli import versions, write_json  # noqa: E402
+
+from learning import DualAgent, PuzzleEnv, PuzzleEnvConfig, SymbolicWorld  # noqa: E402
+from models.generator import RandomGraphConfig, generate_random  # noqa: E402
+
+SIZES = (5, 10, 16)
+
+
+def decision_latency(n: int, episodes: int, max_decisions: int) -> dict[str, float]:
+    """Time every ``choose`` of the dual agent over a few episodes on random N-component graphs."""
+    times = []
+    for episode in range(episodes):
+        spec = generate_random(RandomGraphConfig(n, multi_locker=n >= 4), seed=episode)
+        world = SymbolicWorld(spec, episode)
+        agent = DualAgent()
+        observation = world.observe()
+        agent.begin_episode(observation, np.random.default_rng(episode))
+        for _ in range(max_decisions):
+            if observation.solved:
+                break
+            start = time.perf_counter()
+            index = agent.choose(observation)
+            times.append(time.perf_counter() - start)
+            moved = world.try_toggle(index)
+            observation = world.observe()
+            agent.record(index, moved, observation)
+    ms = 1000.0 * np.array(times)
+    return {"median_ms": float(np.median(ms)), "p90_ms": float(np.percentile(ms, 90)), "decisions": len(ms)}
+
+
+def env_steps_per_second(seconds: float = 1.0) -> float:
+    spec = generate_random(RandomGraphConfig(5), seed=0)
+    env = PuzzleEnv(spec, PuzzleEnvConfig(max_actions=10**9))
+    env.reset(seed=0)
+    actions = np.random.default_rng(0).integers(5, size=1_000_000)
+    steps, start = 0, time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        for a in actions[steps % 900_000 : steps % 900_000 + 1000]:
+            env.step(int(a))
+        steps += 1000
+    return steps / (time.perf_counter() - start)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--out", required=True, help="output JSON file")
+    parser.add_argument("--quick", action="store_true", help="fewer episodes (CI smoke run)")
+    args = parser.parse_args(argv)
+    episodes = 1 if args.quick else 5
+    results = {"command": "bench", "machine": platform.processor() or platform.machine(), "versions": versions()}
+    results["decision_latency"] = {}
+    for n in SIZES:
+        results["decision_latency"][f"N={n}"] = stats = decision_latency(n, episodes, max_decisions=3 * n)
+        print(f"decision latency N={n:>2}: median {stats['median_ms']:.3f} ms, p90 {stats['p90_ms']:.3f} ms "
+              f"over {stats['decisions']} decisions")  # fmt: skip
+    results["symbolic_env_steps_per_s"] = rate = env_steps_per_second(0.3 if args.quick else 2.0)
+    print(f"symbolic env: {rate:,.0f} steps/s")
+    path = write_json(Path(args.out), results)
+    print(f"-> {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
