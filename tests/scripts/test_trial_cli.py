@@ -57,5 +57,74 @@ def test_trial_refuses_unknown_agent_and_unbuilt_sim_without_traceback(tmp_path)
     assert twin.returncode == 2 and "Traceback" not in twin.stderr and "symbolic" in twin.stderr
     broken = tmp_path / "broken.json"
     broken.write_text("{")
-    bad_spec = run(ROOT / "scripts/trial.py", *common[:1], broken, *common[2:], "--sim", "symbolic")
+    bad_spec = run(ROOT / "scripts/trial.py", *common[:1], broken, *common[2:], "--sim", "symbolic", "--agent", "dual")
     assert bad_spec.returncode == 2 and "not valid JSON" in bad_spec.stderr
+
+
+def test_train_then_memory_trial_beats_dual_on_unseen_boxes(tmp_path):
+    specs = tmp_path / "specs"
+    assert run(ROOT / "scripts/generate.py", "paper", "--split", "all", "--out", specs).returncode == 0
+    memory = tmp_path / "memory.sqlite"
+    trained = run(
+        ROOT / "scripts/train.py",
+        "--specs",
+        *sorted(specs.glob("paper-train-*.json")),
+        "--episodes",
+        9,
+        "--memory",
+        memory,
+    )
+    assert trained.returncode == 0, trained.stderr
+    assert json.loads((tmp_path / "memory.sqlite.train.json").read_text())["runs"][8]["spec"] == "paper-train-8"
+    tests = sorted(specs.glob("paper-test-*.json"))
+    means = {}
+    for agent, extra in (("memory", ["--memory", memory]), ("dual", [])):
+        out = tmp_path / agent
+        result = run(
+            ROOT / "scripts/trial.py",
+            "--specs",
+            *tests,
+            "--sim",
+            "symbolic",
+            "--runs",
+            3,
+            "--seed",
+            0,
+            "--max-actions",
+            30,
+            "--out",
+            out,
+            "--agent",
+            agent,
+            *extra,
+        )
+        assert result.returncode == 0, result.stderr
+        means[agent] = json.loads((out / "results.json").read_text())["mean_actions"]
+    assert means["memory"] < means["dual"]
+
+
+def test_memory_trial_refuses_a_missing_or_foreign_memory(tmp_path):
+    specs = tmp_path / "specs"
+    run(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", specs)
+    common = [
+        "--specs",
+        specs / "paper-test-0.json",
+        "--sim",
+        "symbolic",
+        "--runs",
+        1,
+        "--seed",
+        0,
+        "--max-actions",
+        5,
+        "--out",
+        tmp_path / "o",
+        "--agent",
+        "memory",
+    ]
+    missing = run(ROOT / "scripts/trial.py", *common, "--memory", tmp_path / "none.sqlite")
+    assert missing.returncode == 2 and "no memory file" in missing.stderr
+    foreign = tmp_path / "foreign.sqlite"
+    foreign.write_bytes(b"this is not a database at all" * 100)
+    bad = run(ROOT / "scripts/trial.py", *common, "--memory", foreign)
+    assert bad.returncode == 2 and "Traceback" not in bad.stderr and "memory" in bad.stderr
