@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from learning.belief import Belief, default_prior
@@ -60,8 +62,9 @@ class DualAgent:
 class MemoryAgent(DualAgent):
     """The dual controller with its prior recalled from a memory of past graphs (the paper's method).
 
-    With ``learn=True`` every finished episode's learned graph is added to the memory (training);
-    evaluation leaves the memory untouched.
+    With ``learn=True`` every finished episode's learned graph is added to the memory (training), and
+    the controller explores more (``MemoryConfig.training_entropy_scale``); evaluation leaves the
+    memory untouched.
     """
 
     name = "memory"
@@ -76,6 +79,8 @@ class MemoryAgent(DualAgent):
         super().__init__(config)
         self.store = store
         self.memory_config = memory_config or MemoryConfig()
+        if learn and self.memory_config.training_entropy_scale is not None:
+            self.config = replace(self.config, entropy_scale=self.memory_config.training_entropy_scale)
         self.learn = learn
         self.episode_label = ""
         self._observation: SceneObservation | None = None

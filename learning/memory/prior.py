@@ -41,6 +41,12 @@ class MemoryConfig:
     """Added to every hypothesis before renormalising (the authors' release: 0.01)."""
     position_scale: float = 0.02
     """Length weighing like one unit of sin/cos in keys [m] (used when creating a memory)."""
+    training_entropy_scale: float | None = 0.5
+    """The controller's ``entropy_scale`` while learning (training episodes); None keeps the controller's.
+    A smaller h_max explores more, and only failed tries confirm a lock, so training episodes that
+    explore store sharper graphs; trials in the symbolic simulator are cheap. Chosen on the
+    validation split (memory of 6 training variants, the other 3 evaluated): 0.5 gave 7.04 mean
+    actions against 7.55 with the evaluation setting (4.0)."""
 
 
 def recall_prior(
