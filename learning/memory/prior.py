@@ -19,6 +19,9 @@ from learning.belief import block_entropy, default_prior, hypothesis_count
 from learning.memory.keys import relative_pose_keys
 from learning.memory.store import MemoryStore
 
+KEY_DECIMALS = 9
+"""Distances in key space are ranked at this resolution (key units ~ 2 cm / 1 rad)."""
+
 
 @dataclass(frozen=True)
 class MemoryConfig:
@@ -74,7 +77,9 @@ def recall_prior(
                 weights[j, :, 1 + 2 * i : 3 + 2 * i] = fallback[j, :, 1 + 2 * i : 3 + 2 * i]
                 continue
             distances = np.linalg.norm(bucket.keys - keys[i, j], axis=1)
-            nearest = np.argsort(distances, kind="stable")[: config.k]
+            # Rounded before ranking: equidistant memories (layouts on a grid make many) must rank in
+            # storage order, not by 1e-15 of rounding noise that depends on where the box stands.
+            nearest = np.argsort(np.round(distances, KEY_DECIMALS), kind="stable")[: config.k]
             values = bucket.values[nearest, :4].reshape(-1, 2, 2)  # (k, s_j, s_i)
             # per neighbour and row s_j: kernel x confidence (ones for the paper's plain average)
             neighbour_weights = np.ones((len(nearest), 2))

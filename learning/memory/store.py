@@ -86,9 +86,12 @@ class MemoryStore:
 
     # -- persistence -------------------------------------------------------------------------------
     def _open_file(self, path: Path) -> None:
-        exists = path.exists() and path.stat().st_size > 0
+        exists = path.exists()
+        if exists and path.stat().st_size == 0:  # a memory is never empty on disk: cut short or foreign
+            raise MemoryFileError(f"{path} is empty (0 bytes): truncated or not a puzzlebox memory")
         if not exists:
             path.parent.mkdir(parents=True, exist_ok=True)
+        conn = None
         try:
             conn = sqlite3.connect(path)
             if exists:
@@ -105,7 +108,11 @@ class MemoryStore:
                             ("position_scale", repr(self.position_scale)),
                         ],
                     )
-        except sqlite3.DatabaseError as err:
+        except (sqlite3.DatabaseError, MemoryFileError) as err:
+            if conn is not None:
+                conn.close()
+            if isinstance(err, MemoryFileError):
+                raise
             raise MemoryFileError(f"{path} is not a readable puzzlebox memory: {err}") from None
         self._conn = conn
 
@@ -123,7 +130,14 @@ class MemoryStore:
             raise MemoryFileError(
                 f"{path} has memory schema {meta.get('schema_version')}; this version reads {SCHEMA_VERSION}"
             )
-        self.position_scale = float(meta["position_scale"])
+        try:
+            self.position_scale = float(meta["position_scale"])
+        except (KeyError, ValueError):
+            raise MemoryFileError(
+                f"{path} has no valid position_scale in its meta table ({meta.get('position_scale')!r})"
+            ) from None
+        if not self.position_scale > 0.0:
+            raise MemoryFileError(f"{path} has a non-positive position_scale {self.position_scale}")
 
     def _load(self, conn: sqlite3.Connection, path: Path) -> None:
         self.num_episodes = conn.execute("SELECT COUNT(*) FROM episodes").fetchone()[0]
