@@ -11,11 +11,20 @@ export MUJOCO_GL ?= egl
 
 install: $(STAMP)
 
+# Headless rendering: EGL through Mesa (llvmpipe) on the CPU, OSMesa as the fallback (DESIGN.md).
+GL_PACKAGES := libegl1 libegl-mesa0 libgl1-mesa-dri libopengl0 libosmesa6
+
 # torch first and pinned: 2.13.0 resolves to the machine's local CPU build; any other version pulls CUDA.
+# robosuite only ships the xArm-7 model files: installed without its dependencies and never imported.
 $(STAMP): pyproject.toml Makefile
+	@dpkg -s $(GL_PACKAGES) >/dev/null 2>&1 || { \
+		echo "installing $(GL_PACKAGES)"; \
+		if [ "$$(id -u)" = 0 ]; then apt-get update -qq && apt-get install -y -qq $(GL_PACKAGES) >/dev/null; \
+		else sudo apt-get update -qq && sudo apt-get install -y -qq $(GL_PACKAGES) >/dev/null; fi; }
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check torch==2.13.0
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e ".[dev,baselines,cluster]"
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check --no-deps robosuite==1.5.2
 	touch $(STAMP)
 
 lint: $(STAMP)
