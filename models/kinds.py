@@ -7,18 +7,24 @@ x along the component's direction of motion, so that a marker seen by a camera g
 pose directly. Per kind:
 
 ``door``
-    A square flap lying in the lid plane, hinged along one edge. Frame origin: the flap centre.
-    +x points from the hinge edge to the free edge (where the handle is). The hinge axis is the line
-    ``x = -DOOR_HALF`` parallel to y; opening (state 1) turns the free edge up, out of the lid plane,
-    by ``travel`` [rad]. Footprint: the flap, ``[-DOOR_HALF, DOOR_HALF]^2``.
+    A flap lying in the lid plane, hinged along one edge. Frame origin: the marker centre.
+    +x points from the hinge edge to the free edge, where the handle stands. The hinge axis is the
+    line ``x = -DOOR_HALF`` parallel to y; opening (state 1) turns the free edge up, out of the lid
+    plane, by ``travel`` [rad]. Footprint: the flap, ``[-DOOR_HALF, DOOR_HALF + HANDLE_MARGIN] x
+    [-DOOR_HALF, DOOR_HALF]``.
 ``slide``
-    A square plate that slides in the lid plane along +x by ``travel`` [m] to open. Frame origin: the
-    plate centre when closed. Footprint: the plate's swept area, ``[-p, p + travel] x [-p, p]`` with
-    ``p = SLIDE_HALF``.
+    A plate that slides in the lid plane along +x by ``travel`` [m] to open. Frame origin: the
+    marker centre when closed; the knob stands behind the marker (-x). Footprint: the plate's swept
+    area, ``[-p - HANDLE_MARGIN, p + travel] x [-p, p]`` with ``p = SLIDE_HALF``.
 ``wheel``
     A disc that turns in the lid plane about the z axis through its centre, by ``travel`` [rad]
-    counter-clockwise to open. Frame origin: the disc centre; +x points at the handle knob when
-    closed. Footprint: the disc (a circumscribed 16-gon for overlap tests).
+    counter-clockwise to open. Frame origin: the disc centre (the marker centre); +x points at the
+    handle knob when closed. Footprint: the disc (a circumscribed 16-gon for overlap tests).
+
+Every marker is ``MARKER_SIZE`` wide (black square) inside a one-bit white quiet zone; every handle
+is a 12 mm square post ``HANDLE_HEIGHT`` tall, clear of the quiet zone, so the overview camera reads
+every marker and the gripper closes on every handle (DESIGN.md: 12 mm square handles at least 3 cm
+above the surface were grasped in every randomized run).
 
 Dimensions are chosen for the xArm-7's gripper and for markers an overview camera reads reliably;
 travels follow the motions measured on this stack in DESIGN.md (door 85 deg, slide 50 mm, wheel 85 deg).
@@ -36,11 +42,22 @@ from models.errors import UnknownKindError
 from models.geometry import circle_polygon, rectangle, transform_points
 
 DOOR_HALF = 0.035
-"""Half the side of the square door flap [m]."""
+"""Half the width of the door flap, and its extent behind the marker centre to the hinge [m]."""
 SLIDE_HALF = 0.025
-"""Half the side of the square slide plate [m]."""
+"""Half the width of the slide plate, and its extent ahead of the marker centre [m]."""
 WHEEL_RADIUS = 0.045
 """Radius of the wheel disc [m]."""
+MARKER_SIZE = 0.036
+"""Side of every component's ArUco marker (black square) [m]: ~38 px from the overview camera."""
+HANDLE_SIZE = 0.012
+"""Side of the square handle posts [m]."""
+HANDLE_HEIGHT = 0.035
+"""Height of the handle posts above the component's top face [m]."""
+HANDLE_MARGIN = 0.011
+"""Extra flap/plate length beyond the half-width that carries the handle clear of the marker [m]."""
+HANDLE_OFFSET = 0.035
+"""Distance of the handle centre from the marker centre along the component's x [m]: clear of the
+marker's quiet zone (MARKER_SIZE / 2 * 4 / 3 = 24 mm) by 5 mm."""
 
 
 @dataclass(frozen=True)
@@ -59,6 +76,8 @@ class KindTemplate:
     """Joint travel from state 0 to state 1 [rad for hinges, m for slides]."""
     marker_size: float
     """Side of the ArUco marker's black square [m]."""
+    handle_xy: tuple[float, float]
+    """Centre of the handle post in the component frame, state 0 [m]."""
     footprint: np.ndarray = field(repr=False, compare=False)
     """Convex polygon ``(n, 2)`` [m] in the component frame that the component occupies on the lid."""
 
@@ -73,8 +92,9 @@ DOOR = KindTemplate(
     joint_axis=(0.0, -1.0, 0.0),  # right-handed about -y lifts the +x (free) edge
     joint_origin=(-DOOR_HALF, 0.0, 0.0),
     travel=math.radians(85.0),
-    marker_size=0.04,
-    footprint=rectangle(-DOOR_HALF, DOOR_HALF, -DOOR_HALF, DOOR_HALF),
+    marker_size=MARKER_SIZE,
+    handle_xy=(HANDLE_OFFSET, 0.0),
+    footprint=rectangle(-DOOR_HALF, DOOR_HALF + HANDLE_MARGIN, -DOOR_HALF, DOOR_HALF),
 )
 SLIDE = KindTemplate(
     name="slide",
@@ -82,8 +102,9 @@ SLIDE = KindTemplate(
     joint_axis=(1.0, 0.0, 0.0),
     joint_origin=(0.0, 0.0, 0.0),
     travel=0.05,
-    marker_size=0.036,
-    footprint=rectangle(-SLIDE_HALF, SLIDE_HALF + 0.05, -SLIDE_HALF, SLIDE_HALF),
+    marker_size=MARKER_SIZE,
+    handle_xy=(-HANDLE_OFFSET, 0.0),
+    footprint=rectangle(-SLIDE_HALF - HANDLE_MARGIN - 0.005, SLIDE_HALF + 0.05, -SLIDE_HALF, SLIDE_HALF),
 )
 WHEEL = KindTemplate(
     name="wheel",
@@ -91,7 +112,8 @@ WHEEL = KindTemplate(
     joint_axis=(0.0, 0.0, 1.0),
     joint_origin=(0.0, 0.0, 0.0),
     travel=math.radians(85.0),
-    marker_size=0.04,
+    marker_size=MARKER_SIZE,
+    handle_xy=(HANDLE_OFFSET, 0.0),
     footprint=circle_polygon(WHEEL_RADIUS),
 )
 

@@ -96,8 +96,8 @@ def test_overlapping_components_are_rejected(spec_dict):
 
 
 def test_touching_components_do_not_overlap(spec_dict):
-    # door spans x in [-0.155, -0.085]; a slide at yaw 0 spans [x-0.025, x+0.075]: touching at x=-0.06
-    spec_dict["components"][1]["pose"] = [-0.06, 0.05, 0.0]
+    # door spans x in [-0.155, -0.074]; a slide at yaw 0 spans [x-0.041, x+0.075]: touching at x=-0.033
+    spec_dict["components"][1]["pose"] = [-0.033, 0.05, 0.0]
     assert validate_data(spec_dict) == []
 
 
