@@ -1,6 +1,12 @@
 """puzzlebox shared vocabulary: puzzle specs, component kinds, lock semantics, the generator and
 the symbolic observation / ``World`` protocol that the agent and the robot pipeline both speak."""
 
+import os
+
+# Headless by default: dm_control and mujoco pick their GL backend at import time (DESIGN.md: EGL
+# renders on the CPU here); a user's own MUJOCO_GL wins.
+os.environ.setdefault("MUJOCO_GL", "egl")
+
 from models.errors import (
     GeneratorError,
     ModelsError,
