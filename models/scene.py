@@ -141,13 +141,21 @@ def build_scene(spec: PuzzleSpec, config: SceneConfig | None = None) -> Scene:
     root.option.cone = "elliptic"  # DESIGN.md grasping: elliptic cones + impratio 10 hold the handles
     root.option.impratio = 10
     root.option.flag.autoreset = "disable"  # divergence must raise, never silently reset
-    root.visual.headlight.ambient = [0.35, 0.35, 0.35]
-    root.visual.headlight.diffuse = [0.5, 0.5, 0.5]
+    root.visual.headlight.ambient = [0.25, 0.25, 0.25]
+    root.visual.headlight.diffuse = [0.3, 0.3, 0.3]
     getattr(root.visual, "global").offwidth = 1280
     getattr(root.visual, "global").offheight = 960
 
     world = root.worldbody
-    world.add("light", name="key_light", pos=[0.4, -0.3, 1.6], dir=[-0.1, 0.2, -1], directional=True, castshadow=True)
+    world.add(
+        "light",
+        name="key_light",
+        pos=[0.4, -0.3, 1.6],
+        dir=[-0.1, 0.2, -1],
+        directional=True,
+        castshadow=True,
+        diffuse=[0.55, 0.55, 0.55],
+    )
     world.add("geom", name="floor", type="plane", size=[2, 2, 0.05], pos=[0, 0, -0.75], rgba=[0.5, 0.5, 0.52, 1])
     world.add("geom", name="table", type="box", size=[0.6, 0.7, 0.375], pos=[0.35, 0, -0.375], rgba=[0.9, 0.9, 0.88, 1])
     cx, cy = config.overview_xy

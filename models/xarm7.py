@@ -37,8 +37,9 @@ _SERVO_CLASS = {1: 0, 2: 0, 3: 1, 4: 1, 5: 1, 6: 2, 7: 2}
 _SERVO_GAINS = ((1500.0, 150.0, 50.0, 10.0), (1000.0, 100.0, 30.0, 5.0), (800.0, 80.0, 20.0, 2.0))
 TCP_OFFSET = 0.172
 """TCP along the gripper's approach axis from the gripper base (between the finger pads) [m]."""
-HOME_QPOS = (0.0, -0.247, 0.0, 0.909, 0.0, 1.156, 0.0)
-"""A home posture [rad]: the TCP above the table in front of the robot, gripper pointing down."""
+HOME_QPOS = (-1.5708, -0.247, 0.0, 0.909, 0.0, 1.156, 0.0)
+"""The rest posture [rad]: Menagerie's home turned a quarter turn about the base, so the gripper
+points down 40 cm to the robot's right, out of the overview camera's view of the workspace."""
 
 
 class RobotAssetsMissing(ModelsError):

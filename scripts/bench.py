@@ -4,7 +4,10 @@
 
 - agent decision latency: median and 90th percentile milliseconds per dual-controller decision on
   random lock graphs of N = 5, 10, 16 components (beliefs as they evolve during real episodes);
-- symbolic environment: steps per second of ``PuzzleEnv.step`` with random actions.
+- symbolic environment: steps per second of ``PuzzleEnv.step`` with random actions;
+- twin: scene build + compile time; bare ``mj_step`` rate on the compiled paper scene (one step per
+  call, as a Python user steps, and ``nstep`` in C) beside the twin's rate on the same model, with
+  their ratio; overview render time per 640x480 frame without and with shadows.
 Single-threaded numpy is enforced for the agent figures (one core).
 """
 
@@ -64,6 +67,56 @@ def env_steps_per_second(seconds: float = 1.0) -> float:
     return steps / (time.perf_counter() - start)
 
 
+def twin_figures(quick: bool) -> dict[str, float]:
+    import mujoco
+
+    from models.generator import paper_family
+    from models.scene import build_scene
+    from twin.rendering import RenderConfig, Renderer
+    from twin.session import TwinSession
+
+    specs = paper_family("test")
+    build_times = []
+    for spec in specs * (1 if quick else 3):
+        start = time.perf_counter()
+        build_scene(spec).compile()
+        build_times.append(time.perf_counter() - start)
+    steps = 2000 if quick else 10000
+    session = TwinSession(specs[0], seed=0)
+    model, data = session.model, mujoco.MjData(session.model)
+    mujoco.mj_resetData(model, data)
+    data.qpos[session.arm_qpos] = data.ctrl[session.arm_actuators] = session.config.home_qpos
+    runs = {
+        "bare_mj_step_per_call": lambda: [mujoco.mj_step(model, data) for _ in range(steps)],
+        "bare_mj_step_nstep": lambda: mujoco.mj_step(model, data, nstep=steps),
+        "twin_step": lambda: session.step(steps),
+    }
+    samples: dict[str, list[float]] = {label: [] for label in runs}
+    for _ in range(3 if quick else 7):  # interleaved, medians: the machine is shared and noisy
+        for label, run in runs.items():
+            start = time.perf_counter()
+            run()
+            samples[label].append(steps / (time.perf_counter() - start))
+    rates = {label: float(np.median(v)) for label, v in samples.items()}
+    out = {
+        "scene_build_compile_s_median": float(np.median(build_times)),
+        **{f"{k}_per_s": v for k, v in rates.items()},
+        "twin_over_bare_per_call": rates["twin_step"] / rates["bare_mj_step_per_call"],
+        "twin_over_bare_nstep": rates["twin_step"] / rates["bare_mj_step_nstep"],
+    }
+    for shadows in (False, True):
+        with Renderer(model, RenderConfig(shadows=shadows)) as renderer:
+            renderer.render(session.data, "overview")  # warm-up: first frame compiles shaders
+            times = []
+            for _ in range(5 if quick else 30):
+                start = time.perf_counter()
+                renderer.render(session.data, "overview")
+                times.append(time.perf_counter() - start)
+        out[f"overview_render_ms_{'shadows' if shadows else 'no_shadows'}"] = 1000 * float(np.median(times))
+    session.close()
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", required=True, help="output JSON file")
@@ -78,6 +131,14 @@ def main(argv: list[str] | None = None) -> int:
               f"over {stats['decisions']} decisions")  # fmt: skip
     results["symbolic_env_steps_per_s"] = rate = env_steps_per_second(0.3 if args.quick else 2.0)
     print(f"symbolic env: {rate:,.0f} steps/s")
+    results["twin"] = twin = twin_figures(args.quick)
+    print(
+        f"twin: build+compile {twin['scene_build_compile_s_median']:.3f} s; bare mj_step "
+        f"{twin['bare_mj_step_per_call_per_s']:,.0f}/s per call, {twin['bare_mj_step_nstep_per_s']:,.0f}/s nstep; "
+        f"twin {twin['twin_step_per_s']:,.0f}/s (x{twin['twin_over_bare_per_call']:.2f} per call, "
+        f"x{twin['twin_over_bare_nstep']:.2f} nstep); overview render {twin['overview_render_ms_no_shadows']:.1f} ms "
+        f"({twin['overview_render_ms_shadows']:.1f} ms with shadows)"
+    )
     path = write_json(Path(args.out), results)
     print(f"-> {path}")
     return 0

@@ -4,6 +4,7 @@
     python scripts/generate.py chain --kinds door,slide,wheel --seed S --out FILE
     python scripts/generate.py random --components N --seed S [--multi-locker] --out FILE
     python scripts/generate.py validate FILE...     # exit 1 and one line per problem if any is invalid
+    python scripts/generate.py mjcf SPEC --out DIR  # DIR/scene.xml + assets, loadable by mujoco
 
 ``--plot`` on paper/chain/random also writes a top view of each layout (PNG beside the JSON).
 
@@ -43,6 +44,17 @@ def _chain(args: argparse.Namespace) -> None:
 def _random(args: argparse.Namespace) -> None:
     config = RandomGraphConfig(num_components=args.components, multi_locker=args.multi_locker)
     _write(generate_random(config, seed=args.seed, name=args.name), Path(args.out), args.plot)
+
+
+def _mjcf(args: argparse.Namespace) -> None:
+    from models.scene import build_scene  # MuJoCo only when asked
+
+    try:
+        spec = load_spec(args.spec)
+    except SpecError as err:
+        fail(str(err))
+    path = build_scene(spec).export(args.out)
+    print(f"wrote {path} and its assets ({len(list(Path(args.out).iterdir())) - 1} files)")
 
 
 def _validate(args: argparse.Namespace) -> int:
@@ -89,6 +101,11 @@ def main(argv: list[str] | None = None) -> int:
     rand.add_argument("--name", default=None, help="spec name (default: derived from N and seed)")
     rand.add_argument("--plot", action="store_true", help="also write a top-view PNG beside each JSON")
     rand.set_defaults(run=_random)
+
+    scene = verbs.add_parser("mjcf", help="the MuJoCo scene of a spec: DIR/scene.xml + assets")
+    scene.add_argument("spec", help="puzzle spec file")
+    scene.add_argument("--out", required=True, help="output directory")
+    scene.set_defaults(run=_mjcf)
 
     validate = verbs.add_parser("validate", help="check spec files; exit 1 if any is invalid")
     validate.add_argument("files", nargs="+")

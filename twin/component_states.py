@@ -37,10 +37,12 @@ class ComponentStates:
 
     def update(self, q: np.ndarray) -> bool:
         """Update from joint positions ``q`` [rad or m]; True if any state changed."""
-        new = np.where(q >= self.open_at, 1, np.where(q <= self.close_at, 0, self.states))
-        changed = bool(np.any(new != self.states))
-        self.states = new
-        return changed
+        flips = np.flatnonzero(np.where(self.states == 0, q >= self.open_at, q <= self.close_at))
+        if flips.size == 0:  # the common case, kept cheap: this runs every few physics steps
+            return False
+        self.states = self.states.copy()
+        self.states[flips] ^= 1
+        return True
 
     def reset(self, q: np.ndarray) -> None:
         """States from scratch: open past the middle of the travel, else closed."""

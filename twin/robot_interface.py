@@ -105,9 +105,14 @@ class RobotInterface:
 
     # -- the wrist F/T sensor ----------------------------------------------------------------------
     def wrench(self) -> np.ndarray:
-        """``[Fx, Fy, Fz, Tx, Ty, Tz]`` in the sensor frame [N, N·m], minus the tare, with sensor noise."""
+        """``[Fx, Fy, Fz, Tx, Ty, Tz]`` in the sensor frame [N, N·m], minus the tare, with sensor noise.
+
+        The load on the sensor: what the gripper exerts on the flange. At rest it is the gripper's
+        weight (7.37 N, downwards in the base frame); a push ``F`` on the gripper or on what it holds
+        adds ``F``. (MuJoCo's force sensor reports the opposite, the arm's support of the gripper.)
+        """
         s = self._session
-        raw = np.concatenate(
+        raw = -np.concatenate(
             [s.data.sensordata[self._force : self._force + 3], s.data.sensordata[self._torque : self._torque + 3]]
         )
         noise = np.concatenate(

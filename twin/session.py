@@ -37,9 +37,9 @@ class TwinConfig:
 
     scene: SceneConfig = field(default_factory=SceneConfig)
     hysteresis: HysteresisConfig = field(default_factory=HysteresisConfig)
-    latch_period: int = 5
-    """Physics steps between latch updates and divergence checks (5 x 2 ms: a latch falls into place
-    within 10 ms; checking every step would cost ~a third of the stepping speed)."""
+    latch_period: int = 10
+    """Physics steps between latch updates and divergence checks (10 x 2 ms: a latch falls into place
+    within 20 ms, as a spring latch would; checking every step would cost ~a third of the stepping speed)."""
     force_noise_std: float = 0.05
     """Standard deviation of the wrist force noise [N] (a 6-axis F/T sensor of the xArm class)."""
     torque_noise_std: float = 0.002

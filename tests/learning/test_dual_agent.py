@@ -1,5 +1,7 @@
 """The dual controller and the agents built on it: memory beats no memory, runs are reproducible."""
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -124,7 +126,13 @@ def needs_two_lockers(spec) -> bool:
     return bool(doubly & set(table.shortest_solution()))
 
 
-@pytest.mark.parametrize("spec_seed", [3, 5, 12])
+def two_locker_seeds(count: int) -> list[int]:
+    """The first generator seeds whose 6-component puzzle needs a component with two lockers opened."""
+    seeds = (s for s in range(200) if needs_two_lockers(generate_random(RandomGraphConfig(6, multi_locker=True), s)))
+    return list(itertools.islice(seeds, count))
+
+
+@pytest.mark.parametrize("spec_seed", two_locker_seeds(3))
 def test_dual_agent_solves_random_puzzles_with_two_lockers_within_a_generous_budget(spec_seed):
     spec = generate_random(RandomGraphConfig(6, multi_locker=True), spec_seed)
     assert needs_two_lockers(spec)
@@ -135,20 +143,26 @@ def test_dual_agent_solves_random_puzzles_with_two_lockers_within_a_generous_bud
         assert result.num_actions >= optimum
 
 
+EXACT_CONTROLLER = DualControllerConfig(belief=EXACT)
 NOISY = DualControllerConfig(belief=BeliefConfig(jam_probability=0.05, false_move_probability=0.025))
 
 
-@pytest.mark.parametrize(("spec_seed", "seed"), [(4, 6), (4, 9), (23, 3), (23, 6)])
+@pytest.mark.parametrize(("spec_seed", "seed"), [(4, 6), (4, 9), (10, 6), (59, 3)])
 def test_noise_aware_dual_agent_solves_the_two_locker_puzzles_that_trap_exact_elimination(spec_seed, seed):
     spec = generate_random(RandomGraphConfig(6, multi_locker=True), spec_seed)
     result = run_episode(DualAgent(NOISY), SymbolicWorld(spec, seed), spec.name, seed, max_actions=100)
     assert result.solved
 
 
-@pytest.mark.parametrize(("spec_seed", "seed"), [(4, 6), (23, 3)])
+@pytest.mark.parametrize(("spec_seed", "seed"), [(4, 6), (10, 6), (59, 3)])
 def test_default_dual_agent_solves_two_locker_puzzles_where_exact_elimination_cycles(spec_seed, seed):
-    # With epsilon = delta = 0 these runs repeat a 14-action cycle: every failure with only one of the
-    # goal's two lockers open blames the wrong locker. The default noise floor keeps them solvable.
+    # With epsilon = delta = 0 these runs cycle for 300 actions: every failure with only one of the
+    # goal's two lockers open blames the wrong locker. The default noise floor solves them. (It does not
+    # solve everything: 3 of 1000 six-component two-locker runs still cycle, a limit of the paper's
+    # single-locker belief.)
+    spec = generate_random(RandomGraphConfig(6, multi_locker=True), spec_seed)
+    exact = run_episode(DualAgent(EXACT_CONTROLLER), SymbolicWorld(spec, seed), "exact", seed, max_actions=300)
+    assert not exact.solved
     spec = generate_random(RandomGraphConfig(6, multi_locker=True), spec_seed)
     assert needs_two_lockers(spec)
     result = run_episode(DualAgent(), SymbolicWorld(spec, seed), spec.name, seed, max_actions=300)

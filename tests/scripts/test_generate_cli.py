@@ -101,3 +101,20 @@ def test_validate_lists_every_problem_and_still_checks_the_other_files(tmp_path,
 def test_unknown_verb_is_a_usage_error():
     result = generate("teleport")
     assert result.returncode == 2 and "invalid choice" in result.stderr
+
+
+def test_mjcf_writes_a_scene_plain_mujoco_loads(tmp_path):
+    import mujoco
+
+    assert generate("paper", "--split", "test", "--out", tmp_path / "specs").returncode == 0
+    result = generate("mjcf", tmp_path / "specs" / "paper-test-0.json", "--out", tmp_path / "scene")
+    assert result.returncode == 0, result.stderr
+    model = mujoco.MjModel.from_xml_path(str(tmp_path / "scene" / "scene.xml"))
+    assert model.nu == 8 and model.neq == 8  # 7 arm servos + gripper; 3 gripper couplings + 5 latches
+
+
+def test_mjcf_refuses_an_invalid_spec_without_traceback(tmp_path):
+    bad = tmp_path / "bad.json"
+    bad.write_text("{}")
+    result = generate("mjcf", bad, "--out", tmp_path / "scene")
+    assert result.returncode == 2 and "Traceback" not in result.stderr and "format" in result.stderr

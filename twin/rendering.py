@@ -1,0 +1,370 @@
+"""Headless RGB rendering of a MuJoCo model's named cameras, with their pinhole intrinsics and poses.
+
+OpenGL backend
+--------------
+The :class:`Renderer` owns its OpenGL context and picks the backend from the ``MUJOCO_GL`` environment
+variable, as MuJoCo does: ``egl`` (the default when ``MUJOCO_GL`` is unset: headless, on the GPU or
+on the CPU through Mesa's llvmpipe), ``osmesa`` (pure software, needs ``libosmesa6``) or ``glfw`` (needs
+a display). It creates the context itself instead of going through ``mujoco.Renderer``, so it works
+whatever ``MUJOCO_GL`` was when ``mujoco`` was first imported (unset, MuJoCo would have chosen GLFW,
+which fails without a display).
+
+There is no automatic fallback from EGL to OSMesa within one process, on purpose. PyOpenGL fixes its
+platform at its first import (``PYOPENGL_PLATFORM``, which ``mujoco.egl`` sets to ``egl``), and once
+``libEGL`` is loaded MuJoCo's GL loader finds it before ``libOSMesa`` and fails with "gladLoadGL error"
+on an OSMesa context (measured with mujoco 3.17.0). So when EGL fails, :class:`Renderer` raises a
+:class:`~twin.errors.RenderingError` telling to start the process with ``MUJOCO_GL=osmesa``.
+
+Shadows are off unless asked for (:attr:`RenderConfig.shadows`): on the CPU they make a frame 3-4x
+slower (DESIGN.md) and ArUco detection does not need them.
+
+Camera conventions
+------------------
+MuJoCo cameras look along their -z axis with y up. :meth:`Renderer.camera_pose_in_world` returns the
+OpenCV camera frame (x right, y down, z forward) so that poses from ``cv2.solvePnP`` compose with it
+directly: ``T_world_marker = T_world_camera @ T_camera_marker``. :meth:`Renderer.camera_intrinsics`
+uses OpenCV's pixel convention (integer coordinates at pixel centres), which puts the principal point
+of a centred camera at ``((W - 1) / 2, (H - 1) / 2)``, not ``(W / 2, H / 2)``.
+"""
+
+from __future__ import annotations
+
+import atexit
+import contextlib
+import importlib
+import math
+import os
+import threading
+import warnings
+import weakref
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from twin.errors import RenderingError, UnknownCamera
+
+__all__ = [
+    "GL_BACKENDS",
+    "RenderConfig",
+    "Renderer",
+    "gl_backend",
+]
+
+GL_BACKENDS: tuple[str, ...] = ("egl", "osmesa", "glfw")
+"""OpenGL backends a :class:`Renderer` can use, as spelled in ``MUJOCO_GL``."""
+
+# MUJOCO_GL values that MuJoCo itself accepts to mean "its default": here the default is headless EGL.
+_DEFAULT_VALUES = ("", "enable", "enabled", "on", "true", "1")
+_DISABLED_VALUES = ("disable", "disabled", "off", "false", "0")
+# OpenCV's camera frame from MuJoCo's: same x, y and z flipped (MuJoCo looks along -z with y up).
+_MUJOCO_TO_OPENCV = np.diag([1.0, -1.0, -1.0])
+
+
+@dataclass(frozen=True)
+class RenderConfig:
+    """How a :class:`Renderer` draws its images."""
+
+    width: int = 640
+    """Image width [px]."""
+    height: int = 480
+    """Image height [px]."""
+    shadows: bool = False
+    """Draw shadows of lights that cast them. Off by default: 3-4x slower per frame on the CPU."""
+    max_geoms: int = 10_000
+    """Capacity of the abstract scene [geoms]; geoms beyond it are silently not drawn."""
+
+    def __post_init__(self) -> None:
+        if self.width < 1 or self.height < 1:
+            raise ValueError(f"image size must be positive [px], got {self.width}x{self.height}")
+        if self.max_geoms < 1:
+            raise ValueError(f"max_geoms must be positive, got {self.max_geoms}")
+
+
+def gl_backend() -> str:
+    """The OpenGL backend a new :class:`Renderer` uses, from ``MUJOCO_GL`` (``egl`` when unset).
+
+    Raises:
+        RenderingError: if ``MUJOCO_GL`` disables rendering or names a backend this platform lacks.
+    """
+    value = os.environ.get("MUJOCO_GL", "").strip().lower()
+    if value in GL_BACKENDS:
+        return value
+    if value in _DEFAULT_VALUES:
+        # mujoco.egl refuses to load once PYOPENGL_PLATFORM names another platform; follow it then.
+        pyopengl = os.environ.get("PYOPENGL_PLATFORM", "").strip().lower()
+        return pyopengl if pyopengl in ("egl", "osmesa") else "egl"
+    if value in _DISABLED_VALUES:
+        raise RenderingError(f"rendering is disabled by MUJOCO_GL={value!r}; use one of {list(GL_BACKENDS)}")
+    raise RenderingError(f"MUJOCO_GL={value!r} is not a backend a Renderer can use; use one of {list(GL_BACKENDS)}")
+
+
+def _context_hint(backend: str) -> str:
+    if backend == "egl":
+        return (
+            "EGL needs libegl1 and a driver (libegl-mesa0 and libgl1-mesa-dri on the CPU). Without one, install "
+            "libosmesa6 and start the process with MUJOCO_GL=osmesa: once libEGL is loaded, MuJoCo cannot switch "
+            "to OSMesa in the same process."
+        )
+    if backend == "osmesa":
+        return "OSMesa needs libosmesa6; or start the process with MUJOCO_GL=egl."
+    return "GLFW needs a display; headless, start the process with MUJOCO_GL=egl (or osmesa)."
+
+
+def _create_gl_context(backend: str, width: int, height: int):
+    """A current OpenGL context of the given backend, from MuJoCo's own context classes."""
+    try:
+        module = importlib.import_module(f"mujoco.{backend}")
+        gl_context = module.GLContext(width, height)
+    except Exception as exc:  # ImportError, RuntimeError, EGLError, GLFWError...: all mean "no context"
+        raise RenderingError(
+            f"cannot create an OpenGL context with MUJOCO_GL={backend} ({type(exc).__name__}: {exc}). "
+            + _context_hint(backend)
+        ) from exc
+    try:
+        gl_context.make_current()
+    except Exception as exc:
+        _free_gl_context(gl_context)
+        raise RenderingError(
+            f"cannot make the {backend} OpenGL context current ({type(exc).__name__}: {exc}). " + _context_hint(backend)
+        ) from exc
+    return gl_context
+
+
+def _free_gl_context(gl_context) -> None:
+    try:
+        gl_context.free()
+    finally:
+        # MuJoCo's context classes free themselves again in __del__; after a failed free (e.g. EGL already
+        # terminated) that second attempt would print a traceback at interpreter exit.
+        if hasattr(gl_context, "_context"):
+            gl_context._context = None
+
+
+# Renderers still open at interpreter exit are closed by an atexit hook registered after the first GL
+# context exists: atexit runs hooks last-in first-out, so ours runs before the eglTerminate that
+# mujoco.egl registers when it first initialises the display, and closing still finds EGL alive.
+_open_renderers: weakref.WeakSet[Renderer] = weakref.WeakSet()
+_atexit_lock = threading.Lock()
+_atexit_registered = False
+
+
+def _close_open_renderers() -> None:
+    for renderer in list(_open_renderers):
+        with contextlib.suppress(Exception):
+            renderer.close()
+
+
+def _track(renderer: Renderer) -> None:
+    global _atexit_registered
+    with _atexit_lock:
+        if not _atexit_registered:
+            atexit.register(_close_open_renderers)
+            _atexit_registered = True
+        _open_renderers.add(renderer)
+
+
+class Renderer:
+    """Renders RGB images of a model's named cameras offscreen, headless.
+
+    Owns an OpenGL context (see the module docstring for the backend); close it with :meth:`close` or
+    use the renderer as a context manager. A renderer is meant for one thread at a time.
+
+    Example::
+
+        with Renderer(model, RenderConfig(width=640, height=480)) as renderer:
+            image = renderer.render(data, "overview")  # (480, 640, 3) uint8
+            K = renderer.camera_intrinsics("overview")
+            T_world_camera = renderer.camera_pose_in_world(data, "overview")
+    """
+
+    def __init__(self, model: mujoco.MjModel, config: RenderConfig = RenderConfig()) -> None:  # noqa: B008
+        """Create the OpenGL context and MuJoCo's render context for ``model``.
+
+        If the model's offscreen buffer (``<visual><global offwidth offheight>``, 640x480 by default) is
+        smaller than the configured image, it is enlarged on ``model``: a visual-only setting.
+
+        Raises:
+            RenderingError: if no OpenGL context can be created with the backend in ``MUJOCO_GL``.
+        """
+        # Set first so that close() and __del__ work whatever fails below.
+        self._gl_context = None
+        self._mjr_context: mujoco.MjrContext | None = None
+        self._model = model
+        self._config = config
+        self._backend = gl_backend()
+        names = (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_CAMERA, i) for i in range(model.ncam))
+        self._camera_ids = {name: i for i, name in enumerate(names) if name}
+        global_ = model.vis.global_
+        global_.offwidth = max(int(global_.offwidth), config.width)
+        global_.offheight = max(int(global_.offheight), config.height)
+
+        self._scene = mujoco.MjvScene(model, maxgeom=config.max_geoms)
+        self._scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = config.shadows
+        self._option = mujoco.MjvOption()
+        self._camera = mujoco.MjvCamera()
+        self._camera.type = mujoco.mjtCamera.mjCAMERA_FIXED
+        self._rect = mujoco.MjrRect(0, 0, config.width, config.height)
+        self._pixels = np.empty((config.height, config.width, 3), dtype=np.uint8)
+
+        self._gl_context = _create_gl_context(self._backend, config.width, config.height)
+        try:
+            # The smallest font scale: no text is drawn, and the font textures cost memory per context.
+            self._mjr_context = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_50)
+            mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._mjr_context)
+        except Exception as exc:  # mujoco.FatalError: "gladLoadGL error", "no OpenGL platform library"...
+            self.close()
+            raise RenderingError(
+                f"MuJoCo cannot render with the {self._backend} OpenGL context ({type(exc).__name__}: {exc}). "
+                + _context_hint(self._backend)
+            ) from exc
+        _track(self)
+
+    @property
+    def model(self) -> mujoco.MjModel:
+        """The model this renderer draws."""
+        return self._model
+
+    @property
+    def config(self) -> RenderConfig:
+        """The configuration this renderer was created with."""
+        return self._config
+
+    @property
+    def backend(self) -> str:
+        """The OpenGL backend in use: ``egl``, ``osmesa`` or ``glfw``."""
+        return self._backend
+
+    @property
+    def camera_names(self) -> tuple[str, ...]:
+        """Names of the model's cameras, in model order."""
+        return tuple(self._camera_ids)
+
+    @property
+    def closed(self) -> bool:
+        """Whether :meth:`close` has freed the OpenGL resources."""
+        return self._mjr_context is None
+
+    def camera_id(self, camera: str) -> int:
+        """Index of a named camera in the model.
+
+        Raises:
+            UnknownCamera: if the model has no camera of that name; the message lists those it has.
+        """
+        try:
+            return self._camera_ids[camera]
+        except KeyError:
+            raise UnknownCamera(camera, self._camera_ids) from None
+
+    def render(self, data: mujoco.MjData, camera: str) -> np.ndarray:
+        """Draw the scene in state ``data`` as seen by a named camera.
+
+        ``data`` must hold positions computed for its state (``mj_forward``, ``mj_kinematics`` or a step).
+
+        Returns:
+            A new ``uint8`` array of shape ``(height, width, 3)``, RGB, row 0 at the top of the image.
+
+        Raises:
+            UnknownCamera: if the model has no camera of that name.
+            RenderingError: if the renderer is closed.
+        """
+        self._camera.fixedcamid = self.camera_id(camera)
+        if self._mjr_context is None:
+            raise RenderingError("render() called on a closed Renderer; create a new one")
+        mujoco.mjv_updateScene(
+            self._model, data, self._option, None, self._camera, mujoco.mjtCatBit.mjCAT_ALL, self._scene
+        )
+        self._gl_context.make_current()
+        mujoco.mjr_render(self._rect, self._scene, self._mjr_context)
+        mujoco.mjr_readPixels(self._pixels, None, self._rect, self._mjr_context)
+        # OpenGL's rows run bottom-up.
+        return np.flipud(self._pixels).copy()
+
+    def camera_intrinsics(self, camera: str) -> np.ndarray:
+        """Pinhole matrix ``K`` of a named camera at the configured image size, OpenCV convention.
+
+        For a camera given by ``fovy``: ``fx = fy = (H / 2) / tan(fovy / 2)``, ``cx = (W - 1) / 2``,
+        ``cy = (H - 1) / 2`` (pixel centres at integer coordinates; MuJoCo keeps pixels square by
+        widening the horizontal field of view with the aspect ratio). For a camera given by
+        ``sensorsize``/``focal``/``principal`` the frustum MuJoCo builds from them is used; pixels are then
+        square only if the image has the sensor's aspect ratio. The images carry no lens distortion.
+
+        Returns:
+            ``(3, 3)`` float array [px].
+
+        Raises:
+            UnknownCamera: if the model has no camera of that name.
+            RenderingError: for an orthographic camera, which has no pinhole model.
+        """
+        cam = self.camera_id(camera)
+        width, height = self._config.width, self._config.height
+        if self._model.cam_projection[cam] == mujoco.mjtProjection.mjPROJ_ORTHOGRAPHIC:
+            raise RenderingError(f"camera {camera!r} is orthographic: it has no pinhole intrinsics")
+        sensor = self._model.cam_sensorsize[cam]
+        if sensor[1] > 0:
+            # The frustum mjv_updateScene builds on the near plane n (read back from MjvGLCamera with
+            # mujoco 3.17.0): centre n/fx * px, half-width n/fx * sx/2, bottom n/fy * (-sy/2 - py),
+            # top n/fy * (sy/2 - py), with focal lengths (fx, fy) and principal offsets (px, py) from
+            # cam_intrinsic and the sensor size (sx, sy), all in sensor units [m].
+            focal_x, focal_y, principal_x, principal_y = self._model.cam_intrinsic[cam]
+            fx = width * focal_x / sensor[0]
+            fy = height * focal_y / sensor[1]
+            cx = width * (0.5 - principal_x / sensor[0]) - 0.5
+            cy = height * (0.5 - principal_y / sensor[1]) - 0.5
+        else:
+            fy = 0.5 * height / math.tan(math.radians(self._model.cam_fovy[cam]) / 2)
+            fx = fy
+            cx, cy = (width - 1) / 2, (height - 1) / 2
+        return np.array([[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]])
+
+    def camera_pose_in_world(self, data: mujoco.MjData, camera: str) -> np.ndarray:
+        """``T_world_camera`` of a named camera in state ``data``, OpenCV camera frame (x right, y down,
+        z forward).
+
+        ``data`` must hold positions computed for its state (``mj_forward`` or ``mj_kinematics``).
+
+        Returns:
+            ``(4, 4)`` homogeneous transform, translation [m].
+
+        Raises:
+            UnknownCamera: if the model has no camera of that name.
+        """
+        cam = self.camera_id(camera)
+        transform = np.eye(4)
+        transform[:3, :3] = data.cam_xmat[cam].reshape(3, 3) @ _MUJOCO_TO_OPENCV
+        transform[:3, 3] = data.cam_xpos[cam]
+        return transform
+
+    def close(self) -> None:
+        """Free the OpenGL resources. Idempotent; the renderer cannot render afterwards."""
+        mjr_context, gl_context = self._mjr_context, self._gl_context
+        self._mjr_context = None
+        self._gl_context = None
+        _open_renderers.discard(self)
+        try:
+            if mjr_context is not None and gl_context is not None:
+                # MuJoCo's render context deletes GL objects: its own context must be current.
+                gl_context.make_current()
+                mjr_context.free()
+        finally:
+            if gl_context is not None:
+                _free_gl_context(gl_context)
+
+    def __enter__(self) -> Renderer:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        if getattr(self, "_gl_context", None) is None:
+            return
+        # Like an unclosed file: say so (hidden by default), then free without ever raising from __del__.
+        with contextlib.suppress(Exception):
+            warnings.warn(f"unclosed {self!r}; call close() or use it as a context manager", ResourceWarning, 2)
+        with contextlib.suppress(Exception):
+            self.close()
+
+    def __repr__(self) -> str:
+        state = "closed" if self.closed else self._backend
+        return f"Renderer({self._config.width}x{self._config.height}, {state}, cameras={list(self.camera_names)})"
