@@ -55,6 +55,8 @@ HANDLE_HEIGHT = 0.035
 """Height of the handle posts above the component's top face [m]."""
 HANDLE_MARGIN = 0.011
 """Extra flap/plate length beyond the half-width that carries the handle clear of the marker [m]."""
+SLIDE_BACK = SLIDE_HALF + HANDLE_MARGIN + 0.005
+"""Extent of the slide plate behind its marker centre, carrying the knob [m]."""
 HANDLE_OFFSET = 0.035
 """Distance of the handle centre from the marker centre along the component's x [m]: clear of the
 marker's quiet zone (MARKER_SIZE / 2 * 4 / 3 = 24 mm) by 5 mm."""
@@ -104,7 +106,7 @@ SLIDE = KindTemplate(
     travel=0.05,
     marker_size=MARKER_SIZE,
     handle_xy=(-HANDLE_OFFSET, 0.0),
-    footprint=rectangle(-SLIDE_HALF - HANDLE_MARGIN - 0.005, SLIDE_HALF + 0.05, -SLIDE_HALF, SLIDE_HALF),
+    footprint=rectangle(-SLIDE_BACK, SLIDE_HALF + 0.05, -SLIDE_HALF, SLIDE_HALF),
 )
 WHEEL = KindTemplate(
     name="wheel",

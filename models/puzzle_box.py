@@ -28,6 +28,7 @@ from models.kinds import (
     HANDLE_HEIGHT,
     HANDLE_MARGIN,
     HANDLE_SIZE,
+    SLIDE_BACK,
     SLIDE_HALF,
     WHEEL_RADIUS,
     get_kind,
@@ -107,7 +108,7 @@ def build_puzzle_box(spec: PuzzleSpec, with_markers: bool = True) -> mjcf.RootEl
         x, y, yaw = component.pose
         body = box.add("body", name=name, pos=[x, y, 0.0], quat=yaw_quat(yaw))
         builder = {"door": _door, "slide": _slide, "wheel": _wheel}[component.kind]
-        joint = builder(root, body, name)
+        joint = builder(body, name)
         template = get_kind(component.kind)
         hx, hy = template.handle_xy
         body.add("site", name=f"{name}:handle_site", pos=[hx, hy, PLATE_THICKNESS + HANDLE_HEIGHT], size=[0.003])
@@ -159,23 +160,26 @@ def _handle(body: mjcf.Element, name: str, kind: str) -> None:
     )
 
 
-def _door(root: mjcf.RootElement, body: mjcf.Element, name: str) -> mjcf.Element:
-    x_min, x_max = -DOOR_HALF, DOOR_HALF + HANDLE_MARGIN
+def _plate(body: mjcf.Element, name: str, kind: str, x_min: float, x_max: float, half_width: float) -> None:
     body.add(
         "geom",
         name=f"{name}:plate",
         type="box",
-        size=[(x_max - x_min) / 2, DOOR_HALF, PLATE_THICKNESS / 2],
+        size=[(x_max - x_min) / 2, half_width, PLATE_THICKNESS / 2],
         pos=[(x_max + x_min) / 2, 0, PLATE_THICKNESS / 2],
         density=700,
-        rgba=COLOURS["door"],
+        rgba=COLOURS[kind],
     )
+
+
+def _door(body: mjcf.Element, name: str) -> mjcf.Element:
+    _plate(body, name, "door", -DOOR_HALF, DOOR_HALF + HANDLE_MARGIN, DOOR_HALF)
     body.add(  # the hinge pin, for the eye
         "geom",
         name=f"{name}:hinge_pin",
         type="cylinder",
         size=[0.003, DOOR_HALF],
-        pos=[x_min, 0, PLATE_THICKNESS / 2],
+        pos=[-DOOR_HALF, 0, PLATE_THICKNESS / 2],
         quat=[math.cos(math.pi / 4), math.sin(math.pi / 4), 0, 0],  # cylinder axis along y
         rgba=[0.6, 0.6, 0.6, 1],
         contype=0,
@@ -186,22 +190,13 @@ def _door(root: mjcf.RootElement, body: mjcf.Element, name: str) -> mjcf.Element
     return _add_joint(body, name, "door")
 
 
-def _slide(root: mjcf.RootElement, body: mjcf.Element, name: str) -> mjcf.Element:
-    x_min, x_max = -SLIDE_HALF - HANDLE_MARGIN - 0.005, SLIDE_HALF
-    body.add(
-        "geom",
-        name=f"{name}:plate",
-        type="box",
-        size=[(x_max - x_min) / 2, SLIDE_HALF, PLATE_THICKNESS / 2],
-        pos=[(x_max + x_min) / 2, 0, PLATE_THICKNESS / 2],
-        density=700,
-        rgba=COLOURS["slide"],
-    )
+def _slide(body: mjcf.Element, name: str) -> mjcf.Element:
+    _plate(body, name, "slide", -SLIDE_BACK, SLIDE_HALF, SLIDE_HALF)
     _handle(body, name, "slide")
     return _add_joint(body, name, "slide")
 
 
-def _wheel(root: mjcf.RootElement, body: mjcf.Element, name: str) -> mjcf.Element:
+def _wheel(body: mjcf.Element, name: str) -> mjcf.Element:
     body.add(
         "geom",
         name=f"{name}:disc",
