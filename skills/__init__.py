@@ -1,3 +1,29 @@
-"""puzzlebox skills layer (see DESIGN.md, "Layers")."""
+"""puzzlebox skills: the robot's pipeline — perception, joint models, primitives — over the twin's
+robot interface only (DESIGN.md, "Layers": never simulator ground truth)."""
 
-__all__: list[str] = []
+from skills.errors import MarkersNotFound, SkillError, UnknownMarker
+from skills.joint_model import JointModel, joint_model
+from skills.perception import (
+    MarkerDetection,
+    MarkerDetector,
+    PerceptionConfig,
+    kind_of,
+    lid_height,
+    select_markers,
+    upright_pose,
+)
+
+__all__ = [
+    "JointModel",
+    "MarkerDetection",
+    "MarkerDetector",
+    "MarkersNotFound",
+    "PerceptionConfig",
+    "SkillError",
+    "UnknownMarker",
+    "joint_model",
+    "kind_of",
+    "lid_height",
+    "select_markers",
+    "upright_pose",
+]

@@ -1,0 +1,31 @@
+"""Exceptions of the `skills` package; all derive from :class:`SkillError`."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+
+class SkillError(Exception):
+    """Base class of every error raised on purpose by the `skills` package."""
+
+
+class MarkersNotFound(SkillError):
+    """Markers the cell expects were not seen (or seen twice) from any camera: no pose is invented."""
+
+    def __init__(self, missing: Iterable[int], duplicated: Iterable[int] = (), cameras: Iterable[str] = ()) -> None:
+        self.missing = tuple(sorted(missing))
+        self.duplicated = tuple(sorted(duplicated))
+        self.cameras = tuple(cameras)
+        parts = []
+        if self.missing:
+            parts.append(f"missing marker ids {list(self.missing)}")
+        if self.duplicated:
+            parts.append(f"marker ids seen more than once {list(self.duplicated)}")
+        super().__init__(f"{' and '.join(parts)} after looking from {list(self.cameras)}")
+
+
+class UnknownMarker(SkillError, KeyError):
+    """A marker id the marker map does not list."""
+
+    def __str__(self) -> str:
+        return str(self.args[0])
