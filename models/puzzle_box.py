@@ -82,8 +82,10 @@ def component_prefixes(spec: PuzzleSpec) -> dict[str, str]:
 
 
 def _handle_geom_defaults() -> dict[str, object]:
-    # DESIGN.md, grasping: priority 2 so the handle's friction wins, friction 1, condim 4 (torsional)
-    return {"priority": 2, "friction": [1.0, 0.01, 0.001], "condim": 4, "rgba": HANDLE_COLOUR}
+    # DESIGN.md, grasping: priority 2 so the handle's friction wins, friction 1, condim 4 (torsional).
+    # Torsional friction 2 mm: a door handle pivots between the pads as the door swings; at 1 cm the
+    # pads' grip resisted that pivot with ~1 N·m, which the wrist felt as a latch.
+    return {"priority": 2, "friction": [1.0, 0.002, 0.0001], "condim": 4, "rgba": HANDLE_COLOUR}
 
 
 def build_puzzle_box(spec: PuzzleSpec, with_markers: bool = True) -> mjcf.RootElement:
@@ -144,6 +146,7 @@ def _add_joint(body: mjcf.Element, name: str, kind: str) -> mjcf.Element:
         frictionloss=dynamics.frictionloss,
         armature=dynamics.armature,
         solreflimit=[0.004, 1.0],  # stiffer end stops: a door resting on its limit sags < 0.1 deg
+        solreffriction=[0.002, 1.0],  # stiff dry friction: an open door stays open (default 0.02 creeps)
     )
 
 

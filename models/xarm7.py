@@ -14,7 +14,8 @@ Adapted in code, as DESIGN.md records:
   ``wrist_force`` / ``wrist_torque`` sensors (they measure what the gripper subtree exchanges with
   the arm, expressed in the site frame);
 - the gripper mounted on the flange at link7's origin (robosuite mounts it 2.7 cm inside link7), its
-  ``<default group>`` attribute that MuJoCo rejects removed, its own sensors removed;
+  ``<default group>`` attribute that MuJoCo rejects removed, its own sensors removed, and its finger
+  joints limited to 0..0.85 rad as in Menagerie (robosuite's class nesting leaves them unlimited);
 - a ``tcp`` site between the finger pads and a ``wrist_camera`` looking along the approach axis.
 """
 
@@ -88,6 +89,11 @@ def _load_gripper(path: Path) -> mjcf.RootElement:
     eef = gripper.find("body", "eef")
     if eef is not None:
         eef.remove()
+    # robosuite's driver/follower/spring_link defaults are siblings of the class that sets the
+    # finger range, so its joints come out unlimited; Menagerie nests them: range 0..0.85 rad.
+    for joint in gripper.find_all("joint"):
+        joint.range = [0.0, 0.85]
+        joint.limited = True
     gripper.find("actuator", "fingers_actuator").name = "fingers"
     gripper.model = "gripper"  # its namescope: xarm7/gripper/...
     return gripper

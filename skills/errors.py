@@ -29,3 +29,11 @@ class UnknownMarker(SkillError, KeyError):
 
     def __str__(self) -> str:
         return str(self.args[0])
+
+
+class IKFailure(SkillError):
+    """Inverse kinematics could not reach a target (out of reach, or stalled at a joint limit)."""
+
+
+class GraspFailure(SkillError):
+    """The gripper closed on nothing."""

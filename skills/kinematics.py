@@ -1,0 +1,126 @@
+"""Differential inverse kinematics of the xArm-7 with mink, on a robot-only model.
+
+The IK model is the robot alone (``models.xarm7``), as a real controller's URDF is: IK never sees,
+let alone moves, the box. Tasks: a FrameTask on the TCP site, a PostureTask (cost 1e-2) that keeps
+the redundant arm near a comfortable posture, joint limits; solved with daqp (DESIGN.md: 0.1-0.3 ms
+per iteration, ~6-13 iterations to 1 mm). mink neither flags an unreachable target (it stalls) nor
+rejects a NaN target (it returns NaN velocities), so both are checked here and become
+:class:`~skills.errors.IKFailure` — no NaN ever reaches a joint command.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mink
+import mujoco
+import numpy as np
+from dm_control import mjcf
+
+from models.xarm7 import ARM_JOINTS, HOME_QPOS, build_xarm7
+from skills.errors import IKFailure
+
+TCP_SITE = "gripper/tcp"
+
+
+@dataclass(frozen=True)
+class IKConfig:
+    """Solver settings."""
+
+    dt: float = 0.01
+    """Integration step of one IK iteration [s] (one control tick)."""
+    position_cost: float = 1.0
+    orientation_cost: float = 0.5
+    posture_cost: float = 1e-4
+    """Pull towards a relaxed posture (measured here: 1e-2 and 1e-3 left a 2 mm steady-state error)."""
+    damping: float = 1e-3
+    """Levenberg-Marquardt damping of the QP, for smooth motion near singularities."""
+    position_tolerance: float = 0.001
+    """Converged when the TCP is this close to the target [m]..."""
+    orientation_tolerance: float = 0.01
+    """... and this close in orientation [rad]."""
+    max_iterations: int = 300
+    """Iterations allowed to converge before the target is declared unreachable."""
+
+
+class ArmKinematics:
+    """IK for the arm joints (the gripper's joints are not moved)."""
+
+    def __init__(self, config: IKConfig | None = None) -> None:
+        self.config = config or IKConfig()
+        root = mjcf.RootElement(model="ik")
+        root.attach(build_xarm7())
+        self.model = mujoco.MjModel.from_xml_string(root.to_xml_string(), root.get_assets())
+        self.arm_qpos = np.array([self.model.joint(f"xarm7/{j}").qposadr[0] for j in ARM_JOINTS])
+        self.configuration = mink.Configuration(self.model)
+        self.tcp = mink.FrameTask(
+            f"xarm7/{TCP_SITE}", "site", position_cost=self.config.position_cost,
+            orientation_cost=self.config.orientation_cost, lm_damping=1.0,
+        )  # fmt: skip
+        self.posture = mink.PostureTask(self.model, cost=self.config.posture_cost)
+        rest = self.model.qpos0.copy()
+        rest[self.arm_qpos] = (0.0, -0.247, 0.0, 0.909, 0.0, 1.156, 0.0)  # Menagerie home: a relaxed posture
+        self.posture.set_target(rest)
+        self.limits = [mink.ConfigurationLimit(self.model)]
+
+    def set_joints(self, q_arm: np.ndarray) -> None:
+        q = self.configuration.q.copy()
+        q[self.arm_qpos] = q_arm
+        self.configuration.update(q)
+
+    @property
+    def joints(self) -> np.ndarray:
+        return self.configuration.q[self.arm_qpos].copy()
+
+    def tcp_pose(self) -> np.ndarray:
+        """4x4 TCP pose in the base frame for the current IK joints."""
+        return self.configuration.get_transform_frame_to_world(f"xarm7/{TCP_SITE}", "site").as_matrix()
+
+    def step_towards(self, T_base_tcp: np.ndarray, iterations: int = 1) -> tuple[np.ndarray, float, float]:
+        """Run ``iterations`` IK iterations towards a target; returns the arm joints and the position
+        [m] and orientation [rad] errors left."""
+        if not np.all(np.isfinite(T_base_tcp)):
+            raise IKFailure(f"IK target is not finite: {T_base_tcp}")
+        self.tcp.set_target(mink.SE3.from_matrix(T_base_tcp))
+        for _ in range(iterations):
+            velocity = mink.solve_ik(
+                self.configuration, [self.tcp, self.posture], self.config.dt, "daqp",
+                damping=self.config.damping, limits=self.limits,
+            )  # fmt: skip
+            if not np.all(np.isfinite(velocity)):
+                raise IKFailure("IK returned non-finite joint velocities")
+            self.configuration.integrate_inplace(velocity, self.config.dt)
+        error = self.tcp.compute_error(self.configuration)
+        return self.joints, float(np.linalg.norm(error[:3])), float(np.linalg.norm(error[3:]))
+
+    def solve(self, T_base_tcp: np.ndarray, q_seed: np.ndarray | None = None) -> np.ndarray:
+        """Arm joints that put the TCP at ``T_base_tcp``; :class:`IKFailure` if it stays out of reach."""
+        if q_seed is not None:
+            self.set_joints(q_seed)
+        position_error = orientation_error = np.inf
+        for _ in range(self.config.max_iterations):
+            q, position_error, orientation_error = self.step_towards(T_base_tcp)
+            if (
+                position_error < self.config.position_tolerance
+                and orientation_error < self.config.orientation_tolerance
+            ):
+                return q
+        raise IKFailure(
+            f"IK stalled {position_error * 1000:.1f} mm / {np.degrees(orientation_error):.1f} deg from the target "
+            f"at {np.round(T_base_tcp[:3, 3], 3).tolist()} after {self.config.max_iterations} iterations: out of reach"
+        )
+
+
+def top_down(position: np.ndarray, yaw: float) -> np.ndarray:
+    """TCP pose at ``position`` [m] pointing straight down (approach axis -z), fingers closing along the
+    horizontal direction ``yaw`` + 90 deg (the gripper's y axis) [rad]."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    R = np.array([[c, s, 0.0], [s, -c, 0.0], [0.0, 0.0, -1.0]])  # x = (c, s, 0), z = down, y = z cross x
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = position
+    return T
+
+
+__all__ = ["ArmKinematics", "IKConfig", "top_down"]
+_ = HOME_QPOS

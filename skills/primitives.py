@@ -1,0 +1,237 @@
+"""Manipulation primitives: toggle a component with the arm, feeling through the wrist F/T sensor
+whether it was latched.
+
+A toggle approaches the handle from above, descends, closes the gripper, drives the grasp point
+along the perceived joint (arc for hinges, line for slides) towards the other state, then releases
+and retreats. Motion is differential IK on the robot-only model at a 10 ms control tick, targets
+sent to the position servos. While actuating, the wrist force — rotated into the base frame, tared
+with the fingers open — is projected on the handle's direction of motion: if the force opposing the
+motion exceeds ``blocked_force`` while the measured progress is below ``blocked_progress``, the
+component is latched: the arm backs off to where it started and lets go (DESIGN.md: this rule made no
+error in 36 randomized attempts and stopped every latched attempt within 0.13-1.2 s; without a stop
+the grasp is torn off at 100-300 N).
+
+Outcomes are ``moved``, ``blocked`` or ``failed`` (with a reason); IK failures and empty grasps are
+typed errors underneath and reported as ``failed``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+from scipy.spatial.transform import Rotation, Slerp
+
+from skills.errors import GraspFailure, IKFailure
+from skills.joint_model import JointModel
+from skills.kinematics import ArmKinematics, top_down
+
+Outcome = Literal["moved", "blocked", "failed"]
+
+
+@dataclass(frozen=True)
+class PrimitiveConfig:
+    """Timing and thresholds of a toggle."""
+
+    tick: float = 0.01
+    """Control period [s]."""
+    ik_iterations_per_tick: int = 2
+    approach_height: float = 0.08
+    """Pre-grasp height above the grasp point [m]."""
+    approach_time: float = 1.5
+    descend_time: float = 1.0
+    close_time: float = 0.6
+    actuate_time: float = 2.5
+    release_time: float = 0.4
+    retreat_time: float = 0.8
+    settle_time: float = 0.6
+    """Extra time allowed at the end of a move for the servos to catch up [s]."""
+    lead: float = 0.02
+    """How far the commanded grasp point may run ahead of the measured one, along the path [m]: a
+    pre-planned arc from a slightly wrong perceived hinge would otherwise pull the handle out of the
+    fingers; 2 cm still pulls a latched part with more than ``blocked_force``."""
+    push_force: float = 5.0
+    """A part that ends without progress after being pulled with at least this force is latched [N]."""
+    blocked_force: float = 20.0
+    """Force opposing the motion that, with little progress, means a latch [N]."""
+    blocked_progress: float = 0.10
+    """Progress (fraction of the travel) below which a large opposing force means a latch."""
+    moved_fraction: float = 0.75
+    """Progress that counts as reaching the other state (the twin's hysteresis threshold)."""
+    empty_grasp_closure: float = 0.95
+    """Gripper closure at or above which nothing is between the fingers."""
+
+
+@dataclass
+class ToggleResult:
+    """What a toggle did, as the robot sensed it."""
+
+    outcome: Outcome
+    reason: str = ""
+    progress: float = 0.0
+    """Measured fraction of the travel the grasp point covered (towards the other state)."""
+    peak_opposing_force: float = 0.0
+    """Largest force opposing the motion while actuating [N]."""
+    sim_time: float = 0.0
+    wall_time: float = 0.0
+    forces: list[float] = field(default_factory=list)
+
+
+class Toggler:
+    """Runs toggle primitives on a robot interface (``twin.robot_interface.RobotInterface`` or a real one)."""
+
+    def __init__(self, robot, config: PrimitiveConfig | None = None, kinematics: ArmKinematics | None = None) -> None:
+        self.robot = robot
+        self.config = config or PrimitiveConfig()
+        self.ik = kinematics or ArmKinematics()
+
+    # -- motion ------------------------------------------------------------------------------------
+    def _tick(self, target: np.ndarray) -> tuple[float, float]:
+        q, position_error, orientation_error = self.ik.step_towards(target, self.config.ik_iterations_per_tick)
+        self.robot.command_joint_positions(np.clip(q, *self.robot.joint_limits().T))
+        self.robot.wait(self.config.tick)
+        return position_error, orientation_error
+
+    def move_to(self, target: np.ndarray, duration: float) -> None:
+        """Move the TCP to ``target`` (4x4) along a straight line and a slerp over ``duration`` [s]."""
+        self.ik.set_joints(self.robot.joint_positions())
+        start = self.ik.tcp_pose()
+        slerp = Slerp([0.0, 1.0], Rotation.from_matrix([start[:3, :3], target[:3, :3]]))
+        ticks = max(1, round(duration / self.config.tick))
+        for k in range(1, ticks + 1):
+            s = k / ticks
+            s = s * s * (3 - 2 * s)  # smooth start and stop
+            waypoint = np.eye(4)
+            waypoint[:3, :3] = slerp(s).as_matrix()
+            waypoint[:3, 3] = (1 - s) * start[:3, 3] + s * target[:3, 3]
+            self._tick(waypoint)
+        for _ in range(round(self.config.settle_time / self.config.tick)):
+            position_error, orientation_error = self._tick(target)
+            reached = np.linalg.norm(self.robot.tcp_pose_in_base()[:3, 3] - target[:3, 3]) < 0.003
+            if reached and position_error < 0.002:
+                return
+        if position_error > 0.01:
+            raise IKFailure(f"TCP target {np.round(target[:3, 3], 3).tolist()} not reached: out of reach")
+
+    def _gripper(self, closure: float, duration: float) -> None:
+        self.robot.command_gripper(closure)
+        ticks = round(duration / self.config.tick)
+        for _ in range(ticks):
+            self._tick(self.ik.tcp_pose())
+
+    # -- the toggle --------------------------------------------------------------------------------
+    def grasp_yaw(self, jm: JointModel) -> float:
+        """Yaw of the gripper. Slides and wheels: the fingers close along the handle's (horizontal)
+        direction of motion, so the pads push it. Doors: along the hinge axis, so the handle pivots
+        between the pads like a pin as the door swings and the gripper need not tilt 85 degrees
+        (tilting with it folded the arm onto itself)."""
+        direction = jm.axis if jm.kind == "door" else jm.motion_direction(0.0)
+        return float(np.arctan2(direction[1], direction[0]) + np.pi / 2)
+
+    def toggle(self, jm: JointModel, opening: bool = True) -> ToggleResult:
+        """Try to move the component of joint model ``jm`` to its other state (see the module docstring)."""
+        wall = time.perf_counter()
+        start_time = self.robot.time
+        try:
+            result = self._toggle(jm, 1.0 if opening else -1.0)
+        except (IKFailure, GraspFailure) as err:
+            result = ToggleResult("failed", reason=f"{type(err).__name__}: {err}")
+            self._let_go_and_retreat()
+        result.sim_time = self.robot.time - start_time
+        result.wall_time = time.perf_counter() - wall
+        return result
+
+    def _toggle(self, jm: JointModel, sign: float) -> ToggleResult:
+        c = self.config
+        begin = 0.0 if sign > 0 else 1.0
+        grasp_yaw = self.grasp_yaw(jm)
+        at_grasp = top_down(jm.grasp_point_at(begin), grasp_yaw)
+        above = at_grasp.copy()
+        above[2, 3] += c.approach_height
+        self.robot.command_gripper(0.0)
+        self.move_to(above, c.approach_time)
+        self.robot.tare()  # fingers open, arm still: the load of the gripper alone
+        self.move_to(at_grasp, c.descend_time)
+        self._gripper(1.0, c.close_time)
+        if self.robot.gripper_opening() >= c.empty_grasp_closure:
+            raise GraspFailure(f"the gripper closed on nothing at {np.round(at_grasp[:3, 3], 3).tolist()}")
+
+        result = self._actuate(jm, sign, begin, at_grasp)
+        self._gripper(0.0, c.release_time)
+        self._let_go_and_retreat()
+        return result
+
+    def _actuate(self, jm: JointModel, sign: float, begin: float, at_grasp: np.ndarray) -> ToggleResult:
+        c = self.config
+        ticks = round(c.actuate_time / c.tick)
+        forces: list[float] = []
+        progress = 0.0
+        path_length = (
+            jm.travel
+            if jm.joint == "slide"
+            else jm.travel
+            * np.linalg.norm((jm.grasp_point - jm.origin) - np.dot(jm.grasp_point - jm.origin, jm.axis) * jm.axis)
+        )
+        lead = c.lead / path_length  # as a fraction of the travel
+        self.ik.set_joints(self.robot.joint_positions())
+        for k in range(1, ticks + 1):
+            s = min(k / ticks, max(progress, 0.0) + lead)
+            fraction = begin + sign * s
+            target = self._pose_along(jm, fraction, at_grasp, begin)
+            self._tick(target)
+            direction = sign * jm.motion_direction(fraction)
+            load = self.robot.ft_rotation_in_base() @ self.robot.wrench()[:3]
+            opposing = float(-np.dot(load, direction))
+            forces.append(opposing)
+            progress = self._progress(jm, sign, begin)
+            if opposing > c.blocked_force and progress < c.blocked_progress:
+                self.move_to(at_grasp, 0.5)  # back off to where the handle was grasped
+                return ToggleResult(
+                    "blocked", "latched: force rose without progress", progress, max(forces), forces=forces
+                )
+        for _ in range(round(2 * c.settle_time / c.tick)):  # let the part catch up with the end target
+            progress = self._progress(jm, sign, begin)
+            self._tick(self._pose_along(jm, begin + sign * min(1.0, max(progress, 0.0) + lead), at_grasp, begin))
+        progress = self._progress(jm, sign, begin)
+        peak = max(forces)
+        if progress >= c.moved_fraction:
+            return ToggleResult("moved", "", progress, peak, forces=forces)
+        if progress < c.blocked_progress and peak >= c.push_force:
+            self.move_to(at_grasp, 0.5)
+            return ToggleResult("blocked", "latched: pulled without progress", progress, peak, forces=forces)
+        return ToggleResult(
+            "failed", f"only {progress:.0%} of the travel covered (slip?)", progress, peak, forces=forces
+        )
+
+    def _pose_along(self, jm: JointModel, fraction: float, at_grasp: np.ndarray, begin: float) -> np.ndarray:
+        T = at_grasp.copy()
+        T[:3, 3] = jm.grasp_point_at(fraction)
+        if jm.joint == "hinge" and abs(jm.axis[2]) > 0.9:  # wheels: the gripper turns with the knob
+            turn = Rotation.from_rotvec(jm.axis * (fraction - begin) * jm.travel).as_matrix()
+            T[:3, :3] = turn @ at_grasp[:3, :3]
+        return T
+
+    def _progress(self, jm: JointModel, sign: float, begin: float) -> float:
+        """Measured fraction of the travel covered towards the other state, from the TCP position."""
+        p = self.robot.tcp_pose_in_base()[:3, 3]
+        p0 = jm.grasp_point_at(begin)
+        if jm.joint == "slide":
+            return float(sign * np.dot(p - p0, jm.axis) / jm.travel)
+        a, b = p0 - jm.origin, p - jm.origin
+        a -= np.dot(a, jm.axis) * jm.axis
+        b -= np.dot(b, jm.axis) * jm.axis
+        angle = np.arctan2(np.dot(jm.axis, np.cross(a, b)), np.dot(a, b))
+        return float(sign * angle / jm.travel)
+
+    def _let_go_and_retreat(self) -> None:
+        c = self.config
+        self.robot.command_gripper(0.0)
+        try:
+            self.ik.set_joints(self.robot.joint_positions())
+            up = self.robot.tcp_pose_in_base()
+            up[2, 3] += c.approach_height
+            self.move_to(up, c.retreat_time)
+        except IKFailure:
+            pass  # already as high as the arm goes: nothing more to do

@@ -1,0 +1,77 @@
+"""The toggle primitive opens free parts of each kind and feels latched ones through the wrist F/T
+sensor; unreachable and non-finite IK targets are typed failures."""
+
+import numpy as np
+import pytest
+
+from models.generator import generate_chain
+from skills import MarkerDetector, joint_model, lid_height, select_markers, upright_pose
+from skills.errors import IKFailure
+from skills.kinematics import ArmKinematics, top_down
+from skills.primitives import Toggler
+from twin.session import TwinSession
+
+
+def perceived_joint_models(session: TwinSession) -> dict:
+    spec = session.spec
+    image = session.robot.capture("overview")
+    detections = select_markers(MarkerDetector().detect(image), {c.marker for c in spec.components}, ("overview",))
+    height = lid_height(detections)
+    return {
+        c.name: joint_model(c.kind, upright_pose(detections[c.marker].planar_pose, height)) for c in spec.components
+    }
+
+
+@pytest.fixture(scope="module")
+def chain():
+    # slide-0 free; door-1 held by slide-0; slide-2 held by door-1; wheel-3 held by slide-2
+    with TwinSession(generate_chain(["slide", "door", "slide", "wheel"], seed=1), seed=0) as session:
+        yield session, perceived_joint_models(session)
+
+
+@pytest.mark.parametrize("name", ["door-1", "slide-2", "wheel-3"])
+def test_a_latched_part_of_each_kind_is_reported_blocked_and_stays_put(chain, name):
+    session, models = chain
+    session.reset()
+    j = session.spec.index_of(name)
+    before = session.component_positions()[j]
+    result = Toggler(session.robot).toggle(models[name])
+    assert result.outcome == "blocked", result.reason
+    assert result.peak_opposing_force > 5.0 and result.progress < 0.1
+    assert abs(session.component_positions()[j] - before) < 0.02  # the latch held against the pull
+    assert session.robot.gripper_opening() < 0.2  # and the robot let go
+
+
+def test_a_free_slide_then_the_door_it_released_are_opened(chain):
+    session, models = chain
+    session.reset()
+    toggler = Toggler(session.robot)
+    slide = toggler.toggle(models["slide-0"])
+    assert slide.outcome == "moved" and session.component_states()[0] == 1
+    door = toggler.toggle(models["door-1"])
+    assert door.outcome == "moved", door.reason
+    assert session.component_states()[1] == 1
+    assert 5.0 < door.sim_time < 12.0
+
+
+def test_a_free_wheel_is_turned_open():
+    with TwinSession(generate_chain(["wheel", "slide"], seed=2), seed=0) as session:
+        result = Toggler(session.robot).toggle(perceived_joint_models(session)["wheel-0"])
+        assert result.outcome == "moved", result.reason
+        assert session.component_states()[0] == 1
+
+
+def test_an_out_of_reach_target_is_a_typed_ik_failure():
+    ik = ArmKinematics()
+    with pytest.raises(IKFailure, match="out of reach"):
+        ik.solve(top_down(np.array([1.2, 0.0, 0.1]), 0.0))
+    with pytest.raises(IKFailure, match="not finite"):
+        ik.step_towards(np.full((4, 4), np.nan))
+
+
+def test_ik_reaches_targets_over_the_box_to_a_millimetre():
+    ik = ArmKinematics()
+    for target in ([0.45, 0.0, 0.2], [0.55, 0.15, 0.15], [0.30, -0.15, 0.12], [0.60, 0.0, 0.12]):
+        q = ik.solve(top_down(np.array(target), 0.3))
+        ik.set_joints(q)
+        assert np.linalg.norm(ik.tcp_pose()[:3, 3] - target) < 0.001
