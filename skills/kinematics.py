@@ -31,8 +31,9 @@ class IKConfig:
     """Integration step of one IK iteration [s] (one control tick)."""
     position_cost: float = 1.0
     orientation_cost: float = 0.5
-    posture_cost: float = 1e-4
-    """Pull towards a relaxed posture (measured here: 1e-2 and 1e-3 left a 2 mm steady-state error)."""
+    posture_cost: float = 1e-3
+    """Pull towards a relaxed posture: 1e-2 left a 2 mm steady-state error here; much weaker lets the
+    redundant arm drift into folded postures over successive motions."""
     damping: float = 1e-3
     """Levenberg-Marquardt damping of the QP, for smooth motion near singularities."""
     position_tolerance: float = 0.001

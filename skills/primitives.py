@@ -38,6 +38,9 @@ class PrimitiveConfig:
     tick: float = 0.01
     """Control period [s]."""
     ik_iterations_per_tick: int = 2
+    pregrasp_closure: float = 0.6
+    """Gripper closure while descending onto a handle: open just enough to clear the 12 mm post, so the
+    fingers stay over the part and do not land on a neighbour 1.5 cm away (fully open they span ~8 cm)."""
     approach_height: float = 0.08
     """Pre-grasp height above the grasp point [m]."""
     approach_time: float = 1.5
@@ -46,6 +49,9 @@ class PrimitiveConfig:
     actuate_time: float = 2.5
     release_time: float = 0.4
     retreat_time: float = 0.8
+    rest_time: float = 1.5
+    """Time to return to the rest posture after a toggle [s]: out of the overview camera's view, and
+    every toggle starts from the same arm configuration."""
     settle_time: float = 0.6
     """Extra time allowed at the end of a move for the servos to catch up [s]."""
     lead: float = 0.02
@@ -86,6 +92,7 @@ class Toggler:
         self.robot = robot
         self.config = config or PrimitiveConfig()
         self.ik = kinematics or ArmKinematics()
+        self.rest_posture = robot.joint_positions()  # where the robot was handed over: out of view
 
     # -- motion ------------------------------------------------------------------------------------
     def _tick(self, target: np.ndarray) -> tuple[float, float]:
@@ -150,7 +157,7 @@ class Toggler:
         at_grasp = top_down(jm.grasp_point_at(begin), grasp_yaw)
         above = at_grasp.copy()
         above[2, 3] += c.approach_height
-        self.robot.command_gripper(0.0)
+        self.robot.command_gripper(c.pregrasp_closure)
         self.move_to(above, c.approach_time)
         self.robot.tare()  # fingers open, arm still: the load of the gripper alone
         self.move_to(at_grasp, c.descend_time)
@@ -235,3 +242,15 @@ class Toggler:
             self.move_to(up, c.retreat_time)
         except IKFailure:
             pass  # already as high as the arm goes: nothing more to do
+        self.go_rest()
+
+    def go_rest(self) -> None:
+        """Back to the rest posture by joint interpolation (no IK: always feasible)."""
+        start, goal = self.robot.joint_positions(), np.asarray(self.rest_posture)
+        ticks = max(1, round(self.config.rest_time / self.config.tick))
+        for k in range(1, ticks + 1):
+            s = k / ticks
+            s = s * s * (3 - 2 * s)
+            self.robot.command_joint_positions(np.clip((1 - s) * start + s * goal, *self.robot.joint_limits().T))
+            self.robot.wait(self.config.tick)
+        self.robot.wait(self.config.settle_time)
