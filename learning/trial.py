@@ -62,16 +62,16 @@ def run_episode(agent: Agent, world: World, spec_name: str, seed: int, max_actio
     )
 
 
-def summarise(runs: list[RunResult], max_actions: int) -> dict[str, Any]:
+def summarise(runs: list[RunResult | dict[str, Any]], max_actions: int) -> dict[str, Any]:
     """The ``results.json`` object: success rate, mean actions (an unsolved run counts ``max_actions``)
-    and every run."""
-    if not runs:
+    and every run (``RunResult`` or its dict with extra keys, as twin trials give)."""
+    rows = [r.to_dict() if isinstance(r, RunResult) else r for r in runs]
+    if not rows:
         return {"success_rate": 0.0, "mean_actions": float(max_actions), "runs": []}
-    solved = [r.solved for r in runs]
-    counted = [r.num_actions if r.solved else max_actions for r in runs]
+    counted = [r["num_actions"] if r["solved"] else max_actions for r in rows]
     return {
-        "success_rate": float(np.mean(solved)),
+        "success_rate": float(np.mean([r["solved"] for r in rows])),
         "mean_actions": float(np.mean(counted)),
         "max_actions": max_actions,
-        "runs": [r.to_dict() for r in runs],
+        "runs": rows,
     }

@@ -1,7 +1,13 @@
 """Run seeded trials of an agent on puzzle specs and write ``DIR/results.json``.
 
-    python scripts/trial.py --specs FILE... --sim symbolic --runs K --seed S --max-actions M \
-                            --out DIR [--agent NAME]
+    python scripts/trial.py --specs FILE... [--memory MEM.sqlite] --sim {symbolic,twin} --runs K --seed S \
+                            --max-actions M --out DIR [--agent NAME] [--video]
+
+``--sim twin`` runs each trial end to end in the MuJoCo twin (ArUco perception, the agent, mink
+primitives, F/T outcomes) and adds a per-action ``timeline`` to each run (sensed outcome beside the
+simulator's truth, F/T peak, perceived position error, simulated and wall time) and summary figures;
+``--video`` writes the overview camera's rollout with marker detections drawn (``rollout.mp4`` for a
+single run).
 
 Run ``r`` on every spec uses seed ``S + r`` for the world (component order, faults) and the agent.
 ``DIR/config.json`` records the resolved arguments and package versions, so the result can be re-run.
@@ -17,9 +23,27 @@ from tqdm import tqdm
 
 from learning import AGENT_NAMES, LearningError, SymbolicWorld, make_agent, run_episode, summarise
 from learning.memory import MemoryStore
-from models import SpecError, load_spec
+from models import ModelsError, SpecError, load_spec
+from skills.errors import SkillError
+from twin.errors import TwinError
 
 SIMS = ("symbolic", "twin")
+
+
+def twin_figures(runs: list) -> dict:
+    """Outcome agreement with ground truth, perception error and speed over all twin runs."""
+    actions = [a for r in runs for a in r["timeline"]]
+    errors = [e for r in runs for e in r["perceived_position_error_m"].values()]
+    sim, wall = sum(r["sim_time_s"] for r in runs), sum(r["wall_time_s"] for r in runs)
+    return {
+        "outcome_agreement": float(sum(a["moved"] == a["true_moved"] for a in actions) / max(len(actions), 1)),
+        "actions_total": len(actions),
+        "perceived_position_error_max_m": max(errors, default=0.0),
+        "perceived_position_error_mean_m": sum(errors) / max(len(errors), 1),
+        "wall_time_per_trial_s_max": max((r["wall_time_s"] for r in runs), default=0.0),
+        "wall_time_per_trial_s_mean": wall / max(len(runs), 1),
+        "sim_over_wall": sim / wall if wall else 0.0,
+    }
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -40,11 +64,9 @@ def main(argv: list[str] | None = None) -> int:
         fail("--runs and --max-actions must be >= 1")
     if args.agent not in AGENT_NAMES:
         fail(f"unknown agent {args.agent!r}. Available agents: {sorted(AGENT_NAMES)}")
-    if args.sim != "symbolic":
-        fail(f"--sim {args.sim} is not available yet; available: ['symbolic']")
     if (args.agent == "memory") != (args.memory is not None):
         fail("--memory goes with --agent memory (and only with it): train one with scripts/train.py")
-    if args.video:
+    if args.video and args.sim != "twin":
         fail("--video needs --sim twin")
     try:
         specs = [load_spec(path) for path in args.specs]
@@ -60,19 +82,34 @@ def main(argv: list[str] | None = None) -> int:
     write_json(out / "config.json", {"command": "trial", **vars(args), "versions": versions()})
     runs = []
     jobs = [(spec, args.seed + r) for spec in specs for r in range(args.runs)]
-    for spec, seed in tqdm(jobs, desc=f"{args.agent} trials", unit="run", disable=None):
+    for spec, seed in tqdm(jobs, desc=f"{args.agent} {args.sim} trials", unit="run", disable=None):
         try:
-            agent = make_agent(args.agent, spec, memory)
-            world = SymbolicWorld(spec, seed)
-            runs.append(run_episode(agent, world, spec.name, seed, args.max_actions))
-        except LearningError as err:
+            if args.sim == "twin":
+                from _twin_trial import run_twin_trial  # MuJoCo and rendering only when asked
+
+                name = "rollout.mp4" if len(jobs) == 1 else f"rollout-{spec.name}-s{seed}.mp4"
+                video = out / name if args.video else None
+                runs.append(run_twin_trial(spec, seed, args.agent, memory, args.max_actions, video))
+            else:
+                agent = make_agent(args.agent, spec, memory)
+                runs.append(run_episode(agent, SymbolicWorld(spec, seed), spec.name, seed, args.max_actions))
+        except (LearningError, ModelsError, SkillError, TwinError) as err:
             fail(f"{spec.name} seed {seed}: {err}")
     results = summarise(runs, args.max_actions)
+    if args.sim == "twin":
+        results.update(twin_figures(runs))
     write_json(out / "results.json", results)
     print(
         f"{args.agent} on {len(specs)} spec(s) x {args.runs} run(s): success {results['success_rate']:.1%}, "
         f"mean actions {results['mean_actions']:.2f} -> {out / 'results.json'}"
     )
+    if args.sim == "twin":
+        print(
+            f"outcome agreement {results['outcome_agreement']:.1%} over {results['actions_total']} actions; "
+            f"perceived position error max {1000 * results['perceived_position_error_max_m']:.1f} mm; "
+            f"wall time per trial max {results['wall_time_per_trial_s_max']:.1f} s; "
+            f"simulated/wall x{results['sim_over_wall']:.1f}"
+        )
     return 0
 
 

@@ -86,6 +86,13 @@ class MarkerDetector:
         # marker corners in the marker frame, in the order IPPE_SQUARE expects
         self._object_points = np.array([[-half, half, 0], [half, half, 0], [half, -half, 0], [-half, -half, 0]])
 
+    def detect_pixels(self, rgb: np.ndarray) -> list[tuple[np.ndarray, int]]:
+        """Image corners ``(4, 2)`` [px] and id of every marker in an RGB image (no pose)."""
+        corners, ids, _ = self._detector.detectMarkers(cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY))
+        if ids is None:
+            return []
+        return [(c.reshape(4, 2), int(i)) for c, i in zip(corners, ids.ravel(), strict=True)]
+
     def detect(self, image) -> list[MarkerDetection]:  # image: twin.robot_interface.CameraImage-like
         """All markers in ``image`` (an object with ``rgb``, ``K``, ``T_base_camera``, ``camera``)."""
         gray = cv2.cvtColor(image.rgb, cv2.COLOR_RGB2GRAY)

@@ -60,6 +60,8 @@ class TwinWorld:
     seed: int = 0
     ground_truth: Callable[[int], int] | None = None
     """Evaluation only: marker id -> the simulator's state of that component (never used to decide)."""
+    names: dict[int, str] | None = None
+    """Evaluation only: marker id -> the spec's component name, for result files."""
     log: list[ActionLog] = field(default_factory=list)
 
     def __post_init__(self) -> None:
@@ -119,5 +121,6 @@ class TwinWorld:
         return away if opening else not away
 
     def ground_truth_name(self, index: int) -> str:
-        """For logs: the marker id of component ``index``."""
-        return f"marker-{self.markers[index]}"
+        """For logs: the spec name of component ``index`` when given, else its marker id."""
+        marker = self.markers[index]
+        return self.names[marker] if self.names else f"marker-{marker}"

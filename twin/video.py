@@ -158,6 +158,9 @@ class VideoWriter:
             raise VideoError(f"no frames were appended; nothing was written to {self._path}")
         try:
             encoder.close()  # waits for ffmpeg to finish the file
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(temporary, 0o666 & ~umask)  # the temporary file was private; the video is not
             os.replace(temporary, self._path)
         except Exception as exc:
             with contextlib.suppress(OSError):
