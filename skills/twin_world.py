@@ -1,6 +1,7 @@
 """``TwinWorld``: the ``World`` protocol over the robot — perception in, primitives out.
 
-``observe()`` gives the components as the overview camera sees them at the start (kind from the
+``observe()`` gives the components as the overview camera sees them at the start (markers it misses
+are looked for again from the wrist camera; any still missing raise ``MarkersNotFound``) (kind from the
 cell's marker map, planar pose of each component frame in the base frame), in an order shuffled by
 the seed, with states the world tracks from its own outcomes. ``try_toggle(i)`` runs the toggle
 primitive on component ``i`` and decides "moved" from what the robot sensed: the primitive's
@@ -22,10 +23,22 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from models import ComponentObservation, SceneObservation
+from skills.errors import IKFailure, MarkersNotFound
 from skills.joint_model import JointModel, joint_model
+from skills.kinematics import top_down
 from skills.perception import MarkerDetection, MarkerDetector, kind_of, lid_height, select_markers, upright_pose
 from skills.primitives import Toggler, ToggleResult
 
+WRIST_CAMERA = "xarm7/gripper/wrist_camera"
+WRIST_VIEW_HEIGHT = 0.30
+"""Height of the TCP above the markers when looking from the wrist camera [m]."""
+WRIST_VIEW_OFFSETS = ((0.0, 0.0), (0.0, 0.15), (0.0, -0.15), (0.15, 0.0), (-0.15, 0.0))
+"""Where the wrist camera looks from, relative to the markers seen so far [m]."""
+TABLE_VIEW_HEIGHT = 0.40
+"""TCP height when sweeping the workspace for a box the overview camera does not see [m]."""
+WORKSPACE_VIEWPOINTS = ((0.40, 0.0), (0.30, 0.30), (0.30, -0.30), (0.50, 0.20), (0.50, -0.20), (0.25, 0.45),
+                        (0.25, -0.45))  # fmt: skip
+"""Where the wrist camera looks when no marker was seen at all, in the base frame [m]."""
 MOVED_DISTANCE = 0.01
 """A re-observed marker this far from its closed pose has moved [m]..."""
 MOVED_ANGLE = math.radians(20)
@@ -79,8 +92,37 @@ class TwinWorld:
         self.states = np.zeros(len(self.markers), dtype=np.int64)
 
     def _look(self) -> dict[int, MarkerDetection]:
-        image = self.robot.capture("overview")
-        return select_markers(self.detector.detect(image), set(self.marker_map), ("overview",))
+        """Markers from the overview camera; if some are missing or ambiguous, look again from the wrist
+        camera held above the markers seen so far, then report what is still missing."""
+        expected = set(self.marker_map)
+        seen = self.detector.detect(self.robot.capture("overview"))
+        try:
+            return select_markers(seen, expected, ("overview",))
+        except MarkersNotFound:
+            pass
+        wrist = self._look_from_wrist(seen)
+        return select_markers([d for d in seen if d.marker_id not in {w.marker_id for w in wrist}] + wrist,
+                              expected, ("overview", WRIST_CAMERA))  # fmt: skip
+
+    def _look_from_wrist(self, seen: list[MarkerDetection]) -> list[MarkerDetection]:
+        if seen:  # a few viewpoints around the markers seen so far
+            centre = np.mean([d.T_base_marker[:3, 3] for d in seen], axis=0)
+            viewpoints = [centre + (dx, dy, WRIST_VIEW_HEIGHT) for dx, dy in WRIST_VIEW_OFFSETS]
+        else:  # nothing seen: sweep the workspace
+            viewpoints = [np.array([x, y, TABLE_VIEW_HEIGHT]) for x, y in WORKSPACE_VIEWPOINTS]
+        found: list[MarkerDetection] = []
+        for point in viewpoints:  # until every id is seen
+            view = top_down(point, 0.0)
+            try:
+                self.toggler.move_to(view, 1.5)
+            except IKFailure:
+                continue
+            found += [d for d in self.detector.detect(self.robot.capture(WRIST_CAMERA))
+                      if d.marker_id not in {f.marker_id for f in found}]  # fmt: skip
+            if set(self.marker_map) <= {d.marker_id for d in found} | {d.marker_id for d in seen}:
+                break
+        self.toggler.go_rest()
+        return found
 
     def observe(self) -> SceneObservation:
         components = tuple(

@@ -76,3 +76,29 @@ def test_trial_cli_runs_the_twin_and_writes_a_timeline(tmp_path):
     assert [a["component"] for a in run["actions"]] == ["door-0", "slide-1"]
     assert {"outcome", "true_moved", "peak_force", "sim_time", "wall_time", "pose_error_m"} <= set(run["timeline"][0])
     assert (tmp_path / "out" / "rollout.mp4").stat().st_size > 10_000
+
+
+def test_markers_the_overview_camera_misses_are_found_from_the_wrist_camera():
+    from dataclasses import replace
+
+    from skills import MarkerDetector
+
+    spec = generate_chain(["door", "slide", "wheel"], seed=4)
+    spec = replace(spec, box=replace(spec.box, pose=(0.25, 0.36, 0.0)))  # beyond the overview's view
+    with TwinSession(spec, seed=0) as session:
+        assert MarkerDetector().detect(session.robot.capture("overview")) == []
+        world = twin_world(session)
+        truth = spec.poses_in_world()
+        for i, c in enumerate(spec.components):
+            assert np.linalg.norm(world.closed_poses[c.marker][:2] - truth[i, :2]) < 0.005
+        assert run_episode(OracleAgent(spec), world, spec.name, 0, max_actions=6).solved
+
+
+def test_a_marker_nobody_can_see_is_reported_missing():
+    import pytest
+
+    from skills import MarkersNotFound
+
+    spec = generate_chain(["door", "slide"], seed=1)
+    with TwinSession(spec, seed=0) as session, pytest.raises(MarkersNotFound, match=r"missing marker ids \[9\]"):
+        TwinWorld(session.robot, {**{c.marker: c.kind for c in spec.components}, 9: "wheel"}, 1)
