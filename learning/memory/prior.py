@@ -6,7 +6,7 @@ k nearest stored blocks in bucket ``(kind_i, kind_j)`` around j's pose in i's fr
 with the uninformed prior as a pseudo-neighbour: see :class:`MemoryConfig`). The weights are
 normalised, then ``uniform_mass`` is added to every possible hypothesis and the block renormalised, so
 a bad prior can still be unlearned. A bucket the memory has never filled falls back to the
-uninformed prior's value.
+uninformed prior's value, or — with ``back_off`` — is recalled from all pairs at a similar pose.
 """
 
 from __future__ import annotations
@@ -40,6 +40,12 @@ class MemoryConfig:
     """Weigh each recalled block by how resolved it was when stored (1 - entropy / max entropy), so
     blocks an episode actually pinned down outweigh blocks it left vague. False: the paper's equal
     weights."""
+    back_off: bool = True
+    """For a kind pair the memory has never seen, recall from every stored pair at a similar relative
+    pose (kernel-weighted, so a pose unlike any memory still recalls the uninformed prior) — a
+    back-off to the coarser bucket, as n-gram models do. Measured with one training variant (no
+    wheels): 100% / 5.93 actions on the unseen variants against 95.3% / 8.33 without; unchanged at
+    9 episodes (5.07) and on the validation split (6.96)."""
     uniform_mass: float = 0.01
     """Added to every hypothesis before renormalising (the authors' release: 0.01)."""
     position_scale: float = 0.02
@@ -73,6 +79,8 @@ def recall_prior(
             if i == j:
                 continue
             bucket = store.pair_bucket(kinds[i], kinds[j])
+            if bucket is None and config.back_off:
+                bucket = store.all_pairs_bucket()
             if bucket is None:
                 weights[j, :, 1 + 2 * i : 3 + 2 * i] = fallback[j, :, 1 + 2 * i : 3 + 2 * i]
                 continue

@@ -220,6 +220,15 @@ class MemoryStore:
             self._cache[cache_key] = Bucket(np.stack([k for k, _ in entries]), np.stack([v for _, v in entries]))
         return self._cache[cache_key]
 
+    def all_pairs_bucket(self) -> Bucket | None:
+        """Every stored pair, whatever its kinds (for kind pairs the memory has never seen)."""
+        if not self._pairs:
+            return None
+        if ("all-pairs",) not in self._cache:
+            entries = [entry for bucket in self._pairs.values() for entry in bucket]
+            self._cache[("all-pairs",)] = Bucket(np.stack([k for k, _ in entries]), np.stack([v for _, v in entries]))
+        return self._cache[("all-pairs",)]
+
     def independence_values(self, kind: str) -> np.ndarray | None:
         """``(M, 2)`` stored independence probabilities of a kind, or None if never seen."""
         entries = self._independence.get(kind)

@@ -472,11 +472,13 @@ def test_unseen_kind_pair_falls_back_to_the_uninformed_prior():
     probs[1, 0] = [0.0, 1.0, 0.0, 0.0, 0.0]  # "door in state 0 holds slide in state 0", resolved
     pair_values, independence = episode_record(Belief(probs).probs)
     store.add_episode(("door", "slide"), relative_pose_keys(poses, 0.02), pair_values, independence)
-    config = MemoryConfig(uniform_mass=0.0)
+    config = MemoryConfig(uniform_mass=0.0, back_off=False)
     recalled = recall_prior(store, ("door", "slide"), poses, config)
     assert recalled[1, 0, 1] > 0.5  # the same pose recalls the lock
     unseen = recall_prior(store, ("wheel", "wheel"), poses, config)
     np.testing.assert_allclose(unseen, default_prior(2))
+    backed_off = recall_prior(store, ("wheel", "wheel"), poses, MemoryConfig(uniform_mass=0.0))
+    assert backed_off[1, 0, 1] > 0.5  # with back-off, the pose alone recalls the lock
 
 
 def test_memory_recalls_which_locker_state_at_the_pose_it_was_learned_and_not_far_away():
