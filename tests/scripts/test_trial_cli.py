@@ -46,15 +46,17 @@ def test_symbolic_oracle_trial_writes_contract_results(tmp_path):
     assert config["agent"] == "oracle" and "versions" in config
 
 
-def test_trial_refuses_unknown_agent_and_unbuilt_sim_without_traceback(tmp_path):
+def test_trial_refuses_bad_requests_without_traceback(tmp_path):
     specs = tmp_path / "specs"
     run(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", specs)
     spec = specs / "paper-test-0.json"
     common = ["--specs", spec, "--runs", 1, "--seed", 0, "--max-actions", 5, "--out", tmp_path / "o"]
     bad_agent = run(ROOT / "scripts/trial.py", *common, "--sim", "symbolic", "--agent", "genius")
     assert bad_agent.returncode == 2 and "Available agents" in bad_agent.stderr
-    twin = run(ROOT / "scripts/trial.py", *common, "--sim", "twin")
-    assert twin.returncode == 2 and "Traceback" not in twin.stderr and "symbolic" in twin.stderr
+    video = run(ROOT / "scripts/trial.py", *common, "--sim", "symbolic", "--agent", "dual", "--video")
+    assert video.returncode == 2 and "Traceback" not in video.stderr and "--sim twin" in video.stderr
+    no_memory = run(ROOT / "scripts/trial.py", *common, "--sim", "twin", "--agent", "memory")
+    assert no_memory.returncode == 2 and "Traceback" not in no_memory.stderr and "--memory" in no_memory.stderr
     broken = tmp_path / "broken.json"
     broken.write_text("{")
     bad_spec = run(ROOT / "scripts/trial.py", *common[:1], broken, *common[2:], "--sim", "symbolic", "--agent", "dual")
