@@ -22,6 +22,8 @@ import numpy as np
 
 from learning.belief import Belief
 
+SMALL_N = 10
+"""Up to this N, the free table is one fancy-indexed gather; above, the doubling construction."""
 EXACT_MAX_COMPONENTS = 18
 """Largest N planned exactly over all 2^N states (2^18 states x N floats: ~40 MB)."""
 
@@ -45,8 +47,13 @@ def free_table(belief: Belief) -> np.ndarray:
     n = belief.num_components
     locker_probs = belief.probs[:, :, 1:].reshape(n, 2, n, 2)  # [c, x_c, m, x_m]
     size = 1 << n
-    free = np.empty((n, size))
     index = np.arange(size)
+    if n <= SMALL_N:  # one gather over (state, c, m): cheapest when 2^N * N^2 is small
+        bits = (index[:, None] >> np.arange(n)) & 1
+        c_idx, m_idx = np.arange(n)[None, :, None], np.arange(n)[None, None, :]
+        held = locker_probs[c_idx, bits[:, :, None], m_idx, bits[:, None, :]].sum(axis=2)
+        return np.clip(1.0 - held.T, 0.0, 1.0)
+    free = np.empty((n, size))
     for c in range(n):
         held_by_own_state = []
         for own in (0, 1):
