@@ -17,7 +17,7 @@ import mujoco
 import numpy as np
 from dm_control import mjcf
 
-from models.xarm7 import ARM_JOINTS, HOME_QPOS, build_xarm7
+from models.xarm7 import ARM_JOINTS, build_xarm7
 from skills.errors import IKFailure
 
 TCP_SITE = "gripper/tcp"
@@ -124,4 +124,3 @@ def top_down(position: np.ndarray, yaw: float) -> np.ndarray:
 
 
 __all__ = ["ArmKinematics", "IKConfig", "top_down"]
-_ = HOME_QPOS

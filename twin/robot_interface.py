@@ -16,7 +16,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-import mujoco
 import numpy as np
 
 from twin.errors import CommandError
@@ -175,5 +174,3 @@ class RobotInterface:
 
 
 __all__ = ["GRIPPER_CTRL_MAX", "CameraImage", "RobotInterface"]
-
-_ = mujoco  # the interface reads MuJoCo data but needs no MuJoCo call of its own
