@@ -1,6 +1,7 @@
 """Deep-RL baselines of the paper (torch, the ``baselines`` extra): a graph network over components,
 DQN on it, and (to come) the model-based precondition planner and MT-OPT variants."""
 
+from learning.baselines.dqn import DQNAgent, DQNConfig
 from learning.baselines.graph_network import GraphNetwork, GraphNetworkConfig, observation_tensors
 
-__all__ = ["GraphNetwork", "GraphNetworkConfig", "observation_tensors"]
+__all__ = ["DQNAgent", "DQNConfig", "GraphNetwork", "GraphNetworkConfig", "observation_tensors"]
