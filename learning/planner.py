@@ -68,11 +68,17 @@ def free_table(belief: Belief) -> np.ndarray:
 
 def state_values(belief: Belief, goal: int, goal_state: int, gamma: float) -> np.ndarray:
     """``V(x)`` for all ``2^N`` states by value iteration to the exact fixed point."""
-    n = belief.num_components
+    return value_iteration(free_table(belief), goal, goal_state, gamma)
+
+
+def value_iteration(free: np.ndarray, goal: int, goal_state: int, gamma: float) -> np.ndarray:
+    """``V(x)`` for all ``2^N`` states from any table ``free`` (N, 2^N) of move probabilities (the
+    belief's, or a learned precondition model's)."""
+    n = free.shape[0]
     size = 1 << n
     index = np.arange(size)
     is_goal = ((index >> goal) & 1) == goal_state
-    step = gamma * free_table(belief)  # (N, 2^N): gamma * P(c free | x)
+    step = gamma * free  # (N, 2^N): gamma * P(c free | x)
     values = is_goal.astype(np.float64)
     for _ in range(size):  # converges far sooner: each sweep extends the best paths by one action
         new = values.copy()

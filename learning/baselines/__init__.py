@@ -3,5 +3,14 @@ DQN on it, and (to come) the model-based precondition planner and MT-OPT variant
 
 from learning.baselines.dqn import DQNAgent, DQNConfig
 from learning.baselines.graph_network import GraphNetwork, GraphNetworkConfig, observation_tensors
+from learning.baselines.model_based import ModelBasedAgent, ModelBasedConfig
 
-__all__ = ["DQNAgent", "DQNConfig", "GraphNetwork", "GraphNetworkConfig", "observation_tensors"]
+__all__ = [
+    "DQNAgent",
+    "DQNConfig",
+    "GraphNetwork",
+    "GraphNetworkConfig",
+    "ModelBasedAgent",
+    "ModelBasedConfig",
+    "observation_tensors",
+]
