@@ -55,7 +55,13 @@ def annotate(frame: np.ndarray, detector: MarkerDetector) -> np.ndarray:
 
 
 def run_twin_trial(
-    spec: PuzzleSpec, seed: int, agent_name: str, memory: MemoryStore | None, max_actions: int, video: Path | None
+    spec: PuzzleSpec,
+    seed: int,
+    agent_name: str,
+    memory: MemoryStore | None,
+    max_actions: int,
+    video: Path | None,
+    checkpoint: str | None = None,
 ) -> dict[str, Any]:
     """One end-to-end trial; returns the contract's run entry plus a ``timeline`` and figures."""
     wall = time.perf_counter()
@@ -80,7 +86,8 @@ def run_twin_trial(
             for c in spec.components:  # perceived closed pose against the simulator's (evaluation only)
                 truth = session.data.site(session.scene.names.components[c.name].frame_site).xpos
                 pose_errors[c.name] = float(np.linalg.norm(world.closed_poses[c.marker][:2] - truth[:2]))
-            result = run_episode(make_agent(agent_name, spec, memory), world, spec.name, seed, max_actions)
+            agent = make_agent(agent_name, spec, memory, checkpoint)
+            result = run_episode(agent, world, spec.name, seed, max_actions)
         finally:
             if writer is not None:
                 writer.close()

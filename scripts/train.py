@@ -1,6 +1,7 @@
 """Train the memory agent in the symbolic simulator and write its memory.
 
     python scripts/train.py --specs FILE... --episodes E --memory MEM.sqlite [--seed S]
+    python scripts/train.py --specs FILE... --episodes E --agent {dqn,model-based} --checkpoint FILE [--seed S]
 
 Episode ``e`` runs on ``specs[e % len(specs)]`` with world seed ``S + e``. The memory is written to
 SQLite after every episode (one transaction each), so an interrupted run keeps every finished
@@ -26,7 +27,9 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--specs", nargs="+", required=True, help="training puzzle spec files")
     parser.add_argument("--episodes", type=int, required=True, help="training episodes (cycling through the specs)")
-    parser.add_argument("--memory", required=True, help="SQLite memory file (created or continued)")
+    parser.add_argument("--memory", default=None, help="SQLite memory file (created or continued): memory agent")
+    parser.add_argument("--agent", default="memory", choices=("memory", "dqn", "model-based"))
+    parser.add_argument("--checkpoint", default=None, help="output checkpoint (dqn and model-based agents)")
     parser.add_argument("--seed", type=int, default=0, help="world seed of episode 0; episode e uses seed + e")
     parser.add_argument("--max-actions", type=int, default=50, help="action budget per training episode")
     args = parser.parse_args(argv)
@@ -36,6 +39,12 @@ def main(argv: list[str] | None = None) -> int:
         specs = [load_spec(path) for path in args.specs]
     except SpecError as err:
         fail(str(err))
+    if args.agent != "memory":
+        if args.checkpoint is None or args.memory is not None:
+            fail(f"--agent {args.agent} trains a network: give --checkpoint FILE (and no --memory)")
+        return _train_deep(args, specs)
+    if args.memory is None:
+        fail("the memory agent needs --memory MEM.sqlite")
     try:
         store = MemoryStore(args.memory)
     except LearningError as err:
@@ -53,6 +62,23 @@ def main(argv: list[str] | None = None) -> int:
     store.close()
     solved = sum(r["solved"] for r in log["runs"])
     print(f"trained {args.episodes} episode(s), {solved} solved; memory holds {store.num_episodes} -> {args.memory}")
+    return 0
+
+
+def _train_deep(args: argparse.Namespace, specs: list) -> int:
+    from learning.baselines import DQNAgent, ModelBasedAgent, save_checkpoint  # torch only when asked
+
+    agent = DQNAgent() if args.agent == "dqn" else ModelBasedAgent()
+    log = {"command": "train", **vars(args), "versions": versions(), "runs": []}
+    for e in tqdm(range(args.episodes), desc=f"training {args.agent}", unit="episode", disable=None):
+        spec = specs[e % len(specs)]
+        result = run_episode(agent, SymbolicWorld(spec, args.seed + e), spec.name, args.seed + e, args.max_actions)
+        log["runs"].append({k: v for k, v in result.to_dict().items() if k != "actions"})
+        if (e + 1) % 50 == 0 or e + 1 == args.episodes:  # nothing much lost on a crash
+            save_checkpoint(agent, args.checkpoint)
+            write_json(Path(args.checkpoint + ".train.json"), log)
+    solved = sum(r["solved"] for r in log["runs"])
+    print(f"trained {args.agent} for {args.episodes} episode(s), {solved} solved -> {args.checkpoint}")
     return 0
 
 

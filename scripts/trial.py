@@ -56,6 +56,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--max-actions", type=int, required=True, help="action budget per run")
     parser.add_argument("--out", required=True, help="output directory")
     parser.add_argument("--agent", default="memory", help=f"one of {list(AGENT_NAMES)} (default: memory)")
+    parser.add_argument("--checkpoint", default=None, help="checkpoint from train.py (dqn and model-based agents)")
     parser.add_argument("--video", action="store_true", help="record rollout videos (twin only)")
     args = parser.parse_args(argv)
     # The memory is read, never written, during trials: evaluation does not change what was learned.
@@ -89,9 +90,9 @@ def main(argv: list[str] | None = None) -> int:
 
                 name = "rollout.mp4" if len(jobs) == 1 else f"rollout-{spec.name}-s{seed}.mp4"
                 video = out / name if args.video else None
-                runs.append(run_twin_trial(spec, seed, args.agent, memory, args.max_actions, video))
+                runs.append(run_twin_trial(spec, seed, args.agent, memory, args.max_actions, video, args.checkpoint))
             else:
-                agent = make_agent(args.agent, spec, memory)
+                agent = make_agent(args.agent, spec, memory, args.checkpoint)
                 runs.append(run_episode(agent, SymbolicWorld(spec, seed), spec.name, seed, args.max_actions))
         except (LearningError, ModelsError, SkillError, TwinError) as err:
             fail(f"{spec.name} seed {seed}: {err}")

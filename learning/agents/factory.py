@@ -10,13 +10,22 @@ from learning.errors import ConfigError, UnknownAgent
 from learning.memory.store import MemoryStore
 from models import PuzzleSpec
 
-AGENT_NAMES = ("memory", "dual", "random", "oracle")
+AGENT_NAMES = ("memory", "dual", "random", "oracle", "dqn", "model-based")
 """``memory``: dual controller + memory prior (needs a memory); ``dual``: no memory; ``random``;
-``oracle``: knows the spec's locks and plays a shortest plan (the floor on actions)."""
+``oracle``: knows the spec's locks and plays a shortest plan (the floor on actions); ``dqn`` and
+``model-based``: the deep baselines (need a checkpoint; torch)."""
 
 
-def make_agent(name: str, spec: PuzzleSpec, memory: MemoryStore | None = None) -> Agent:
+def make_agent(name: str, spec: PuzzleSpec, memory: MemoryStore | None = None, checkpoint: str | None = None) -> Agent:
     """A fresh agent for one puzzle; :class:`UnknownAgent` lists the names that exist."""
+    if name in ("dqn", "model-based"):
+        if checkpoint is None:
+            raise ConfigError(f"agent {name!r} needs a checkpoint (train one with scripts/train.py --agent {name})")
+        from learning.baselines.checkpoint import load_checkpoint  # torch only when asked
+
+        return load_checkpoint(checkpoint, expected_agent=name)
+    if checkpoint is not None:
+        raise ConfigError(f"agent {name!r} takes no checkpoint; --checkpoint is for dqn and model-based")
     if name == "memory":
         if memory is None:
             raise ConfigError("agent 'memory' needs a memory (train one with scripts/train.py, pass --memory)")

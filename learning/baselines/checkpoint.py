@@ -1,0 +1,86 @@
+"""Checkpoints of the deep baselines: the network's ``state_dict`` (``FILE``) and a JSON beside it
+(``FILE.json``) with the agent's name, its resolved config, training progress and package versions,
+so a checkpoint can be reloaded — and its result re-run — exactly.
+"""
+
+from __future__ import annotations
+
+import json
+import platform
+from dataclasses import asdict
+from importlib import metadata
+from pathlib import Path
+
+import torch
+
+from learning.baselines.dqn import DQNAgent, DQNConfig
+from learning.baselines.graph_network import GraphNetworkConfig
+from learning.baselines.model_based import ModelBasedAgent, ModelBasedConfig
+from learning.errors import LearningError
+
+CHECKPOINT_FORMAT = "puzzlebox-baseline/1"
+AGENTS = {"dqn": (DQNAgent, DQNConfig), "model-based": (ModelBasedAgent, ModelBasedConfig)}
+
+
+class CheckpointError(LearningError):
+    """A checkpoint that cannot be loaded: missing, unreadable, or of another agent or format."""
+
+
+def _network(agent: DQNAgent | ModelBasedAgent) -> torch.nn.Module:
+    return agent.q if isinstance(agent, DQNAgent) else agent.net
+
+
+def save_checkpoint(agent: DQNAgent | ModelBasedAgent, path: str | Path) -> Path:
+    """Write ``path`` (weights) and ``path.json`` (metadata), each atomically."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    meta = {
+        "format": CHECKPOINT_FORMAT,
+        "agent": agent.name,
+        "config": asdict(agent.config),
+        "episodes": agent.episodes,
+        "versions": {"python": platform.python_version(), "torch": torch.__version__,
+                     "puzzlebox": _version("puzzlebox")},
+    }  # fmt: skip
+    tmp = path.with_name(path.name + ".tmp")
+    torch.save(_network(agent).state_dict(), tmp)
+    tmp.replace(path)
+    meta_path = Path(str(path) + ".json")
+    tmp_meta = meta_path.with_name(meta_path.name + ".tmp")
+    tmp_meta.write_text(json.dumps(meta, indent=2))
+    tmp_meta.replace(meta_path)
+    return path
+
+
+def load_checkpoint(path: str | Path, expected_agent: str | None = None) -> DQNAgent | ModelBasedAgent:
+    """The agent of a checkpoint, ready to evaluate (``training = False``)."""
+    path = Path(path)
+    meta_path = Path(str(path) + ".json")
+    if not path.is_file() or not meta_path.is_file():
+        raise CheckpointError(f"no checkpoint at {path} (needs {path.name} and {meta_path.name})")
+    try:
+        meta = json.loads(meta_path.read_text())
+    except (OSError, json.JSONDecodeError) as err:
+        raise CheckpointError(f"{meta_path} is not readable JSON: {err}") from None
+    if meta.get("format") != CHECKPOINT_FORMAT or meta.get("agent") not in AGENTS:
+        raise CheckpointError(f"{meta_path} is not a puzzlebox baseline checkpoint (agents: {sorted(AGENTS)})")
+    if expected_agent is not None and meta["agent"] != expected_agent:
+        raise CheckpointError(f"{path} holds agent {meta['agent']!r}, not {expected_agent!r}")
+    agent_cls, config_cls = AGENTS[meta["agent"]]
+    raw = dict(meta["config"])
+    raw["network"] = GraphNetworkConfig(**raw["network"])
+    agent = agent_cls(config_cls(**raw))
+    try:
+        _network(agent).load_state_dict(torch.load(path, weights_only=True))
+    except (RuntimeError, OSError, ValueError) as err:
+        raise CheckpointError(f"{path}: weights do not match the recorded config: {err}") from None
+    agent.episodes = int(meta.get("episodes", 0))
+    agent.training = False
+    return agent
+
+
+def _version(package: str) -> str:
+    try:
+        return metadata.version(package)
+    except metadata.PackageNotFoundError:
+        return "not installed"
