@@ -71,6 +71,11 @@ def state_values(belief: Belief, goal: int, goal_state: int, gamma: float) -> np
     return value_iteration(free_table(belief), goal, goal_state, gamma)
 
 
+def bitmask(states: np.ndarray) -> int:
+    """The joint state as a bitmask: bit ``c`` is the state (0/1) of component ``c``."""
+    return int(sum(int(s) << c for c, s in enumerate(states)))
+
+
 def value_iteration(free: np.ndarray, goal: int, goal_state: int, gamma: float) -> np.ndarray:
     """``V(x)`` for all ``2^N`` states from any table ``free`` (N, 2^N) of move probabilities (the
     belief's, or a learned precondition model's)."""
@@ -98,7 +103,7 @@ def exploit_values(
     """``Q_exploit`` for every action from joint state ``states`` (0/1 per component)."""
     config = config or PlannerConfig()
     n = belief.num_components
-    x = int(sum(int(s) << c for c, s in enumerate(states)))
+    x = bitmask(states)
     if n <= EXACT_MAX_COMPONENTS:
         values = state_values(belief, goal, goal_state, config.gamma)
         free = np.array([belief.probability_free(states, c) for c in range(n)])

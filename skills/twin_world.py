@@ -154,8 +154,10 @@ class TwinWorld:
             return False
         seen = self.detector.detect(self.robot.capture("overview"))
         poses = [d.planar_pose for d in seen if d.marker_id == marker]
-        if not poses:  # a door standing open shows its marker edge-on; otherwise trust the F/T verdict
-            return result.outcome == "moved" if kind_of(self.marker_map, marker) != "door" or not opening else True
+        if not poses:
+            if opening and kind_of(self.marker_map, marker) == "door":
+                return True  # a door standing open shows its marker edge-on: it left its closed pose
+            return result.outcome == "moved"  # otherwise hidden (the arm?): trust the F/T verdict
         else:
             delta = poses[0] - self.closed_poses[marker]
             turn = abs((delta[2] + math.pi) % (2 * math.pi) - math.pi)

@@ -9,8 +9,6 @@ evaluation with epsilon 0.1. Rewards: +1 on reaching the goal, ``step_reward`` p
 from __future__ import annotations
 
 import copy
-import random
-from collections import defaultdict, deque
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -18,6 +16,7 @@ import torch
 from torch import nn
 
 from learning.baselines.graph_network import GraphNetwork, GraphNetworkConfig, observation_tensors
+from learning.baselines.learner import EpsilonGreedyLearner
 from models import SceneObservation
 
 
@@ -54,64 +53,31 @@ class _Transition:
     done: bool
 
 
-class DQNAgent:
+class DQNAgent(EpsilonGreedyLearner):
     """The agent (``Agent`` protocol). ``training=True``: epsilon-greedy with learning; else evaluation."""
 
     name = "dqn"
 
     def __init__(self, config: DQNConfig | None = None) -> None:
-        self.config = config or DQNConfig()
-        torch.manual_seed(self.config.seed)
+        super().__init__(config or DQNConfig())
         self.q = GraphNetwork(self.config.network)
         self.target = copy.deepcopy(self.q)
         self.optimizer = torch.optim.Adam(self.q.parameters(), lr=self.config.learning_rate)
-        self.replay: dict[int, deque[_Transition]] = defaultdict(lambda: deque(maxlen=self.config.replay_size))
-        self.epsilon = self.config.epsilon_start
-        self.training = True
-        self._sample_rng = random.Random(self.config.seed)
-        self._rng = np.random.default_rng(0)
-        self._last: tuple[np.ndarray, np.ndarray] | None = None
-        self.episodes = 0
 
-    # -- the Agent protocol -----------------------------------------------------------------------
-    def begin_episode(self, observation: SceneObservation, rng: np.random.Generator) -> None:
-        self._rng = rng
-
-    def choose(self, observation: SceneObservation) -> int:
-        self._last = observation_tensors(observation, self.config.network.position_scale)
-        epsilon = self.epsilon if self.training else self.config.epsilon_eval
-        if self._rng.random() < epsilon:
-            return int(self._rng.integers(len(observation)))
+    def greedy_values(self, observation: SceneObservation) -> np.ndarray:
         nodes, edges = self._last
         with torch.no_grad():
-            q = self.q(torch.from_numpy(nodes)[None], torch.from_numpy(edges)[None])[0].numpy()
-        best = np.flatnonzero(q >= q.max() - 1e-9)
-        return int(self._rng.choice(best))
+            return self.q(torch.from_numpy(nodes)[None], torch.from_numpy(edges)[None])[0].numpy()
 
-    def record(self, index: int, moved: bool, observation: SceneObservation) -> None:
-        if not self.training or self._last is None:
-            return
+    def example(self, index: int, moved: bool, observation: SceneObservation) -> _Transition:
         done = observation.solved
         reward = self.config.goal_reward if done else self.config.step_reward
         next_nodes, next_edges = observation_tensors(observation, self.config.network.position_scale)
         nodes, edges = self._last
-        self.replay[len(nodes)].append(_Transition(nodes, edges, index, reward, next_nodes, next_edges, done))
-        for _ in range(self.config.updates_per_action):
-            self.update()
+        return _Transition(nodes, edges, index, reward, next_nodes, next_edges, done)
 
-    def end_episode(self, solved: bool) -> None:
-        if self.training:
-            self.episodes += 1
-            self.epsilon = max(self.config.epsilon_min, self.epsilon * self.config.epsilon_decay)
-
-    # -- learning ----------------------------------------------------------------------------------
-    def update(self) -> float | None:
-        """One gradient step on a replay batch (of puzzles with one component count); the Huber loss."""
-        sizes = [n for n, buffer in self.replay.items() if len(buffer) >= self.config.batch_size]
-        if not sizes:
-            return None
-        buffer = self.replay[self._sample_rng.choice(sizes)]
-        batch = self._sample_rng.sample(list(buffer), self.config.batch_size)
+    def learn(self, batch: list[_Transition]) -> float:
+        """TD step with the Huber loss, then a soft update of the target network."""
         nodes = torch.from_numpy(np.stack([t.nodes for t in batch]))
         edges = torch.from_numpy(np.stack([t.edges for t in batch]))
         next_nodes = torch.from_numpy(np.stack([t.next_nodes for t in batch]))

@@ -10,8 +10,6 @@ iteration (``learning.planner.value_iteration``) turns into Q_exploit; epsilon-g
 
 from __future__ import annotations
 
-import random
-from collections import defaultdict, deque
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -19,7 +17,8 @@ import torch
 from torch import nn
 
 from learning.baselines.graph_network import GraphNetwork, GraphNetworkConfig, observation_tensors
-from learning.planner import value_iteration
+from learning.baselines.learner import EpsilonGreedyLearner
+from learning.planner import bitmask, value_iteration
 from models import KIND_NAMES, SceneObservation
 
 STATE_FEATURE = len(KIND_NAMES)
@@ -52,26 +51,15 @@ class _Example:
     moved: bool
 
 
-class ModelBasedAgent:
+class ModelBasedAgent(EpsilonGreedyLearner):
     """The agent (``Agent`` protocol); ``training=True`` explores and fits, else evaluates."""
 
     name = "model-based"
 
     def __init__(self, config: ModelBasedConfig | None = None) -> None:
-        self.config = config or ModelBasedConfig()
-        torch.manual_seed(self.config.seed)
+        super().__init__(config or ModelBasedConfig())
         self.net = GraphNetwork(self.config.network)
         self.optimizer = torch.optim.Adam(self.net.parameters(), lr=self.config.learning_rate)
-        self.examples: dict[int, deque[_Example]] = defaultdict(lambda: deque(maxlen=self.config.replay_size))
-        self.epsilon = self.config.epsilon_start
-        self.training = True
-        self.episodes = 0
-        self._sample_rng = random.Random(self.config.seed)
-        self._rng = np.random.default_rng(0)
-        self._last: tuple[np.ndarray, np.ndarray] | None = None
-
-    def begin_episode(self, observation: SceneObservation, rng: np.random.Generator) -> None:
-        self._rng = rng
 
     def move_probabilities(self, observation: SceneObservation) -> np.ndarray:
         """``(N, 2^N)``: the network's P(component moves) in every joint state of this scene."""
@@ -84,37 +72,19 @@ class ModelBasedAgent:
             logits = self.net(torch.from_numpy(batch), torch.from_numpy(edges)[None].expand(len(bits), -1, -1, -1))
         return torch.sigmoid(logits).numpy().T
 
-    def choose(self, observation: SceneObservation) -> int:
-        self._last = observation_tensors(observation, self.config.network.position_scale)
-        epsilon = self.epsilon if self.training else self.config.epsilon_eval
-        if self._rng.random() < epsilon:
-            return int(self._rng.integers(len(observation)))
+    def greedy_values(self, observation: SceneObservation) -> np.ndarray:
+        """Q_exploit from the learned move probabilities (the agent's exploitation search)."""
         free = self.move_probabilities(observation)
         values = value_iteration(free, observation.goal_index, observation.goal_state, self.config.gamma)
-        x = int(sum(int(s) << c for c, s in enumerate(observation.states)))
-        q = self.config.gamma * free[:, x] * values[[x ^ (1 << c) for c in range(len(observation))]]
-        best = np.flatnonzero(q >= q.max() - 1e-12)
-        return int(self._rng.choice(best))
+        x = bitmask(observation.states)
+        return self.config.gamma * free[:, x] * values[[x ^ (1 << c) for c in range(len(observation))]]
 
-    def record(self, index: int, moved: bool, observation: SceneObservation) -> None:
-        if not self.training or self._last is None:
-            return
+    def example(self, index: int, moved: bool, observation: SceneObservation) -> _Example:
         nodes, edges = self._last
-        self.examples[len(nodes)].append(_Example(nodes, edges, index, moved))
-        for _ in range(self.config.updates_per_action):
-            self.update()
+        return _Example(nodes, edges, index, moved)
 
-    def end_episode(self, solved: bool) -> None:
-        if self.training:
-            self.episodes += 1
-            self.epsilon = max(self.config.epsilon_min, self.epsilon * self.config.epsilon_decay)
-
-    def update(self) -> float | None:
+    def learn(self, batch: list[_Example]) -> float:
         """One gradient step of binary cross-entropy on a batch of tries; the loss."""
-        sizes = [n for n, examples in self.examples.items() if len(examples) >= self.config.batch_size]
-        if not sizes:
-            return None
-        batch = self._sample_rng.sample(list(self.examples[self._sample_rng.choice(sizes)]), self.config.batch_size)
         nodes = torch.from_numpy(np.stack([b.nodes for b in batch]))
         edges = torch.from_numpy(np.stack([b.edges for b in batch]))
         actions = torch.tensor([b.action for b in batch])
