@@ -3,7 +3,16 @@ baselines). Imports only ``models`` — never ``twin`` or ``skills`` (DESIGN.md,
 
 import gymnasium
 
-from learning.agents import AGENT_NAMES, Agent, DualAgent, MemoryAgent, OracleAgent, RandomAgent, make_agent
+from learning.agents import (
+    AGENT_NAMES,
+    DEEP_AGENT_NAMES,
+    Agent,
+    DualAgent,
+    MemoryAgent,
+    OracleAgent,
+    RandomAgent,
+    make_agent,
+)
 from learning.errors import ConfigError, InvalidAction, LearningError, UnknownAgent
 from learning.puzzle_env import FaultConfig, PuzzleEnv, PuzzleEnvConfig
 from learning.symbolic_world import SymbolicWorld
@@ -14,6 +23,7 @@ gymnasium.register(id="puzzlebox/Puzzle-v0", entry_point="learning.puzzle_env:Pu
 
 __all__ = [
     "AGENT_NAMES",
+    "DEEP_AGENT_NAMES",
     "ActionRecord",
     "Agent",
     "ConfigError",

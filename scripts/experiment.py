@@ -1,69 +1,119 @@
-"""Run the paper's symbolic protocols and compare with the paper's numbers.
+"""Run the paper's symbolic protocols for every agent and compare with the paper's numbers.
 
-    python scripts/experiment.py {variants,episodes,noise} --agents memory,dual,random,oracle --out DIR [--quick]
+    python scripts/experiment.py {variants,episodes,noise,all} --agents memory,dqn,model-based,mt-dqn,mt-model-based \\
+        --out DIR [--quick] [--runs R] [--seeds S] [--workers W]
 
-Writes ``DIR/<protocol>.json`` (every point, mean and std over training seeds, the settings),
-``DIR/<protocol>.png`` (success and mean actions, like the paper's Fig. 3 panels) and
-``DIR/<protocol>.md`` (our numbers beside the paper's), and prints the tables.
+Writes ``DIR/<protocol>.json`` (every point, mean and std over training seeds and each seed's value,
+the settings), ``DIR/<protocol>.png`` (success and mean actions, like the paper's Fig. 3 panels) and
+``DIR/<protocol>.md`` (our numbers beside the paper's), and prints the tables. ``all`` runs the three
+protocols (sharing the deep agents' training) and adds ``DIR/all.md`` with the episodes-to-100 %
+table and the wall time of every part.
+
+The deep agents (``dqn``, ``model-based``, ``mt-dqn``, ``mt-model-based``; torch) train as jobs, one
+per agent, training seed and training-variant count, ``--workers`` at a time (default: one per
+core). Every finished job is saved in ``DIR/jobs/`` at once: run the same command again after an
+interruption and it resumes, reusing every finished job.
 """
 
 from __future__ import annotations
 
 import argparse
 import time
-from dataclasses import replace
+from dataclasses import asdict, replace
 from pathlib import Path
+from typing import Any
 
 from _cli import fail, versions, write_json
 
 from learning.errors import LearningError
 from learning.experiments import PROTOCOLS, SYMBOLIC_AGENTS, ProtocolConfig, comparison_table, plot, results_table
+from learning.experiments.deep_protocols import DEEP_AGENTS, DeepSchedule, jobs_for, merge_deep_points, run_jobs
+from learning.experiments.report import episodes_to_solve_table
 
 PLANNED = ("disassembly",)
+ALL = "all"
+AGENTS = (*SYMBOLIC_AGENTS, *DEEP_AGENTS)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("protocol", choices=(*PROTOCOLS, *PLANNED))
-    parser.add_argument("--agents", required=True, help=f"comma-separated, from {list(SYMBOLIC_AGENTS)}")
-    parser.add_argument("--out", required=True, help="output directory")
-    parser.add_argument("--quick", action="store_true", help="CI size: few runs, one training seed, 3 points")
+    parser.add_argument("protocol", choices=(*PROTOCOLS, ALL, *PLANNED))
+    parser.add_argument("--agents", required=True, help=f"comma-separated, from {list(AGENTS)}")
+    parser.add_argument("--out", required=True, help="output directory (also the resume cache of deep jobs)")
+    parser.add_argument("--quick", action="store_true", help="CI size: few runs, one training seed, short schedules")
     parser.add_argument("--runs", type=int, default=None, help="runs per unseen variant (default 50)")
     parser.add_argument("--seeds", type=int, default=None, help="training seeds (default 3)")
+    parser.add_argument("--workers", type=int, default=None, help="parallel deep-agent jobs (default: cores)")
     args = parser.parse_args(argv)
 
     if args.protocol in PLANNED:
-        fail(f"protocol {args.protocol!r} is not available yet; available: {sorted(PROTOCOLS)}")
+        fail(f"protocol {args.protocol!r} is not available yet; available: {sorted(PROTOCOLS)} and {ALL!r}")
     agents = [a.strip() for a in args.agents.split(",") if a.strip()]
-    unknown = [a for a in agents if a not in SYMBOLIC_AGENTS]
+    unknown = [a for a in agents if a not in AGENTS]
     if not agents or unknown:
-        fail(f"unknown agents {unknown or agents}; available: {list(SYMBOLIC_AGENTS)}")
-    config = ProtocolConfig()
+        fail(f"unknown agents {unknown or agents}; available: {list(AGENTS)}")
+    config, schedule = ProtocolConfig(), DeepSchedule()
     if args.quick:
-        config = config.quick()
+        config, schedule = config.quick(), schedule.quick()
     if args.runs is not None:
         config = replace(config, runs_per_variant=args.runs)
     if args.seeds is not None:
         config = replace(config, training_seeds=args.seeds)
-    if config.runs_per_variant < 1 or config.training_seeds < 1:
-        fail("--runs and --seeds must be >= 1")
+    if config.runs_per_variant < 1 or config.training_seeds < 1 or (args.workers is not None and args.workers < 1):
+        fail("--runs, --seeds and --workers must be >= 1")
 
     out = Path(args.out)
-    write_json(out / f"{args.protocol}.config.json", {"command": "experiment", **vars(args), "versions": versions()})
+    protocols = list(PROTOCOLS) if args.protocol == ALL else [args.protocol]
+    write_json(
+        out / f"{args.protocol}.config.json",
+        {"command": "experiment", **vars(args), "protocol_config": asdict(config),
+         "deep_schedule": asdict(schedule), "versions": versions()},
+    )  # fmt: skip
+    symbolic = [a for a in agents if a in SYMBOLIC_AGENTS]
+    deep = [a for a in agents if a in DEEP_AGENTS]
     start = time.perf_counter()
+    timings: dict[str, float] = {}
+    results: dict[str, dict[str, Any]] = {}
     try:
-        result = PROTOCOLS[args.protocol](agents, config, quick=args.quick)
+        for protocol in protocols:
+            t0 = time.perf_counter()
+            results[protocol] = PROTOCOLS[protocol](symbolic, config, quick=args.quick)
+            timings[f"{protocol}: symbolic agents"] = time.perf_counter() - t0
+        if deep:
+            jobs = [job for protocol in protocols for job in jobs_for(protocol, deep, config, schedule)]
+            records, summary = run_jobs(jobs, config, out, args.workers)
+            timings["deep agents (all their jobs)"] = summary["wall_time_s"]
+            print(f"deep agents: {summary['computed']} job(s) run, {summary['reused']} reused from {out}/jobs")
+            for protocol in protocols:
+                results[protocol] = merge_deep_points(results[protocol], deep, records, config, schedule)
+                results[protocol]["deep_jobs"] = summary
     except LearningError as err:
         fail(str(err))
-    result["wall_time_s"] = time.perf_counter() - start
-    write_json(out / f"{args.protocol}.json", result)
-    plot(result, out / f"{args.protocol}.png")
-    tables = f"## {args.protocol}: all points (success / mean actions)\n\n{results_table(result)}\n\n"
-    tables += f"## {args.protocol}: ours beside the paper\n\n{comparison_table(result)}\n"
-    (out / f"{args.protocol}.md").write_text(tables)
-    print(tables)
-    print(f"{args.protocol}: {result['wall_time_s']:.0f} s -> {out}/{args.protocol}.{{json,png,md}}")
+    total = time.perf_counter() - start
+    for protocol, result in results.items():
+        result["wall_time_s"] = total
+        result["timings_s"] = timings
+        _write(result, out, protocol)
+    if args.protocol == ALL:
+        lines = ["# All protocols", "", "## Episodes to 100% on the unseen variants", ""]
+        lines += [episodes_to_solve_table(results["episodes"]), "", "## Wall time", "", "| part | s |", "|---|---|"]
+        lines += [f"| {part} | {seconds:.0f} |" for part, seconds in timings.items()]
+        lines += [f"| **total** | **{total:.0f}** |", ""]
+        (out / "all.md").write_text("\n".join(lines))
+        print("\n".join(lines))
+    print(f"{args.protocol}: {total:.0f} s -> {out}/")
     return 0
+
+
+def _write(result: dict[str, Any], out: Path, protocol: str) -> None:
+    write_json(out / f"{protocol}.json", result)
+    plot(result, out / f"{protocol}.png")
+    tables = f"## {protocol}: all points (success / mean actions)\n\n{results_table(result)}\n\n"
+    tables += f"## {protocol}: ours beside the paper\n\n{comparison_table(result)}\n"
+    if protocol == "episodes":
+        tables += f"\n## episodes to 100% on the unseen variants\n\n{episodes_to_solve_table(result)}\n"
+    (out / f"{protocol}.md").write_text(tables)
+    print(tables)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,9 @@
 """Train the memory agent in the symbolic simulator and write its memory.
 
     python scripts/train.py --specs FILE... --episodes E --memory MEM.sqlite [--seed S]
-    python scripts/train.py --specs FILE... --episodes E --agent {dqn,model-based} --checkpoint FILE [--seed S]
+    python scripts/train.py --specs FILE... --episodes E --agent DEEP --checkpoint FILE [--seed S]
+
+``DEEP`` is one of dqn, model-based, mt-dqn, mt-model-based.
 
 Episode ``e`` runs on ``specs[e % len(specs)]`` with world seed ``S + e``. The memory is written to
 SQLite after every episode (one transaction each), so an interrupted run keeps every finished
@@ -17,7 +19,7 @@ from pathlib import Path
 from _cli import fail, versions, write_json
 from tqdm import tqdm
 
-from learning import MemoryAgent, SymbolicWorld, run_episode
+from learning import DEEP_AGENT_NAMES, MemoryAgent, SymbolicWorld, run_episode
 from learning.errors import LearningError
 from learning.memory import MemoryStore
 from models import SpecError, load_spec
@@ -28,7 +30,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--specs", nargs="+", required=True, help="training puzzle spec files")
     parser.add_argument("--episodes", type=int, required=True, help="training episodes (cycling through the specs)")
     parser.add_argument("--memory", default=None, help="SQLite memory file (created or continued): memory agent")
-    parser.add_argument("--agent", default="memory", choices=("memory", "dqn", "model-based"))
+    parser.add_argument("--agent", default="memory", choices=("memory", *DEEP_AGENT_NAMES))
     parser.add_argument("--checkpoint", default=None, help="output checkpoint (dqn and model-based agents)")
     parser.add_argument("--seed", type=int, default=0, help="world seed of episode 0; episode e uses seed + e")
     parser.add_argument("--max-actions", type=int, default=50, help="action budget per training episode")
@@ -66,9 +68,9 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _train_deep(args: argparse.Namespace, specs: list) -> int:
-    from learning.baselines import DQNAgent, ModelBasedAgent, save_checkpoint  # torch only when asked
+    from learning.baselines import make_learner, save_checkpoint  # torch only when asked
 
-    agent = DQNAgent() if args.agent == "dqn" else ModelBasedAgent()
+    agent = make_learner(args.agent, args.seed)
     log = {"command": "train", **vars(args), "versions": versions(), "runs": []}
     for e in tqdm(range(args.episodes), desc=f"training {args.agent}", unit="episode", disable=None):
         spec = specs[e % len(specs)]

@@ -56,7 +56,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--max-actions", type=int, required=True, help="action budget per run")
     parser.add_argument("--out", required=True, help="output directory")
     parser.add_argument("--agent", default="memory", help=f"one of {list(AGENT_NAMES)} (default: memory)")
-    parser.add_argument("--checkpoint", default=None, help="checkpoint from train.py (dqn and model-based agents)")
+    parser.add_argument("--checkpoint", default=None, help="checkpoint from train.py (deep agents)")
     parser.add_argument("--video", action="store_true", help="record rollout videos (twin only)")
     args = parser.parse_args(argv)
     # The memory is read, never written, during trials: evaluation does not change what was learned.

@@ -2,8 +2,17 @@
 
 from learning.agents.base import Agent
 from learning.agents.dual_agent import DualAgent, MemoryAgent
-from learning.agents.factory import AGENT_NAMES, make_agent
+from learning.agents.factory import AGENT_NAMES, DEEP_AGENT_NAMES, make_agent
 from learning.agents.oracle_agent import OracleAgent
 from learning.agents.random_agent import RandomAgent
 
-__all__ = ["AGENT_NAMES", "Agent", "DualAgent", "MemoryAgent", "OracleAgent", "RandomAgent", "make_agent"]
+__all__ = [
+    "AGENT_NAMES",
+    "DEEP_AGENT_NAMES",
+    "Agent",
+    "DualAgent",
+    "MemoryAgent",
+    "OracleAgent",
+    "RandomAgent",
+    "make_agent",
+]

@@ -10,22 +10,27 @@ from learning.errors import ConfigError, UnknownAgent
 from learning.memory.store import MemoryStore
 from models import PuzzleSpec
 
-AGENT_NAMES = ("memory", "dual", "random", "oracle", "dqn", "model-based")
+DEEP_AGENT_NAMES = ("dqn", "model-based", "mt-dqn", "mt-model-based")
+"""The deep baselines (torch; ``learning.baselines``): DQN, the precondition planner, and their MT-OPT
+variants."""
+AGENT_NAMES = ("memory", "dual", "random", "oracle", *DEEP_AGENT_NAMES)
 """``memory``: dual controller + memory prior (needs a memory); ``dual``: no memory; ``random``;
-``oracle``: knows the spec's locks and plays a shortest plan (the floor on actions); ``dqn`` and
-``model-based``: the deep baselines (need a checkpoint; torch)."""
+``oracle``: knows the spec's locks and plays a shortest plan (the floor on actions); the deep
+baselines need a checkpoint."""
 
 
 def make_agent(name: str, spec: PuzzleSpec, memory: MemoryStore | None = None, checkpoint: str | None = None) -> Agent:
     """A fresh agent for one puzzle; :class:`UnknownAgent` lists the names that exist."""
-    if name in ("dqn", "model-based"):
+    if name in DEEP_AGENT_NAMES:
         if checkpoint is None:
             raise ConfigError(f"agent {name!r} needs a checkpoint (train one with scripts/train.py --agent {name})")
         from learning.baselines.checkpoint import load_checkpoint  # torch only when asked
 
         return load_checkpoint(checkpoint, expected_agent=name)
     if checkpoint is not None:
-        raise ConfigError(f"agent {name!r} takes no checkpoint; --checkpoint is for dqn and model-based")
+        raise ConfigError(
+            f"agent {name!r} takes no checkpoint; --checkpoint is for the deep agents {list(DEEP_AGENT_NAMES)}"
+        )
     if name == "memory":
         if memory is None:
             raise ConfigError("agent 'memory' needs a memory (train one with scripts/train.py, pass --memory)")

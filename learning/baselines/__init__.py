@@ -1,10 +1,11 @@
 """Deep-RL baselines of the paper (torch, the ``baselines`` extra): a graph network over components,
-DQN on it, and (to come) the model-based precondition planner and MT-OPT variants."""
+DQN on it, the model-based precondition planner, and their MT-OPT variants (``registry.make_learner``)."""
 
 from learning.baselines.checkpoint import CheckpointError, load_checkpoint, save_checkpoint
 from learning.baselines.dqn import DQNAgent, DQNConfig
 from learning.baselines.graph_network import GraphNetwork, GraphNetworkConfig, observation_tensors
 from learning.baselines.model_based import ModelBasedAgent, ModelBasedConfig
+from learning.baselines.registry import LEARNERS, make_learner
 
 __all__ = [
     "CheckpointError",
@@ -12,9 +13,11 @@ __all__ = [
     "DQNConfig",
     "GraphNetwork",
     "GraphNetworkConfig",
+    "LEARNERS",
     "ModelBasedAgent",
     "ModelBasedConfig",
     "load_checkpoint",
+    "make_learner",
     "observation_tensors",
     "save_checkpoint",
 ]

@@ -18,8 +18,14 @@ from learning.baselines.graph_network import GraphNetworkConfig
 from learning.baselines.model_based import ModelBasedAgent, ModelBasedConfig
 from learning.errors import LearningError
 
-CHECKPOINT_FORMAT = "puzzlebox-baseline/1"
-AGENTS = {"dqn": (DQNAgent, DQNConfig), "model-based": (ModelBasedAgent, ModelBasedConfig)}
+CHECKPOINT_FORMAT = "puzzlebox-baseline/2"
+"""/2: GN blocks apply the edge MLP's first layer per part (``GNBlock``); MT-OPT flags in the config."""
+AGENTS = {
+    "dqn": (DQNAgent, DQNConfig),
+    "mt-dqn": (DQNAgent, DQNConfig),
+    "model-based": (ModelBasedAgent, ModelBasedConfig),
+    "mt-model-based": (ModelBasedAgent, ModelBasedConfig),
+}
 
 
 class CheckpointError(LearningError):

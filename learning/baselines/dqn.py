@@ -4,6 +4,10 @@ Q(s, n) is the network's output at component n. Replay memory, a target network 
 (tau), epsilon-greedy exploration decaying per episode to a floor, Huber loss, Adam. The authors'
 release: replay 1e5, batch 16, gamma 0.99, lr 3e-4, tau = lr, epsilon x0.999 per episode down to 0.2,
 evaluation with epsilon 0.1. Rewards: +1 on reaching the goal, ``step_reward`` per other action.
+
+``mt-dqn`` (MT-OPT, Kalashnikov et al. 2021) adds cross-task data sharing — each finished episode is
+relabelled for the task "bring component g to its goal" for every g (``multitask.py``) — and
+success/failure balancing: half of every batch comes from episodes that reached their task's goal.
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ from torch import nn
 
 from learning.baselines.graph_network import GraphNetwork, GraphNetworkConfig, observation_tensors
 from learning.baselines.learner import EpsilonGreedyLearner
+from learning.baselines.multitask import RelabelledStep, Step, relabel_episode
 from models import SceneObservation
 
 
@@ -39,44 +44,61 @@ class DQNConfig:
     goal_reward: float = 1.0
     step_reward: float = -0.05
     updates_per_action: int = 1
+    share_across_tasks: bool = False
+    """MT-OPT data sharing: relabel every episode for every component as the goal."""
+    balance: bool = False
+    """MT-OPT balancing: half of each batch from success episodes, half from failures."""
     seed: int = 0
 
-
-@dataclass
-class _Transition:
-    nodes: np.ndarray
-    edges: np.ndarray
-    action: int
-    reward: float
-    next_nodes: np.ndarray
-    next_edges: np.ndarray
-    done: bool
+    @classmethod
+    def multitask(cls, **overrides: object) -> DQNConfig:
+        """The MT-OPT variant (``mt-dqn``): data sharing and balancing on."""
+        return cls(**{"share_across_tasks": True, "balance": True, **overrides})
 
 
 class DQNAgent(EpsilonGreedyLearner):
     """The agent (``Agent`` protocol). ``training=True``: epsilon-greedy with learning; else evaluation."""
 
-    name = "dqn"
-
     def __init__(self, config: DQNConfig | None = None) -> None:
         super().__init__(config or DQNConfig())
+        self.name = "mt-dqn" if self.config.share_across_tasks or self.config.balance else "dqn"
+        self._episode: list[Step] = []
+        self._goal = (0, 1)
         self.q = GraphNetwork(self.config.network)
         self.target = copy.deepcopy(self.q)
-        self.optimizer = torch.optim.Adam(self.q.parameters(), lr=self.config.learning_rate)
+        self.optimizer = torch.optim.Adam(self.q.parameters(), lr=self.config.learning_rate, fused=True)
 
     def greedy_values(self, observation: SceneObservation) -> np.ndarray:
         nodes, edges = self._last
         with torch.no_grad():
             return self.q(torch.from_numpy(nodes)[None], torch.from_numpy(edges)[None])[0].numpy()
 
-    def example(self, index: int, moved: bool, observation: SceneObservation) -> _Transition:
+    def begin_episode(self, observation: SceneObservation, rng: np.random.Generator) -> None:
+        super().begin_episode(observation, rng)
+        self._episode = []
+        self._goal = (observation.goal_index, observation.goal_state)
+
+    def observe_outcome(self, index: int, moved: bool, observation: SceneObservation) -> None:
+        nodes, edges = self._last
+        next_nodes, next_edges = observation_tensors(observation, self.config.network.position_scale)
+        if self.config.share_across_tasks or self.config.balance:  # stored once the episode's outcome is known
+            self._episode.append(Step(nodes, edges, index, next_nodes, next_edges))
+            return
         done = observation.solved
         reward = self.config.goal_reward if done else self.config.step_reward
-        next_nodes, next_edges = observation_tensors(observation, self.config.network.position_scale)
-        nodes, edges = self._last
-        return _Transition(nodes, edges, index, reward, next_nodes, next_edges, done)
+        self.store(RelabelledStep(nodes, edges, index, reward, next_nodes, next_edges, done), len(nodes), done)
 
-    def learn(self, batch: list[_Transition]) -> float:
+    def finish_episode(self, solved: bool) -> None:
+        """MT-OPT: relabel the episode for every task and file it as a success or a failure of each."""
+        c = self.config
+        for _, steps, success in relabel_episode(
+            self._episode, *self._goal, c.goal_reward, c.step_reward, all_tasks=c.share_across_tasks
+        ):
+            for step in steps:
+                self.store(step, len(step.nodes), success)
+        self._episode = []
+
+    def learn(self, batch: list[RelabelledStep]) -> float:
         """TD step with the Huber loss, then a soft update of the target network."""
         nodes = torch.from_numpy(np.stack([t.nodes for t in batch]))
         edges = torch.from_numpy(np.stack([t.edges for t in batch]))
@@ -92,7 +114,6 @@ class DQNAgent(EpsilonGreedyLearner):
         self.optimizer.zero_grad()
         loss.backward()
         self.optimizer.step()
-        with torch.no_grad():
-            for p, tp in zip(self.q.parameters(), self.target.parameters(), strict=True):
-                tp.mul_(1 - self.config.tau).add_(self.config.tau * p)
+        with torch.no_grad():  # target <- (1 - tau) target + tau q, in one fused call
+            torch._foreach_lerp_(list(self.target.parameters()), list(self.q.parameters()), self.config.tau)
         return loss.item()

@@ -52,11 +52,20 @@ def _mlp(inputs: int, hidden: int, outputs: int) -> nn.Sequential:
 
 
 class GNBlock(nn.Module):
-    """One full GN block: edge update, node update from summed incoming edges, global update."""
+    """One full GN block: edge update, node update from summed incoming edges, global update.
+
+    The edge MLP's first layer acts on ``[edge, sender, receiver, global]``; it is applied as the sum
+    of one linear map per part, so the node and global parts are computed once per node (N) instead of
+    once per edge (N^2): the same function, fewer multiplications.
+    """
 
     def __init__(self, node: int, edge: int, glob: int, hidden: int) -> None:
         super().__init__()
-        self.edge_mlp = _mlp(edge + 2 * node + glob, hidden, hidden)
+        self.edge_in = nn.Linear(edge, hidden)
+        self.sender_in = nn.Linear(node, hidden, bias=False)
+        self.receiver_in = nn.Linear(node, hidden, bias=False)
+        self.global_in = nn.Linear(glob, hidden, bias=False)
+        self.edge_out = nn.Sequential(nn.ReLU(), nn.Linear(hidden, hidden), nn.LayerNorm(hidden))
         self.node_mlp = _mlp(node + hidden + glob, hidden, hidden)
         self.global_mlp = _mlp(glob + 2 * hidden, hidden, hidden)
 
@@ -64,10 +73,13 @@ class GNBlock(nn.Module):
         self, nodes: torch.Tensor, edges: torch.Tensor, glob: torch.Tensor, mask: torch.Tensor
     ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         b, n, _ = nodes.shape
-        sender = nodes[:, :, None, :].expand(b, n, n, -1)  # i
-        receiver = nodes[:, None, :, :].expand(b, n, n, -1)  # j
-        g = glob[:, None, None, :].expand(b, n, n, -1)
-        new_edges = self.edge_mlp(torch.cat([edges, sender, receiver, g], dim=-1)) * mask[..., None]
+        first = (
+            self.edge_in(edges)
+            + self.sender_in(nodes)[:, :, None, :]  # i
+            + self.receiver_in(nodes)[:, None, :, :]  # j
+            + self.global_in(glob)[:, None, None, :]
+        )
+        new_edges = self.edge_out(first) * mask[..., None]
         incoming = new_edges.sum(dim=1)  # into j from every i
         new_nodes = self.node_mlp(torch.cat([nodes, incoming, glob[:, None, :].expand(b, n, -1)], dim=-1))
         edge_mean = new_edges.sum(dim=(1, 2)) / mask.sum(dim=(1, 2)).clamp(min=1)[:, None]

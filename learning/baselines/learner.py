@@ -1,6 +1,7 @@
 """What the deep baselines share: epsilon-greedy acting, a replay of examples grouped by component
-count (a batch must hold puzzles of one size), seeded sampling, and the ``Agent`` protocol plumbing.
-Subclasses say how to act greedily, what an example is, and how to learn from a batch."""
+count (a batch must hold puzzles of one size), optional success/failure balancing of the batches
+(MT-OPT), seeded sampling, and the ``Agent`` protocol plumbing. Subclasses say how to act greedily,
+what an example is, and how to learn from a batch."""
 
 from __future__ import annotations
 
@@ -17,14 +18,20 @@ from models import SceneObservation
 
 class EpsilonGreedyLearner:
     """Base of the deep agents. ``config`` needs: network, batch_size, replay_size, epsilon_start,
-    epsilon_decay, epsilon_min, epsilon_eval, updates_per_action, seed."""
+    epsilon_decay, epsilon_min, epsilon_eval, updates_per_action, balance, seed.
+
+    The replay holds, per component count, two buffers: ``success`` and ``failure`` examples (what
+    counts as a success is the subclass's call). Without ``balance`` a batch is drawn from both
+    together, i.e. in the proportion they were collected; with it (MT-OPT's success/failure
+    balancing) half of every batch comes from each as soon as both can fill their half.
+    """
 
     name = "learner"
 
     def __init__(self, config: Any) -> None:
         self.config = config
         torch.manual_seed(config.seed)
-        self.replay: dict[int, deque] = defaultdict(lambda: deque(maxlen=config.replay_size))
+        self.replay: dict[tuple[int, bool], deque] = defaultdict(lambda: deque(maxlen=config.replay_size))
         self.epsilon = config.epsilon_start
         self.training = True
         self.episodes = 0
@@ -37,13 +44,16 @@ class EpsilonGreedyLearner:
         """Value of trying each component (higher is better)."""
         raise NotImplementedError
 
-    def example(self, index: int, moved: bool, observation: SceneObservation) -> Any:
-        """The replay entry for trying ``index`` from the last observation."""
+    def observe_outcome(self, index: int, moved: bool, observation: SceneObservation) -> None:
+        """Store what trying ``index`` from the last observation taught (call :meth:`store`)."""
         raise NotImplementedError
 
     def learn(self, batch: list) -> float:
         """One gradient step on a batch; the loss."""
         raise NotImplementedError
+
+    def finish_episode(self, solved: bool) -> None:
+        """Hook at the end of a training episode (e.g. relabel and store the episode's data)."""
 
     # -- the Agent protocol ------------------------------------------------------------------------
     def begin_episode(self, observation: SceneObservation, rng: np.random.Generator) -> None:
@@ -60,19 +70,45 @@ class EpsilonGreedyLearner:
     def record(self, index: int, moved: bool, observation: SceneObservation) -> None:
         if not self.training or self._last is None:
             return
-        self.replay[len(self._last[0])].append(self.example(index, moved, observation))
+        self.observe_outcome(index, moved, observation)
         for _ in range(self.config.updates_per_action):
             self.update()
 
     def end_episode(self, solved: bool) -> None:
         if self.training:
+            self.finish_episode(solved)
             self.episodes += 1
             self.epsilon = max(self.config.epsilon_min, self.epsilon * self.config.epsilon_decay)
 
+    # -- replay ------------------------------------------------------------------------------------
+    def store(self, example: Any, components: int, success: bool) -> None:
+        """Add one example of a ``components``-component puzzle to the success or failure buffer."""
+        self.replay[(components, success)].append(example)
+
+    def replay_size(self) -> int:
+        """Examples held, over every buffer."""
+        return sum(len(buffer) for buffer in self.replay.values())
+
     def update(self) -> float | None:
         """One gradient step on a replay batch of one component count; None until a batch is available."""
-        sizes = [n for n, buffer in self.replay.items() if len(buffer) >= self.config.batch_size]
-        if not sizes:
+        batch = self.sample_batch()
+        return None if batch is None else self.learn(batch)
+
+    def sample_batch(self) -> list | None:
+        """A batch of one component count (drawn uniformly among the counts that can fill one)."""
+        size = self.config.batch_size
+        counts = sorted({n for n, _ in self.replay})
+        ready = [n for n in counts if len(self.replay[(n, True)]) + len(self.replay[(n, False)]) >= size]
+        if not ready:
             return None
-        buffer = self.replay[self._sample_rng.choice(sizes)]
-        return self.learn(self._sample_rng.sample(list(buffer), self.config.batch_size))
+        n = self._sample_rng.choice(ready)
+        success, failure = self.replay[(n, True)], self.replay[(n, False)]
+        half = size // 2
+        if self.config.balance and len(success) >= half and len(failure) >= size - half:
+            return self._draw(success, half) + self._draw(failure, size - half)
+        picks = self._sample_rng.sample(range(len(success) + len(failure)), size)
+        return [success[i] if i < len(success) else failure[i - len(success)] for i in picks]
+
+    def _draw(self, buffer: deque, k: int) -> list:
+        """``k`` distinct examples (indices, not a copy of the buffer: replays hold up to 1e5)."""
+        return [buffer[i] for i in self._sample_rng.sample(range(len(buffer)), k)]

@@ -6,6 +6,12 @@ Every try is a labelled example (the observation, the component, moved or not), 
 and fitted with binary cross-entropy. To act, the network scores every component in every joint
 state of the puzzle (2^N states, batched), which gives the table of move probabilities that value
 iteration (``learning.planner.value_iteration``) turns into Q_exploit; epsilon-greedy exploration.
+
+``mt-model-based`` (MT-OPT) adds cross-task data sharing — a precondition does not depend on the task,
+so every try is also stored with the goal flag on each other component (``multitask.py``), teaching
+the network that invariance from data — and success/failure balancing: half of every batch are tries
+that moved the component, half tries that did not (the classifier's two outcomes; most tries in a
+locked box fail).
 """
 
 from __future__ import annotations
@@ -18,11 +24,9 @@ from torch import nn
 
 from learning.baselines.graph_network import GraphNetwork, GraphNetworkConfig, observation_tensors
 from learning.baselines.learner import EpsilonGreedyLearner
+from learning.baselines.multitask import STATE_COLUMN, with_goal
 from learning.planner import bitmask, value_iteration
-from models import KIND_NAMES, SceneObservation
-
-STATE_FEATURE = len(KIND_NAMES)
-"""Index of the state flag in the node features."""
+from models import SceneObservation
 
 
 @dataclass(frozen=True)
@@ -40,7 +44,16 @@ class ModelBasedConfig:
     epsilon_min: float = 0.2
     epsilon_eval: float = 0.1
     updates_per_action: int = 1
+    share_across_tasks: bool = False
+    """MT-OPT data sharing: store every try with the goal flag on each component."""
+    balance: bool = False
+    """MT-OPT balancing: half of each batch tries that moved, half tries that did not."""
     seed: int = 0
+
+    @classmethod
+    def multitask(cls, **overrides: object) -> ModelBasedConfig:
+        """The MT-OPT variant (``mt-model-based``): data sharing and balancing on."""
+        return cls(**{"share_across_tasks": True, "balance": True, **overrides})
 
 
 @dataclass
@@ -54,12 +67,12 @@ class _Example:
 class ModelBasedAgent(EpsilonGreedyLearner):
     """The agent (``Agent`` protocol); ``training=True`` explores and fits, else evaluates."""
 
-    name = "model-based"
-
     def __init__(self, config: ModelBasedConfig | None = None) -> None:
         super().__init__(config or ModelBasedConfig())
+        multitask = self.config.share_across_tasks or self.config.balance
+        self.name = "mt-model-based" if multitask else "model-based"
         self.net = GraphNetwork(self.config.network)
-        self.optimizer = torch.optim.Adam(self.net.parameters(), lr=self.config.learning_rate)
+        self.optimizer = torch.optim.Adam(self.net.parameters(), lr=self.config.learning_rate, fused=True)
 
     def move_probabilities(self, observation: SceneObservation) -> np.ndarray:
         """``(N, 2^N)``: the network's P(component moves) in every joint state of this scene."""
@@ -67,7 +80,7 @@ class ModelBasedAgent(EpsilonGreedyLearner):
         n = len(nodes)
         bits = ((np.arange(1 << n)[:, None] >> np.arange(n)) & 1).astype(np.float32)
         batch = np.repeat(nodes[None], len(bits), axis=0)
-        batch[:, :, STATE_FEATURE] = bits
+        batch[:, :, STATE_COLUMN] = bits
         with torch.no_grad():
             logits = self.net(torch.from_numpy(batch), torch.from_numpy(edges)[None].expand(len(bits), -1, -1, -1))
         return torch.sigmoid(logits).numpy().T
@@ -79,9 +92,12 @@ class ModelBasedAgent(EpsilonGreedyLearner):
         x = bitmask(observation.states)
         return self.config.gamma * free[:, x] * values[[x ^ (1 << c) for c in range(len(observation))]]
 
-    def example(self, index: int, moved: bool, observation: SceneObservation) -> _Example:
+    def observe_outcome(self, index: int, moved: bool, observation: SceneObservation) -> None:
         nodes, edges = self._last
-        return _Example(nodes, edges, index, moved)
+        goals = range(len(nodes)) if self.config.share_across_tasks else [None]
+        for goal in goals:
+            example_nodes = nodes if goal is None else with_goal(nodes, goal)
+            self.store(_Example(example_nodes, edges, index, moved), len(nodes), moved)
 
     def learn(self, batch: list[_Example]) -> float:
         """One gradient step of binary cross-entropy on a batch of tries; the loss."""

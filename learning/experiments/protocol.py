@@ -124,8 +124,8 @@ def evaluate(
     return Score(float(np.mean(solved)), float(np.mean(actions)), len(solved))
 
 
-def summarise_scores(scores: Sequence[Score]) -> dict[str, float]:
-    """Mean and standard deviation over training seeds."""
+def summarise_scores(scores: Sequence[Score]) -> dict[str, float | int | list[float]]:
+    """Mean and standard deviation over training seeds, and each seed's value."""
     success = np.array([s.success_rate for s in scores])
     actions = np.array([s.mean_actions for s in scores])
     return {
@@ -134,6 +134,8 @@ def summarise_scores(scores: Sequence[Score]) -> dict[str, float]:
         "mean_actions": float(actions.mean()),
         "mean_actions_std": float(actions.std()),
         "seeds": len(scores),
+        "success_rate_per_seed": success.tolist(),
+        "mean_actions_per_seed": actions.tolist(),
     }
 
 

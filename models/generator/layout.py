@@ -63,13 +63,30 @@ class Layout:
         ax, ay, ayaw = self.poses[anchor]
         yaw = ayaw + turn
         step = self.config.distance_step
-        distance = step
-        while True:  # walk outwards until the new footprint clears the anchor
+
+        def at(distance: float) -> tuple[tuple[float, float, float], np.ndarray]:
             pose = compose((ax, ay, 0.0), (distance * math.cos(yaw), distance * math.sin(yaw), yaw))
-            polygon = template.footprint_in_lid(pose)
-            if polygon_gap(polygon, self._footprints[anchor]) >= self.config.clearance:
-                break
-            distance += step
+            return pose, template.footprint_in_lid(pose)
+
+        def clears(distance: float) -> bool:
+            return polygon_gap(at(distance)[1], self._footprints[anchor]) >= self.config.clearance
+
+        # The first distance on the grid step, 2 step, ... at which the footprint clears the anchor.
+        # The gap is convex in the distance (a max of functions linear in it), so "clears" is false
+        # then true along the grid: an exponential then binary search finds the same grid point as
+        # walking outwards one step at a time, in O(log) gap evaluations. The grid is accumulated
+        # (distance += step) exactly as that walk did, so layouts are unchanged to the bit.
+        grid = [step]
+        probe = 0
+        while not clears(grid[probe]):
+            while len(grid) <= 2 * probe + 1:
+                grid.append(grid[-1] + step)
+            probe = 2 * probe + 1
+        low, high = (probe - 1) // 2, probe  # clears(grid[low]) is false (or low < 0), clears(grid[high])
+        while high - low > 1:
+            middle = (low + high) // 2
+            low, high = (low, middle) if clears(grid[middle]) else (middle, high)
+        pose, polygon = at(grid[high])
         for other, footprint in enumerate(self._footprints):
             if other != anchor and polygon_gap(polygon, footprint) < self.config.clearance:
                 return None

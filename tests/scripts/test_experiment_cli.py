@@ -44,3 +44,39 @@ def test_unknown_agent_and_unbuilt_protocol_are_clear_errors(tmp_path):
     assert bad.returncode == 2 and "genius" in bad.stderr and "Traceback" not in bad.stderr
     later = experiment("disassembly", "--agents", "memory", "--out", tmp_path)
     assert later.returncode == 2 and "not available yet" in later.stderr
+
+
+def test_quick_all_runs_every_deep_agent_and_resumes_from_its_saved_jobs(tmp_path):
+    agents = "memory,dqn,model-based,mt-dqn,mt-model-based"
+    first = experiment("all", "--agents", agents, "--out", tmp_path, "--quick")
+    assert first.returncode == 0, first.stderr
+    assert "6 job(s) run, 0 reused" in first.stdout
+    results = {p: json.loads((tmp_path / f"{p}.json").read_text()) for p in ("variants", "episodes", "noise")}
+    for deep in agents.split(",")[1:]:
+        assert [p["training_episodes"] for p in results["episodes"]["points"] if deep in p] == [0, 5, 10]
+        assert len([p for p in results["noise"]["points"] if deep in p]) == 5
+    assert {p["training_variants"] for p in results["variants"]["points"] if "dqn" in p} == {0, 1, 9}
+    assert "Episodes to 100%" in (tmp_path / "all.md").read_text()
+    assert (tmp_path / "episodes.png").read_bytes().startswith(b"\x89PNG")
+
+    # an interrupted run: one job's file is missing; the rerun computes only that job, identically
+    (tmp_path / "jobs" / "mt-dqn-v9-s0.json").unlink()
+    again = experiment("all", "--agents", agents, "--out", tmp_path, "--quick")
+    assert again.returncode == 0, again.stderr
+    assert "1 job(s) run, 5 reused" in again.stdout
+    rerun = json.loads((tmp_path / "episodes.json").read_text())
+    assert rerun["points"] == results["episodes"]["points"]
+
+    # every job's network is a checkpoint trial.py can run
+    specs = tmp_path / "specs"
+    generate = [sys.executable, str(ROOT / "scripts/generate.py"), "paper", "--split", "test", "--out", str(specs)]
+    assert subprocess.run(generate, capture_output=True, timeout=120).returncode == 0
+    trial = subprocess.run(
+        [sys.executable, str(ROOT / "scripts/trial.py"), "--specs", str(specs / "paper-test-0.json"),
+         "--agent", "mt-dqn", "--checkpoint", str(tmp_path / "jobs/mt-dqn-v9-s0.pt"), "--runs", "1",
+         "--sim", "symbolic", "--seed", "0", "--max-actions", "30",
+         "--out", str(tmp_path / "trial")],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert trial.returncode == 0, trial.stderr
+    assert json.loads((tmp_path / "trial/results.json").read_text())["runs"][0]["num_actions"] >= 5

@@ -1,0 +1,287 @@
+"""The deep baselines through the paper's protocols, as resumable training jobs run in parallel.
+
+One *job* trains one deep agent (``dqn``, ``model-based``, ``mt-dqn``, ``mt-model-based``) with one
+training seed on the first ``k`` training variants, and evaluates it on the unseen variants at fixed
+episode counts. The protocols share jobs:
+
+- ``episodes``: the k = 9 job, evaluated at every ``DeepSchedule.checkpoints`` count;
+- ``variants``: k = 0 is the k = 9 job at 0 episodes (the untrained network), k = 9 the k = 9 job at
+  ``converged_episodes``, other k their own jobs (trained ``converged_episodes``);
+- ``noise``: the k = 9 job at ``converged_episodes``, evaluated under every scene error.
+
+Training and test layouts, world seeds and the success rule are the memory agent's
+(``protocol.py``): every agent meets the same boxes. A finished job is written to
+``OUT/jobs/<agent>-v<k>-s<seed>.json`` (with the network as ``.pt`` beside it, loadable by
+``trial.py --checkpoint``) the moment it ends, so an interrupted run resumes where it stopped; a job
+file made with other settings is recomputed, never mixed in.
+"""
+
+from __future__ import annotations
+
+import json
+import multiprocessing
+import os
+import queue
+import time
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from tqdm import tqdm
+
+from learning.agents.factory import DEEP_AGENT_NAMES
+from learning.errors import ConfigError
+from learning.experiments.protocol import TRAIN_LAYOUT_BASE, ProtocolConfig, evaluate, layout
+from learning.experiments.symbolic_protocols import MOVED_BOX_POSE, NOISE_CONDITIONS
+from learning.symbolic_world import SymbolicWorld
+from learning.trial import run_episode
+from models.generator import TRAIN_INDICES
+
+DEEP_AGENTS = DEEP_AGENT_NAMES
+NONE = "none"
+CONDITIONS = (*NOISE_CONDITIONS, "moved box")
+"""Scene conditions of the noise protocol (``none`` is the clean scene)."""
+
+
+@dataclass(frozen=True)
+class DeepSchedule:
+    """How long the deep agents train, and where they are evaluated."""
+
+    checkpoints: tuple[int, ...] = (0, 10, 25, 50, 75, 100, 150, 200, 300, 400, 500, 650)
+    """Training episodes (over the 9 training variants) at which the episodes protocol evaluates."""
+    converged_episodes: int = 650
+    """Episodes of training "until convergence" (variants and noise protocols): the paper's deep agents
+    solved every unseen variant after ~300 (model-based) and ~650 (model-free) episodes."""
+    variant_counts: tuple[int, ...] = (0, 1, 3, 9)
+    """Training-variant counts of the variants protocol (each extra count is a full training job)."""
+    variant_agents: tuple[str, ...] = ("dqn", "model-based")
+    """Deep agents of the variants protocol (the paper's Fig. 3 left has no MT-OPT agents)."""
+
+    def __post_init__(self) -> None:
+        if self.converged_episodes not in self.checkpoints:
+            raise ConfigError(f"converged_episodes {self.converged_episodes} must be one of {self.checkpoints}")
+        if list(self.checkpoints) != sorted(set(self.checkpoints)) or self.checkpoints[0] < 0:
+            raise ConfigError(f"checkpoints must be increasing and >= 0, got {self.checkpoints}")
+        if not set(self.variant_counts) <= set(range(len(TRAIN_INDICES) + 1)):
+            raise ConfigError(f"variant counts must be within 0..{len(TRAIN_INDICES)}, got {self.variant_counts}")
+
+    def quick(self) -> DeepSchedule:
+        """A CI-sized schedule: a few dozen episodes (measures plumbing, not learning)."""
+        return DeepSchedule(checkpoints=(0, 5, 10), converged_episodes=10, variant_counts=(0, 1, 9))
+
+
+@dataclass(frozen=True)
+class TrainingJob:
+    """Train ``agent`` (seed ``seed``) on the first ``variants`` training variants; evaluate the clean
+    scene at ``evaluate_at`` episode counts and every scene condition at ``conditions_at`` (if set)."""
+
+    agent: str
+    variants: int
+    seed: int
+    evaluate_at: tuple[int, ...]
+    conditions_at: int | None = None
+
+    @property
+    def key(self) -> str:
+        return f"{self.agent}-v{self.variants}-s{self.seed}"
+
+    @property
+    def episodes(self) -> int:
+        return max(self.evaluate_at)
+
+
+def jobs_for(protocol: str, agents: Sequence[str], config: ProtocolConfig, schedule: DeepSchedule) -> list[TrainingJob]:
+    """The jobs a protocol needs (the k = 9 job is the same for all three: it is computed once)."""
+    full = len(TRAIN_INDICES)
+    jobs = []
+    for agent in agents:
+        for seed in range(config.training_seeds):
+            jobs.append(TrainingJob(agent, full, seed, schedule.checkpoints, schedule.converged_episodes))
+            if protocol == "variants" and agent in schedule.variant_agents:
+                jobs += [
+                    TrainingJob(agent, k, seed, (schedule.converged_episodes,))
+                    for k in schedule.variant_counts
+                    if 0 < k < full
+                ]
+    return jobs
+
+
+def _settings(job: TrainingJob, config: ProtocolConfig) -> dict[str, Any]:
+    """Everything a job's numbers depend on (a cached job must match it exactly to be reused)."""
+    return {
+        "job": asdict(job),
+        "runs_per_variant": config.runs_per_variant,
+        "success_actions": config.success_actions,
+        "max_actions": config.max_actions,
+    }
+
+
+def _train(agent: Any, job: TrainingJob, episodes: range, config: ProtocolConfig) -> list[bool]:
+    """Training episodes as the memory agent's (``protocol.train_memory``): same layouts and seeds."""
+    variants = TRAIN_INDICES[: job.variants]
+    solved = []
+    for e in episodes:
+        seed = TRAIN_LAYOUT_BASE + 1000 * job.seed + e
+        spec = layout(variants[e % len(variants)], seed)
+        solved.append(run_episode(agent, SymbolicWorld(spec, seed), spec.name, seed, config.max_actions).solved)
+    return solved
+
+
+def _evaluate(agent: Any, config: ProtocolConfig, condition: str) -> dict[str, float]:
+    agent.training = False
+    kwargs: dict[str, Any] = {"box_pose": MOVED_BOX_POSE} if condition == "moved box" else {}
+    if condition in NOISE_CONDITIONS:
+        kwargs["faults"] = NOISE_CONDITIONS[condition]
+    score = evaluate(lambda spec: agent, config, **kwargs)
+    agent.training = True
+    return {"success_rate": score.success_rate, "mean_actions": score.mean_actions, "runs": score.runs}
+
+
+def run_job(job: TrainingJob, config: ProtocolConfig, out_dir: str, progress: Any = None) -> dict[str, Any]:
+    """Train and evaluate one job; write ``OUT/jobs/<key>.json`` (+ ``.pt``) atomically; the record.
+
+    ``progress`` (a queue) receives the number of training episodes done as they finish."""
+    import torch
+
+    from learning.baselines import make_learner, save_checkpoint
+
+    torch.set_num_threads(1)  # one job per core: the jobs are the parallelism
+    start = time.perf_counter()
+    agent = make_learner(job.agent, job.seed)
+    evaluations, training_solved = [], []
+    done = 0
+    for checkpoint in job.evaluate_at:
+        chunk = range(done, checkpoint)
+        for e0 in range(chunk.start, chunk.stop, 10):  # report progress every 10 episodes
+            training_solved += _train(agent, job, range(e0, min(e0 + 10, chunk.stop)), config)
+            if progress is not None:
+                progress.put(min(e0 + 10, chunk.stop) - e0)
+        done = checkpoint
+        conditions = CONDITIONS if checkpoint == job.conditions_at else (NONE,)
+        for condition in conditions:
+            evaluations.append({"episodes": checkpoint, "condition": condition, **_evaluate(agent, config, condition)})
+    jobs_dir = Path(out_dir) / "jobs"
+    save_checkpoint(agent, jobs_dir / f"{job.key}.pt")
+    record = {
+        "settings": _settings(job, config),
+        "evaluations": evaluations,
+        "training_solved": int(np.sum(training_solved)),
+        "training_episodes": len(training_solved),
+        "wall_time_s": time.perf_counter() - start,
+        "checkpoint": f"{job.key}.pt",
+    }
+    path = jobs_dir / f"{job.key}.json"
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(record, indent=1))
+    tmp.replace(path)
+    return record
+
+
+def cached_record(job: TrainingJob, config: ProtocolConfig, out_dir: Path) -> dict[str, Any] | None:
+    """The finished record of ``job`` in ``out_dir`` if it was made with the same settings."""
+    path = out_dir / "jobs" / f"{job.key}.json"
+    try:
+        record = json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError):
+        return None
+    settings = json.loads(json.dumps(_settings(job, config)))  # tuples -> lists, as stored
+    return record if record.get("settings") == settings else None
+
+
+def run_jobs(
+    jobs: Sequence[TrainingJob], config: ProtocolConfig, out_dir: Path, workers: int | None = None
+) -> tuple[dict[str, dict[str, Any]], dict[str, Any]]:
+    """Run (or reuse) every job, ``workers`` at a time, longest first, with a progress bar in training
+    episodes. Returns the records by job key and a summary (reused, computed, wall time)."""
+    unique = {job.key: job for job in jobs}
+    records: dict[str, dict[str, Any]] = {}
+    todo = []
+    for key, job in unique.items():
+        cached = cached_record(job, config, out_dir)
+        if cached is None:
+            todo.append(job)
+        else:
+            records[key] = cached
+    todo.sort(key=lambda j: (-j.episodes, j.agent.startswith("model"), j.key))
+    start = time.perf_counter()
+    workers = max(1, min(workers or os.cpu_count() or 1, len(todo) or 1))
+    if todo:
+        context = multiprocessing.get_context("spawn")  # torch and fork do not mix
+        with context.Manager() as manager, context.Pool(workers) as pool:
+            progress = manager.Queue()
+            pending = {job.key: pool.apply_async(run_job, (job, config, str(out_dir), progress)) for job in todo}
+            total = sum(job.episodes for job in todo)
+            with tqdm(total=total, desc=f"deep agents ({len(todo)} jobs)", unit="episode", disable=None) as bar:
+                while pending:
+                    try:
+                        bar.update(progress.get(timeout=0.5))
+                    except queue.Empty:
+                        pass
+                    for key in [k for k, result in pending.items() if result.ready()]:
+                        records[key] = pending.pop(key).get()  # re-raises a job's error here
+                        bar.set_postfix_str(f"{len(records)}/{len(unique)} jobs")
+    summary = {
+        "jobs": len(unique),
+        "reused": len(unique) - len(todo),
+        "computed": len(todo),
+        "workers": workers,
+        "wall_time_s": time.perf_counter() - start,
+    }
+    return records, summary
+
+
+def _score(records: Sequence[dict[str, Any]], episodes: int, condition: str) -> dict[str, Any] | None:
+    """Mean and std over seeds of the evaluations at ``episodes`` under ``condition``."""
+    picked = [e for r in records for e in r["evaluations"] if e["episodes"] == episodes and e["condition"] == condition]
+    if not picked:
+        return None
+    success = np.array([e["success_rate"] for e in picked])
+    actions = np.array([e["mean_actions"] for e in picked])
+    return {
+        "success_rate": float(success.mean()),
+        "success_rate_std": float(success.std()),
+        "mean_actions": float(actions.mean()),
+        "mean_actions_std": float(actions.std()),
+        "seeds": len(picked),
+        "success_rate_per_seed": success.tolist(),
+        "mean_actions_per_seed": actions.tolist(),
+    }
+
+
+def merge_deep_points(
+    result: dict[str, Any],
+    agents: Sequence[str],
+    records: dict[str, dict[str, Any]],
+    config: ProtocolConfig,
+    schedule: DeepSchedule,
+) -> dict[str, Any]:
+    """Add the deep agents' entries to a protocol result's points (new x values become new points)."""
+    protocol, x_key = result["protocol"], result["x"]
+    full = len(TRAIN_INDICES)
+    by_x: dict[Any, dict[str, Any]] = {p[x_key]: p for p in result["points"]}
+    fixed = {a: v for a, v in result["points"][0].items() if a not in (x_key, "memory")} if result["points"] else {}
+
+    def put(x: Any, agent: str, entry: dict[str, Any] | None) -> None:
+        if entry is not None:
+            by_x.setdefault(x, {x_key: x, **fixed})[agent] = entry
+
+    def seeds(agent: str, k: int) -> list[dict[str, Any]]:
+        return [records[f"{agent}-v{k}-s{t}"] for t in range(config.training_seeds)]
+
+    for agent in agents:
+        if protocol == "episodes":
+            for x in schedule.checkpoints:
+                put(x, agent, _score(seeds(agent, full), x, NONE))
+        elif protocol == "noise":
+            for condition in CONDITIONS:
+                put(condition, agent, _score(seeds(agent, full), schedule.converged_episodes, condition))
+        elif protocol == "variants" and agent in schedule.variant_agents:
+            for k in schedule.variant_counts:
+                source, episodes = (full, 0) if k == 0 else (k, schedule.converged_episodes)
+                put(k, agent, _score(seeds(agent, source), episodes, NONE))
+    points = [p for p in by_x.values() if len(p) > 1]  # drop x values no agent was evaluated at
+    if protocol != "noise":
+        points.sort(key=lambda p: p[x_key])
+    return {**result, "points": points, "deep_schedule": asdict(schedule)}
