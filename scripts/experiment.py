@@ -25,6 +25,7 @@ from typing import Any
 
 from _cli import fail, versions, write_json
 
+from learning.agents.factory import POSE_ENCODINGS
 from learning.errors import LearningError
 from learning.experiments import PROTOCOLS, SYMBOLIC_AGENTS, ProtocolConfig, comparison_table, plot, results_table
 from learning.experiments.deep_protocols import DEEP_AGENTS, DeepSchedule, jobs_for, merge_deep_points, run_jobs
@@ -44,6 +45,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--runs", type=int, default=None, help="runs per unseen variant (default 50)")
     parser.add_argument("--seeds", type=int, default=None, help="training seeds (default 3)")
     parser.add_argument("--workers", type=int, default=None, help="parallel deep-agent jobs (default: cores)")
+    parser.add_argument(
+        "--poses", choices=POSE_ENCODINGS, default="relative",
+        help="where the deep agents' graph network sees poses: relative (edges, default) or absolute (nodes, "
+        "as the authors' release: an ablation)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
 
     if args.protocol in PLANNED:
@@ -80,12 +86,12 @@ def main(argv: list[str] | None = None) -> int:
             results[protocol] = PROTOCOLS[protocol](symbolic, config, quick=args.quick)
             timings[f"{protocol}: symbolic agents"] = time.perf_counter() - t0
         if deep:
-            jobs = [job for protocol in protocols for job in jobs_for(protocol, deep, config, schedule)]
+            jobs = [job for protocol in protocols for job in jobs_for(protocol, deep, config, schedule, args.poses)]
             records, summary = run_jobs(jobs, config, out, args.workers)
             timings["deep agents (all their jobs)"] = summary["wall_time_s"]
             print(f"deep agents: {summary['computed']} job(s) run, {summary['reused']} reused from {out}/jobs")
             for protocol in protocols:
-                results[protocol] = merge_deep_points(results[protocol], deep, records, config, schedule)
+                results[protocol] = merge_deep_points(results[protocol], deep, records, config, schedule, args.poses)
                 results[protocol]["deep_jobs"] = summary
     except LearningError as err:
         fail(str(err))

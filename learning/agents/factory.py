@@ -13,6 +13,8 @@ from models import PuzzleSpec
 DEEP_AGENT_NAMES = ("dqn", "model-based", "mt-dqn", "mt-model-based")
 """The deep baselines (torch; ``learning.baselines``): DQN, the precondition planner, and their MT-OPT
 variants."""
+POSE_ENCODINGS = ("relative", "absolute")
+"""Where the deep agents' graph network sees poses (``learning.baselines.GraphNetworkConfig.poses``)."""
 AGENT_NAMES = ("memory", "dual", "random", "oracle", *DEEP_AGENT_NAMES)
 """``memory``: dual controller + memory prior (needs a memory); ``dual``: no memory; ``random``;
 ``oracle``: knows the spec's locks and plays a shortest plan (the floor on actions); the deep

@@ -80,7 +80,7 @@ class DQNAgent(EpsilonGreedyLearner):
 
     def observe_outcome(self, index: int, moved: bool, observation: SceneObservation) -> None:
         nodes, edges = self._last
-        next_nodes, next_edges = observation_tensors(observation, self.config.network.position_scale)
+        next_nodes, next_edges = observation_tensors(observation, self.config.network)
         if self.config.share_across_tasks or self.config.balance:  # stored once the episode's outcome is known
             self._episode.append(Step(nodes, edges, index, next_nodes, next_edges))
             return

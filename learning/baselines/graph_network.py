@@ -6,6 +6,11 @@ Node features: kind one-hot, state (0/1), goal flag. Edge features (i -> j): the
 what the memory agent sees. Everything is permutation-equivariant by construction: shuffling the
 components permutes the per-node outputs the same way (aggregations are sums and means over nodes).
 The authors' release used 5 blocks of 64 hidden units.
+
+``poses="absolute"`` is the ablation closer to the authors' release, whose components carried their
+own pose (x, y, sin, cos): the pose goes into the node features instead (position relative to the
+components' centroid, over ``position_scale``; yaw in the world frame) and the edge features are zero,
+so the network must learn relative geometry itself.
 """
 
 from __future__ import annotations
@@ -16,10 +21,13 @@ import numpy as np
 import torch
 from torch import nn
 
+from learning.agents.factory import POSE_ENCODINGS
+from learning.errors import ConfigError
 from learning.memory.keys import relative_pose_keys
 from models import KIND_NAMES, SceneObservation
 
 NODE_FEATURES = len(KIND_NAMES) + 2
+"""Kind one-hot, state, goal flag (plus 4 pose features with ``poses="absolute"``)."""
 EDGE_FEATURES = 4
 
 
@@ -32,18 +40,33 @@ class GraphNetworkConfig:
     hidden: int = 64
     """Width of every MLP layer and latent (the authors' release: 64)."""
     position_scale: float = 0.02
-    """Metres per unit of the edge features' positions (as the memory keys)."""
+    """Metres per unit of the pose features' positions (as the memory keys)."""
+    poses: str = "relative"
+    """Where poses enter: ``relative`` (edge i -> j: pose of j in i's frame) or ``absolute`` (per node)."""
+
+    def __post_init__(self) -> None:
+        if self.poses not in POSE_ENCODINGS:
+            raise ConfigError(f"unknown pose encoding {self.poses!r}; available: {list(POSE_ENCODINGS)}")
+
+    @property
+    def node_features(self) -> int:
+        return NODE_FEATURES + (4 if self.poses == "absolute" else 0)
 
 
-def observation_tensors(observation: SceneObservation, position_scale: float) -> tuple[np.ndarray, np.ndarray]:
-    """Node ``(N, NODE_FEATURES)`` and edge ``(N, N, EDGE_FEATURES)`` features of an observation."""
+def observation_tensors(observation: SceneObservation, config: GraphNetworkConfig) -> tuple[np.ndarray, np.ndarray]:
+    """Node ``(N, config.node_features)`` and edge ``(N, N, EDGE_FEATURES)`` features of an observation."""
     n = len(observation)
-    nodes = np.zeros((n, NODE_FEATURES), dtype=np.float32)
+    nodes = np.zeros((n, config.node_features), dtype=np.float32)
     for i, component in enumerate(observation.components):
         nodes[i, KIND_NAMES.index(component.kind)] = 1.0
         nodes[i, len(KIND_NAMES)] = component.state
     nodes[observation.goal_index, len(KIND_NAMES) + 1] = 1.0
-    edges = relative_pose_keys(observation.poses, position_scale).astype(np.float32)
+    poses = np.asarray(observation.poses, dtype=float)
+    if config.poses == "absolute":
+        xy = (poses[:, :2] - poses[:, :2].mean(axis=0)) / config.position_scale
+        nodes[:, NODE_FEATURES:] = np.column_stack([xy, np.sin(poses[:, 2]), np.cos(poses[:, 2])])
+        return nodes, np.zeros((n, n, EDGE_FEATURES), dtype=np.float32)
+    edges = relative_pose_keys(poses, config.position_scale).astype(np.float32)
     return nodes, edges
 
 
@@ -94,13 +117,13 @@ class GraphNetwork(nn.Module):
         super().__init__()
         self.config = config or GraphNetworkConfig()
         h = self.config.hidden
-        self.encode_nodes = nn.Linear(NODE_FEATURES, h)
+        self.encode_nodes = nn.Linear(self.config.node_features, h)
         self.encode_edges = nn.Linear(EDGE_FEATURES, h)
         self.blocks = nn.ModuleList(GNBlock(h, h, h, h) for _ in range(self.config.blocks))
         self.head = nn.Sequential(nn.Linear(h, h), nn.ReLU(), nn.Linear(h, 1))
 
     def forward(self, nodes: torch.Tensor, edges: torch.Tensor) -> torch.Tensor:
-        """``nodes`` (B, N, NODE_FEATURES), ``edges`` (B, N, N, EDGE_FEATURES) -> (B, N) outputs."""
+        """``nodes`` (B, N, node_features), ``edges`` (B, N, N, EDGE_FEATURES) -> (B, N) outputs."""
         b, n, _ = nodes.shape
         mask = 1.0 - torch.eye(n, dtype=nodes.dtype, device=nodes.device)[None].expand(b, n, n)
         x, e = self.encode_nodes(nodes), self.encode_edges(edges) * mask[..., None]
@@ -112,6 +135,6 @@ class GraphNetwork(nn.Module):
 
     def evaluate(self, observation: SceneObservation) -> np.ndarray:
         """Per-component outputs for one observation."""
-        nodes, edges = observation_tensors(observation, self.config.position_scale)
+        nodes, edges = observation_tensors(observation, self.config)
         with torch.no_grad():
             return self(torch.from_numpy(nodes)[None], torch.from_numpy(edges)[None])[0].numpy()

@@ -60,7 +60,7 @@ class EpsilonGreedyLearner:
         self._rng = rng
 
     def choose(self, observation: SceneObservation) -> int:
-        self._last = observation_tensors(observation, self.config.network.position_scale)
+        self._last = observation_tensors(observation, self.config.network)
         epsilon = self.epsilon if self.training else self.config.epsilon_eval
         if self._rng.random() < epsilon:
             return int(self._rng.integers(len(observation)))

@@ -76,7 +76,7 @@ class ModelBasedAgent(EpsilonGreedyLearner):
 
     def move_probabilities(self, observation: SceneObservation) -> np.ndarray:
         """``(N, 2^N)``: the network's P(component moves) in every joint state of this scene."""
-        nodes, edges = observation_tensors(observation, self.config.network.position_scale)
+        nodes, edges = observation_tensors(observation, self.config.network)
         n = len(nodes)
         bits = ((np.arange(1 << n)[:, None] >> np.arange(n)) & 1).astype(np.float32)
         batch = np.repeat(nodes[None], len(bits), axis=0)

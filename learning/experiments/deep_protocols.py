@@ -33,7 +33,14 @@ from tqdm import tqdm
 
 from learning.agents.factory import DEEP_AGENT_NAMES
 from learning.errors import ConfigError
-from learning.experiments.protocol import TRAIN_LAYOUT_BASE, ProtocolConfig, evaluate, layout
+from learning.experiments.protocol import (
+    TRAIN_LAYOUT_BASE,
+    ProtocolConfig,
+    Score,
+    evaluate,
+    layout,
+    summarise_scores,
+)
 from learning.experiments.symbolic_protocols import MOVED_BOX_POSE, NOISE_CONDITIONS
 from learning.symbolic_world import SymbolicWorld
 from learning.trial import run_episode
@@ -82,26 +89,36 @@ class TrainingJob:
     seed: int
     evaluate_at: tuple[int, ...]
     conditions_at: int | None = None
+    poses: str = "relative"
+    """The graph network's pose encoding (``GraphNetworkConfig.poses``); ``absolute`` is an ablation."""
 
     @property
     def key(self) -> str:
-        return f"{self.agent}-v{self.variants}-s{self.seed}"
+        return job_key(self.agent, self.variants, self.seed, self.poses)
 
     @property
     def episodes(self) -> int:
         return max(self.evaluate_at)
 
 
-def jobs_for(protocol: str, agents: Sequence[str], config: ProtocolConfig, schedule: DeepSchedule) -> list[TrainingJob]:
+def job_key(agent: str, variants: int, seed: int, poses: str = "relative") -> str:
+    """File stem of a job in ``OUT/jobs/``, e.g. ``dqn-v9-s0`` (``dqn-v9-s0-absolute`` for the ablation)."""
+    suffix = "" if poses == "relative" else f"-{poses}"
+    return f"{agent}-v{variants}-s{seed}{suffix}"
+
+
+def jobs_for(
+    protocol: str, agents: Sequence[str], config: ProtocolConfig, schedule: DeepSchedule, poses: str = "relative"
+) -> list[TrainingJob]:
     """The jobs a protocol needs (the k = 9 job is the same for all three: it is computed once)."""
     full = len(TRAIN_INDICES)
     jobs = []
     for agent in agents:
         for seed in range(config.training_seeds):
-            jobs.append(TrainingJob(agent, full, seed, schedule.checkpoints, schedule.converged_episodes))
+            jobs.append(TrainingJob(agent, full, seed, schedule.checkpoints, schedule.converged_episodes, poses))
             if protocol == "variants" and agent in schedule.variant_agents:
                 jobs += [
-                    TrainingJob(agent, k, seed, (schedule.converged_episodes,))
+                    TrainingJob(agent, k, seed, (schedule.converged_episodes,), poses=poses)
                     for k in schedule.variant_counts
                     if 0 < k < full
                 ]
@@ -109,9 +126,13 @@ def jobs_for(protocol: str, agents: Sequence[str], config: ProtocolConfig, sched
 
 
 def _settings(job: TrainingJob, config: ProtocolConfig) -> dict[str, Any]:
-    """Everything a job's numbers depend on (a cached job must match it exactly to be reused)."""
+    """Everything a job's numbers depend on (a cached job must match it exactly to be reused). The
+    default pose encoding is left out, as in the files written before the option existed."""
+    job_fields = asdict(job)
+    if job.poses == "relative":
+        del job_fields["poses"]
     return {
-        "job": asdict(job),
+        "job": job_fields,
         "runs_per_variant": config.runs_per_variant,
         "success_actions": config.success_actions,
         "max_actions": config.max_actions,
@@ -145,11 +166,11 @@ def run_job(job: TrainingJob, config: ProtocolConfig, out_dir: str, progress: An
     ``progress`` (a queue) receives the number of training episodes done as they finish."""
     import torch
 
-    from learning.baselines import make_learner, save_checkpoint
+    from learning.baselines import GraphNetworkConfig, make_learner, save_checkpoint
 
     torch.set_num_threads(1)  # one job per core: the jobs are the parallelism
     start = time.perf_counter()
-    agent = make_learner(job.agent, job.seed)
+    agent = make_learner(job.agent, job.seed, GraphNetworkConfig(poses=job.poses))
     evaluations, training_solved = [], []
     done = 0
     for checkpoint in job.evaluate_at:
@@ -237,17 +258,7 @@ def _score(records: Sequence[dict[str, Any]], episodes: int, condition: str) -> 
     picked = [e for r in records for e in r["evaluations"] if e["episodes"] == episodes and e["condition"] == condition]
     if not picked:
         return None
-    success = np.array([e["success_rate"] for e in picked])
-    actions = np.array([e["mean_actions"] for e in picked])
-    return {
-        "success_rate": float(success.mean()),
-        "success_rate_std": float(success.std()),
-        "mean_actions": float(actions.mean()),
-        "mean_actions_std": float(actions.std()),
-        "seeds": len(picked),
-        "success_rate_per_seed": success.tolist(),
-        "mean_actions_per_seed": actions.tolist(),
-    }
+    return summarise_scores([Score(e["success_rate"], e["mean_actions"], e["runs"]) for e in picked])
 
 
 def merge_deep_points(
@@ -256,6 +267,7 @@ def merge_deep_points(
     records: dict[str, dict[str, Any]],
     config: ProtocolConfig,
     schedule: DeepSchedule,
+    poses: str = "relative",
 ) -> dict[str, Any]:
     """Add the deep agents' entries to a protocol result's points (new x values become new points)."""
     protocol, x_key = result["protocol"], result["x"]
@@ -268,7 +280,7 @@ def merge_deep_points(
             by_x.setdefault(x, {x_key: x, **fixed})[agent] = entry
 
     def seeds(agent: str, k: int) -> list[dict[str, Any]]:
-        return [records[f"{agent}-v{k}-s{t}"] for t in range(config.training_seeds)]
+        return [records[job_key(agent, k, t, poses)] for t in range(config.training_seeds)]
 
     for agent in agents:
         if protocol == "episodes":
@@ -284,4 +296,4 @@ def merge_deep_points(
     points = [p for p in by_x.values() if len(p) > 1]  # drop x values no agent was evaluated at
     if protocol != "noise":
         points.sort(key=lambda p: p[x_key])
-    return {**result, "points": points, "deep_schedule": asdict(schedule)}
+    return {**result, "points": points, "deep_schedule": asdict(schedule), "deep_poses": poses}

@@ -28,7 +28,11 @@ SMALL = GraphNetworkConfig(blocks=1, hidden=16)
 
 
 @pytest.mark.parametrize("agent", [DQNAgent(DQNConfig(network=SMALL, batch_size=4)),
-                                   ModelBasedAgent(ModelBasedConfig(network=SMALL, batch_size=4))])  # fmt: skip
+                                   ModelBasedAgent(ModelBasedConfig(network=SMALL, batch_size=4)),
+                                   DQNAgent(DQNConfig.multitask(network=SMALL, batch_size=4)),
+                                   ModelBasedAgent(ModelBasedConfig.multitask(
+                                       network=GraphNetworkConfig(blocks=1, hidden=16, poses="absolute"),
+                                       batch_size=4))])  # fmt: skip
 def test_checkpoint_round_trip_gives_identical_outputs(tmp_path, agent):
     spec = generate_chain(["door", "slide", "wheel"], seed=0)
     for e in range(5):
@@ -41,7 +45,7 @@ def test_checkpoint_round_trip_gives_identical_outputs(tmp_path, agent):
     np.testing.assert_array_equal(network.evaluate(observation), reloaded.evaluate(observation))
     meta = json.loads((tmp_path / "agent.pt.json").read_text())
     assert meta["agent"] == agent.name and meta["episodes"] == 5 and "torch" in meta["versions"]
-    assert not again.training
+    assert not again.training and again.config == agent.config  # MT-OPT flags and pose encoding included
 
 
 def test_bad_checkpoints_are_clear_errors(tmp_path):

@@ -7,12 +7,14 @@ torch = pytest.importorskip("torch")
 
 from learning import SymbolicWorld  # noqa: E402
 from learning.baselines import GraphNetwork, GraphNetworkConfig, observation_tensors  # noqa: E402
+from learning.errors import ConfigError  # noqa: E402
 from models.generator import paper_family  # noqa: E402
 
 
-def test_shuffling_the_components_permutes_the_outputs():
+@pytest.mark.parametrize("poses", ["relative", "absolute"])
+def test_shuffling_the_components_permutes_the_outputs(poses):
     torch.manual_seed(0)
-    net = GraphNetwork(GraphNetworkConfig(blocks=3, hidden=32))
+    net = GraphNetwork(GraphNetworkConfig(blocks=3, hidden=32, poses=poses))
     spec = paper_family("test")[0]
     a = SymbolicWorld(spec, seed=1).observe()
     b = SymbolicWorld(spec, seed=2).observe()  # the same scene, components in another order
@@ -27,8 +29,22 @@ def test_shuffling_the_components_permutes_the_outputs():
 def test_features_hold_kind_state_goal_and_relative_poses():
     spec = paper_family("test")[1]
     observation = SymbolicWorld(spec, seed=0).observe()
-    nodes, edges = observation_tensors(observation, 0.02)
+    nodes, edges = observation_tensors(observation, GraphNetworkConfig())
     assert nodes.shape == (5, 5) and edges.shape == (5, 5, 4)
     assert nodes[:, :3].sum(axis=1).tolist() == [1.0] * 5
     assert nodes[observation.goal_index, 4] == 1.0 and nodes[:, 4].sum() == 1.0
     np.testing.assert_allclose(np.diagonal(edges[..., 3]), 1.0)  # cos of a zero relative yaw
+
+
+def test_absolute_poses_go_into_the_nodes_and_unknown_encodings_are_config_errors():
+    spec = paper_family("test")[1]
+    observation = SymbolicWorld(spec, seed=0).observe()
+    config = GraphNetworkConfig(poses="absolute")
+    nodes, edges = observation_tensors(observation, config)
+    assert nodes.shape == (5, 9) and not edges.any()
+    np.testing.assert_allclose(nodes[:, 5:7].mean(axis=0), 0.0, atol=1e-5)  # centred on the components
+    np.testing.assert_allclose(nodes[:, 5:7] * config.position_scale, observation.poses[:, :2]
+                               - observation.poses[:, :2].mean(axis=0), atol=1e-6)  # fmt: skip
+    np.testing.assert_allclose(np.hypot(nodes[:, 7], nodes[:, 8]), 1.0, atol=1e-6)
+    with pytest.raises(ConfigError, match="relative"):
+        GraphNetworkConfig(poses="polar")
