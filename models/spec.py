@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from models.atomic import write_text_atomically
 from models.errors import SpecError, SpecProblem
 from models.geometry import compose, wrap_angle
 
@@ -213,12 +214,7 @@ def load_spec(path: str | Path) -> PuzzleSpec:
 
 def save_spec(spec: PuzzleSpec, path: str | Path) -> Path:
     """Write a spec as JSON (atomically: a crash never leaves a half-written file)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(spec.to_json(), encoding="utf-8")
-    tmp.replace(path)
-    return path
+    return write_text_atomically(path, spec.to_json())
 
 
 def build_from_valid_data(data: dict[str, Any]) -> PuzzleSpec:

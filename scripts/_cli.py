@@ -9,6 +9,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
+from models.atomic import write_text_atomically
 from models.spec import dumps_compact
 
 
@@ -25,11 +26,7 @@ def versions() -> dict[str, str]:
 
 def write_json(path: Path, data: Any) -> Path:
     """Write JSON atomically (a crash never leaves a half-written file)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(dumps_compact(data) if isinstance(data, dict) else json.dumps(data, indent=2))
-    tmp.replace(path)
-    return path
+    return write_text_atomically(path, dumps_compact(data) if isinstance(data, dict) else json.dumps(data, indent=2))
 
 
 def fail(message: str, code: int = 2) -> None:

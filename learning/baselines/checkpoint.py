@@ -17,6 +17,7 @@ from learning.baselines.dqn import DQNAgent, DQNConfig
 from learning.baselines.graph_network import GraphNetworkConfig
 from learning.baselines.model_based import ModelBasedAgent, ModelBasedConfig
 from learning.errors import LearningError
+from models.atomic import write_atomically, write_text_atomically
 
 CHECKPOINT_FORMAT = "puzzlebox-baseline/2"
 """/2: GN blocks apply the edge MLP's first layer per part (``GNBlock``); MT-OPT flags in the config."""
@@ -38,8 +39,6 @@ def _network(agent: DQNAgent | ModelBasedAgent) -> torch.nn.Module:
 
 def save_checkpoint(agent: DQNAgent | ModelBasedAgent, path: str | Path) -> Path:
     """Write ``path`` (weights) and ``path.json`` (metadata), each atomically."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     meta = {
         "format": CHECKPOINT_FORMAT,
         "agent": agent.name,
@@ -48,13 +47,8 @@ def save_checkpoint(agent: DQNAgent | ModelBasedAgent, path: str | Path) -> Path
         "versions": {"python": platform.python_version(), "torch": torch.__version__,
                      "puzzlebox": _version("puzzlebox")},
     }  # fmt: skip
-    tmp = path.with_name(path.name + ".tmp")
-    torch.save(_network(agent).state_dict(), tmp)
-    tmp.replace(path)
-    meta_path = Path(str(path) + ".json")
-    tmp_meta = meta_path.with_name(meta_path.name + ".tmp")
-    tmp_meta.write_text(json.dumps(meta, indent=2))
-    tmp_meta.replace(meta_path)
+    path = write_atomically(path, lambda tmp: torch.save(_network(agent).state_dict(), tmp))
+    write_text_atomically(str(path) + ".json", json.dumps(meta, indent=2))
     return path
 
 

@@ -13,55 +13,37 @@ success/failure balancing: half of every batch comes from episodes that reached 
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import torch
 from torch import nn
 
-from learning.baselines.graph_network import GraphNetwork, GraphNetworkConfig, observation_tensors
-from learning.baselines.learner import EpsilonGreedyLearner
+from learning.baselines.graph_network import GraphNetwork
+from learning.baselines.learner import EpsilonGreedyLearner, LearnerConfig
 from learning.baselines.multitask import RelabelledStep, Step, relabel_episode
 from models import SceneObservation
 
 
 @dataclass(frozen=True)
-class DQNConfig:
-    """DQN settings (defaults: the authors' release)."""
+class DQNConfig(LearnerConfig):
+    """DQN settings (defaults: the authors' release). ``share_across_tasks`` relabels every episode for
+    every component as the goal; ``balance`` draws half of each batch from success episodes."""
 
-    network: GraphNetworkConfig = field(default_factory=GraphNetworkConfig)
     gamma: float = 0.99
-    learning_rate: float = 3e-4
-    batch_size: int = 16
-    replay_size: int = 100_000
     tau: float = 3e-4
     """Soft target update rate per gradient step (the release: tau = learning rate)."""
-    epsilon_start: float = 1.0
-    epsilon_decay: float = 0.999
-    """Multiplier of epsilon after every training episode."""
-    epsilon_min: float = 0.2
-    epsilon_eval: float = 0.1
     goal_reward: float = 1.0
     step_reward: float = -0.05
-    updates_per_action: int = 1
-    share_across_tasks: bool = False
-    """MT-OPT data sharing: relabel every episode for every component as the goal."""
-    balance: bool = False
-    """MT-OPT balancing: half of each batch from success episodes, half from failures."""
-    seed: int = 0
-
-    @classmethod
-    def multitask(cls, **overrides: object) -> DQNConfig:
-        """The MT-OPT variant (``mt-dqn``): data sharing and balancing on."""
-        return cls(**{"share_across_tasks": True, "balance": True, **overrides})
 
 
 class DQNAgent(EpsilonGreedyLearner):
     """The agent (``Agent`` protocol). ``training=True``: epsilon-greedy with learning; else evaluation."""
 
+    base_name = "dqn"
+
     def __init__(self, config: DQNConfig | None = None) -> None:
         super().__init__(config or DQNConfig())
-        self.name = "mt-dqn" if self.config.share_across_tasks or self.config.balance else "dqn"
         self._episode: list[Step] = []
         self._goal = (0, 1)
         self.q = GraphNetwork(self.config.network)
@@ -80,8 +62,8 @@ class DQNAgent(EpsilonGreedyLearner):
 
     def observe_outcome(self, index: int, moved: bool, observation: SceneObservation) -> None:
         nodes, edges = self._last
-        next_nodes, next_edges = observation_tensors(observation, self.config.network)
-        if self.config.share_across_tasks or self.config.balance:  # stored once the episode's outcome is known
+        next_nodes, next_edges = self.tensors(observation)
+        if self.config.is_multitask:  # stored once the episode's outcome is known
             self._episode.append(Step(nodes, edges, index, next_nodes, next_edges))
             return
         done = observation.solved

@@ -7,18 +7,49 @@ from __future__ import annotations
 
 import random
 from collections import defaultdict, deque
-from typing import Any
+from dataclasses import dataclass, field
+from typing import Any, Self
 
 import numpy as np
 import torch
 
-from learning.baselines.graph_network import observation_tensors
+from learning.baselines.graph_network import GraphNetworkConfig, observation_tensors
 from models import SceneObservation
 
 
+@dataclass(frozen=True)
+class LearnerConfig:
+    """What every deep agent is configured with (defaults: the authors' release)."""
+
+    network: GraphNetworkConfig = field(default_factory=GraphNetworkConfig)
+    learning_rate: float = 3e-4
+    batch_size: int = 16
+    replay_size: int = 100_000
+    epsilon_start: float = 1.0
+    epsilon_decay: float = 0.999
+    """Multiplier of epsilon after every training episode."""
+    epsilon_min: float = 0.2
+    epsilon_eval: float = 0.1
+    updates_per_action: int = 1
+    share_across_tasks: bool = False
+    """MT-OPT data sharing (what is shared is the agent's call: see ``multitask.py``)."""
+    balance: bool = False
+    """MT-OPT balancing: half of each batch successes, half failures (the agent says which is which)."""
+    seed: int = 0
+
+    @classmethod
+    def multitask(cls, **overrides: Any) -> Self:
+        """The MT-OPT variant: data sharing and balancing on."""
+        return cls(**{"share_across_tasks": True, "balance": True, **overrides})
+
+    @property
+    def is_multitask(self) -> bool:
+        return self.share_across_tasks or self.balance
+
+
 class EpsilonGreedyLearner:
-    """Base of the deep agents. ``config`` needs: network, batch_size, replay_size, epsilon_start,
-    epsilon_decay, epsilon_min, epsilon_eval, updates_per_action, balance, seed.
+    """Base of the deep agents, configured by a :class:`LearnerConfig` (or a subclass of it); named
+    ``base_name``, with an ``mt-`` prefix when the config turns MT-OPT on.
 
     The replay holds, per component count, two buffers: ``success`` and ``failure`` examples (what
     counts as a success is the subclass's call). Without ``balance`` a batch is drawn from both
@@ -26,10 +57,11 @@ class EpsilonGreedyLearner:
     balancing) half of every batch comes from each as soon as both can fill their half.
     """
 
-    name = "learner"
+    base_name = "learner"
 
-    def __init__(self, config: Any) -> None:
+    def __init__(self, config: LearnerConfig) -> None:
         self.config = config
+        self.name = f"mt-{self.base_name}" if config.is_multitask else self.base_name
         torch.manual_seed(config.seed)
         self.replay: dict[tuple[int, bool], deque] = defaultdict(lambda: deque(maxlen=config.replay_size))
         self.epsilon = config.epsilon_start
@@ -38,6 +70,7 @@ class EpsilonGreedyLearner:
         self._sample_rng = random.Random(config.seed)
         self._rng = np.random.default_rng(0)
         self._last: tuple[np.ndarray, np.ndarray] | None = None
+        self._cached: tuple[SceneObservation, tuple[np.ndarray, np.ndarray]] | None = None
 
     # -- to provide --------------------------------------------------------------------------------
     def greedy_values(self, observation: SceneObservation) -> np.ndarray:
@@ -59,8 +92,15 @@ class EpsilonGreedyLearner:
     def begin_episode(self, observation: SceneObservation, rng: np.random.Generator) -> None:
         self._rng = rng
 
+    def tensors(self, observation: SceneObservation) -> tuple[np.ndarray, np.ndarray]:
+        """The network's features of ``observation``, computed once: the scene after a try is both
+        learned from (``record``) and acted on (``choose``)."""
+        if self._cached is None or self._cached[0] is not observation:
+            self._cached = (observation, observation_tensors(observation, self.config.network))
+        return self._cached[1]
+
     def choose(self, observation: SceneObservation) -> int:
-        self._last = observation_tensors(observation, self.config.network)
+        self._last = self.tensors(observation)
         epsilon = self.epsilon if self.training else self.config.epsilon_eval
         if self._rng.random() < epsilon:
             return int(self._rng.integers(len(observation)))

@@ -16,44 +16,26 @@ locked box fail).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import torch
 from torch import nn
 
-from learning.baselines.graph_network import GraphNetwork, GraphNetworkConfig, observation_tensors
-from learning.baselines.learner import EpsilonGreedyLearner
+from learning.baselines.graph_network import GraphNetwork
+from learning.baselines.learner import EpsilonGreedyLearner, LearnerConfig
 from learning.baselines.multitask import STATE_COLUMN, with_goal
 from learning.planner import bitmask, value_iteration
 from models import SceneObservation
 
 
 @dataclass(frozen=True)
-class ModelBasedConfig:
-    """Settings of the precondition learner and its planner."""
+class ModelBasedConfig(LearnerConfig):
+    """Settings of the precondition learner and its planner. ``share_across_tasks`` stores every try
+    with the goal flag on each component; ``balance`` draws half of each batch from tries that moved."""
 
-    network: GraphNetworkConfig = field(default_factory=GraphNetworkConfig)
-    learning_rate: float = 3e-4
-    batch_size: int = 16
-    replay_size: int = 100_000
     gamma: float = 0.9
     """Planner discount per action (the agent's exploitation search)."""
-    epsilon_start: float = 1.0
-    epsilon_decay: float = 0.999
-    epsilon_min: float = 0.2
-    epsilon_eval: float = 0.1
-    updates_per_action: int = 1
-    share_across_tasks: bool = False
-    """MT-OPT data sharing: store every try with the goal flag on each component."""
-    balance: bool = False
-    """MT-OPT balancing: half of each batch tries that moved, half tries that did not."""
-    seed: int = 0
-
-    @classmethod
-    def multitask(cls, **overrides: object) -> ModelBasedConfig:
-        """The MT-OPT variant (``mt-model-based``): data sharing and balancing on."""
-        return cls(**{"share_across_tasks": True, "balance": True, **overrides})
 
 
 @dataclass
@@ -67,16 +49,16 @@ class _Example:
 class ModelBasedAgent(EpsilonGreedyLearner):
     """The agent (``Agent`` protocol); ``training=True`` explores and fits, else evaluates."""
 
+    base_name = "model-based"
+
     def __init__(self, config: ModelBasedConfig | None = None) -> None:
         super().__init__(config or ModelBasedConfig())
-        multitask = self.config.share_across_tasks or self.config.balance
-        self.name = "mt-model-based" if multitask else "model-based"
         self.net = GraphNetwork(self.config.network)
         self.optimizer = torch.optim.Adam(self.net.parameters(), lr=self.config.learning_rate, fused=True)
 
     def move_probabilities(self, observation: SceneObservation) -> np.ndarray:
         """``(N, 2^N)``: the network's P(component moves) in every joint state of this scene."""
-        nodes, edges = observation_tensors(observation, self.config.network)
+        nodes, edges = self.tensors(observation)
         n = len(nodes)
         bits = ((np.arange(1 << n)[:, None] >> np.arange(n)) & 1).astype(np.float32)
         batch = np.repeat(nodes[None], len(bits), axis=0)

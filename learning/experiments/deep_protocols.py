@@ -34,22 +34,20 @@ from tqdm import tqdm
 from learning.agents.factory import DEEP_AGENT_NAMES
 from learning.errors import ConfigError
 from learning.experiments.protocol import (
-    TRAIN_LAYOUT_BASE,
     ProtocolConfig,
     Score,
     evaluate,
-    layout,
     summarise_scores,
+    training_layout,
 )
-from learning.experiments.symbolic_protocols import MOVED_BOX_POSE, NOISE_CONDITIONS
+from learning.experiments.symbolic_protocols import CONDITIONS
 from learning.symbolic_world import SymbolicWorld
 from learning.trial import run_episode
+from models.atomic import write_text_atomically
 from models.generator import TRAIN_INDICES
 
 DEEP_AGENTS = DEEP_AGENT_NAMES
 NONE = "none"
-CONDITIONS = (*NOISE_CONDITIONS, "moved box")
-"""Scene conditions of the noise protocol (``none`` is the clean scene)."""
 
 
 @dataclass(frozen=True)
@@ -140,22 +138,17 @@ def _settings(job: TrainingJob, config: ProtocolConfig) -> dict[str, Any]:
 
 
 def _train(agent: Any, job: TrainingJob, episodes: range, config: ProtocolConfig) -> list[bool]:
-    """Training episodes as the memory agent's (``protocol.train_memory``): same layouts and seeds."""
-    variants = TRAIN_INDICES[: job.variants]
+    """Training episodes on the memory agent's boxes (``protocol.training_layout``)."""
     solved = []
     for e in episodes:
-        seed = TRAIN_LAYOUT_BASE + 1000 * job.seed + e
-        spec = layout(variants[e % len(variants)], seed)
+        spec, seed = training_layout(TRAIN_INDICES[: job.variants], e, job.seed)
         solved.append(run_episode(agent, SymbolicWorld(spec, seed), spec.name, seed, config.max_actions).solved)
     return solved
 
 
 def _evaluate(agent: Any, config: ProtocolConfig, condition: str) -> dict[str, float]:
     agent.training = False
-    kwargs: dict[str, Any] = {"box_pose": MOVED_BOX_POSE} if condition == "moved box" else {}
-    if condition in NOISE_CONDITIONS:
-        kwargs["faults"] = NOISE_CONDITIONS[condition]
-    score = evaluate(lambda spec: agent, config, **kwargs)
+    score = evaluate(lambda spec: agent, config, **CONDITIONS[condition])
     agent.training = True
     return {"success_rate": score.success_rate, "mean_actions": score.mean_actions, "runs": score.runs}
 
@@ -193,10 +186,7 @@ def run_job(job: TrainingJob, config: ProtocolConfig, out_dir: str, progress: An
         "wall_time_s": time.perf_counter() - start,
         "checkpoint": f"{job.key}.pt",
     }
-    path = jobs_dir / f"{job.key}.json"
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(record, indent=1))
-    tmp.replace(path)
+    write_text_atomically(jobs_dir / f"{job.key}.json", json.dumps(record, indent=1))
     return record
 
 

@@ -68,12 +68,18 @@ def train_memory(
     """Train the memory agent for ``episodes`` (episode numbers), cycling through ``variants``."""
     results = []
     for e in episodes:
-        spec = layout(variants[e % len(variants)], TRAIN_LAYOUT_BASE + 1000 * training_seed + e)
+        spec, seed = training_layout(variants, e, training_seed)
         agent = MemoryAgent(store, config.controller, config.memory, learn=True)
         agent.episode_label = spec.name
-        seed = TRAIN_LAYOUT_BASE + 1000 * training_seed + e
         results.append(run_episode(agent, SymbolicWorld(spec, seed), spec.name, seed, config.max_actions))
     return results
+
+
+def training_layout(variants: Sequence[int], episode: int, training_seed: int) -> tuple[PuzzleSpec, int]:
+    """The box of training episode ``episode`` (cycling through ``variants``) and its world seed: the
+    same for every agent trained with ``training_seed``."""
+    seed = TRAIN_LAYOUT_BASE + 1000 * training_seed + episode
+    return layout(variants[episode % len(variants)], seed), seed
 
 
 def agent_factory(name: str, store: MemoryStore | None, config: ProtocolConfig) -> Callable[[PuzzleSpec], Agent]:
@@ -150,4 +156,5 @@ __all__ = [
     "layout",
     "summarise_scores",
     "train_memory",
+    "training_layout",
 ]

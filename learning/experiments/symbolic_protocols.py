@@ -39,6 +39,11 @@ NOISE_CONDITIONS: dict[str, FaultConfig | None] = {
 sigma * pi / 12 on the angle."""
 MOVED_BOX_POSE = (0.32, -0.12, 2.0)
 """A box pose unlike the training boxes' (0.45, 0, 0): moved 18 cm and turned 115 degrees [m, m, rad]."""
+CONDITIONS: dict[str, dict[str, Any]] = {
+    **{name: {"faults": faults} for name, faults in NOISE_CONDITIONS.items()},
+    "moved box": {"box_pose": MOVED_BOX_POSE},
+}
+"""The noise protocol's scene conditions, as keyword arguments of ``protocol.evaluate``."""
 VARIANT_COUNTS = tuple(range(10))
 EPISODE_CHECKPOINTS = (0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 12, 15, 20, 30, 45, 60)
 TRAINING_EPISODES_FOR_CONVERGED = 18
@@ -119,11 +124,9 @@ def run_noise(agents: Sequence[str], config: ProtocolConfig, quick: bool = False
     stores = [
         _trained_store(TRAIN_INDICES, TRAINING_EPISODES_FOR_CONVERGED, t, config) for t in range(config.training_seeds)
     ]
-    conditions: dict[str, dict[str, Any]] = {name: {"faults": faults} for name, faults in NOISE_CONDITIONS.items()}
-    conditions["moved box"] = {"box_pose": MOVED_BOX_POSE}
     points = []
-    for name in _progress(list(conditions), "noise"):
-        kwargs = conditions[name]
+    for name in _progress(list(CONDITIONS), "noise"):
+        kwargs = CONDITIONS[name]
         row: dict[str, Any] = {"condition": name, **_untrained_scores(agents, config, **kwargs)}
         if "memory" in agents:
             row["memory"] = summarise_scores(
