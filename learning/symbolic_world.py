@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from learning.puzzle_env import PuzzleEnv, PuzzleEnvConfig
-from models import KIND_NAMES, ComponentObservation, PuzzleSpec, SceneObservation
+from models import KIND_NAMES, ComponentObservation, PuzzleSpec, SceneObservation, TryResult
 
 
 class SymbolicWorld:
@@ -25,9 +25,9 @@ class SymbolicWorld:
         )
         return SceneObservation(components, goal_index=int(obs["goal"]), goal_state=self.env.table.goal_state)
 
-    def try_toggle(self, index: int) -> bool:
+    def try_toggle(self, index: int) -> TryResult:
         self._obs, _, _, _, info = self.env.step(index)
-        return bool(info["moved"])
+        return TryResult.from_moved(bool(info["moved"]))
 
     def ground_truth_name(self, index: int) -> str:
         """Spec name of the component at observation ``index`` — for logs and evaluation only."""

@@ -12,12 +12,20 @@ from learning.agents.base import Agent
 from models import World
 
 
+MAX_FAILURES_IN_A_ROW = 3
+"""A run ends when one component fails this many tries in a row (each already retried by the world):
+a component the robot cannot try is reported, not looped on."""
+
+
 @dataclass(frozen=True)
 class ActionRecord:
     """One try: which component (its ground-truth name when the world gives one), and its outcome."""
 
     component: str
     moved: bool
+    outcome: str = "moved"
+    """``moved``, ``blocked`` or ``failed`` (see :class:`models.TryResult`)."""
+    reason: str = ""
 
 
 @dataclass(frozen=True)
@@ -30,6 +38,8 @@ class RunResult:
     num_actions: int
     wall_time_s: float
     actions: list[ActionRecord] = field(default_factory=list)
+    ended: str = ""
+    """Why an unsolved run stopped early (a component the world gave up on), else empty."""
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -45,12 +55,19 @@ def run_episode(agent: Agent, world: World, spec_name: str, seed: int, max_actio
     agent.begin_episode(observation, np.random.default_rng(seed))
     name_of = getattr(world, "ground_truth_name", None)
     actions: list[ActionRecord] = []
+    ended = ""
+    failures_in_a_row: dict[int, int] = {}
     while not observation.solved and len(actions) < max_actions:
         index = agent.choose(observation)
-        moved = world.try_toggle(index)
+        result = world.try_toggle(index)
         observation = world.observe()
-        agent.record(index, moved, observation)
-        actions.append(ActionRecord(name_of(index) if name_of else str(index), moved))
+        agent.record(index, result, observation)
+        name = name_of(index) if name_of else str(index)
+        actions.append(ActionRecord(name, result.moved, result.outcome, result.reason))
+        failures_in_a_row = {index: failures_in_a_row.get(index, 0) + 1} if result.outcome == "failed" else {}
+        if result.give_up or failures_in_a_row.get(index, 0) >= MAX_FAILURES_IN_A_ROW:
+            ended = f"could not try {name}: {result.reason}"
+            break
     agent.end_episode(observation.solved)
     return RunResult(
         spec=spec_name,
@@ -59,6 +76,7 @@ def run_episode(agent: Agent, world: World, spec_name: str, seed: int, max_actio
         num_actions=len(actions),
         wall_time_s=time.perf_counter() - start,
         actions=actions,
+        ended=ended,
     )
 
 

@@ -31,10 +31,19 @@ from models.spec import (
     spec_from_json,
 )
 from models.validation import validate_data
+from models.robot import CameraImage, Robot
+from models.try_outcome import BLOCKED, MOVED, OUTCOMES, Outcome, TryResult
 from models.world import World
 
 __all__ = [
     "ALLOWED_NEIGHBOURS",
+    "BLOCKED",
+    "MOVED",
+    "OUTCOMES",
+    "CameraImage",
+    "Outcome",
+    "Robot",
+    "TryResult",
     "KIND_NAMES",
     "PUZZLE_KINDS",
     "SPEC_FORMAT",

@@ -204,7 +204,22 @@ def _names(spec: PuzzleSpec) -> SceneNames:
     )
 
 
+def unreachable_handles(spec: PuzzleSpec, box_pose: tuple[float, float, float], config: SceneConfig) -> list[str]:
+    """The components whose handle would lie outside the robot's reach with the box at ``box_pose``
+    ``[x, y, yaw]`` [m, m, rad] (empty: the pose is reachable)."""
+    return _handle_problems(spec, lid_to_world(box_pose, spec.box.size[2]), config)
+
+
 def _check_reach(spec: PuzzleSpec, T_world_lid: np.ndarray, config: SceneConfig) -> None:
+    problems = _handle_problems(spec, T_world_lid, config)
+    if problems:
+        raise UnreachableBoxPose(
+            f"box pose {spec.box.pose} puts handles outside the robot's reach "
+            f"({config.min_reach:.2f}..{config.max_reach:.2f} m from the base axis): {', '.join(problems)}"
+        )
+
+
+def _handle_problems(spec: PuzzleSpec, T_world_lid: np.ndarray, config: SceneConfig) -> list[str]:
     problems = []
     for c in spec.components:
         hx, hy = get_kind(c.kind).handle_xy
@@ -221,8 +236,4 @@ def _check_reach(spec: PuzzleSpec, T_world_lid: np.ndarray, config: SceneConfig)
         radius = math.hypot(wx, wy)
         if not config.min_reach <= radius <= config.max_reach:
             problems.append(f"{c.name!r} handle at {radius:.3f} m")
-    if problems:
-        raise UnreachableBoxPose(
-            f"box pose {spec.box.pose} puts handles outside the robot's reach "
-            f"({config.min_reach:.2f}..{config.max_reach:.2f} m from the base axis): {', '.join(problems)}"
-        )
+    return problems

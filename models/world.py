@@ -10,6 +10,7 @@ from __future__ import annotations
 from typing import Protocol, runtime_checkable
 
 from models.observation import SceneObservation
+from models.try_outcome import TryResult
 
 
 @runtime_checkable
@@ -20,6 +21,7 @@ class World(Protocol):
         """The components' kinds, poses and states, in this episode's (shuffled) order."""
         ...
 
-    def try_toggle(self, index: int) -> bool:
-        """Try to move component ``index`` of the observation to its other state; True iff it moved."""
+    def try_toggle(self, index: int) -> TryResult:
+        """Try to move component ``index`` of the observation to its other state: ``moved``,
+        ``blocked`` (felt held: evidence of a lock) or ``failed`` (no proper try: no evidence)."""
         ...

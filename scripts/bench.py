@@ -47,9 +47,9 @@ def decision_latency(n: int, episodes: int, max_decisions: int) -> dict[str, flo
             start = time.perf_counter()
             index = agent.choose(observation)
             times.append(time.perf_counter() - start)
-            moved = world.try_toggle(index)
+            result = world.try_toggle(index)
             observation = world.observe()
-            agent.record(index, moved, observation)
+            agent.record(index, result, observation)
     ms = 1000.0 * np.array(times)
     return {"median_ms": float(np.median(ms)), "p90_ms": float(np.percentile(ms, 90)), "decisions": len(ms)}
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from models import ComponentObservation, SceneObservation
+from models import ComponentObservation, SceneObservation, TryResult
 from skills.errors import IKFailure, MarkersNotFound
 from skills.joint_model import JointModel, joint_model
 from skills.kinematics import top_down
@@ -131,7 +131,7 @@ class TwinWorld:
         )
         return SceneObservation(components, goal_index=self.markers.index(self.goal_marker), goal_state=1)
 
-    def try_toggle(self, index: int) -> bool:
+    def try_toggle(self, index: int) -> TryResult:
         marker = self.markers[index]
         opening = self.states[index] == 0
         before = self.ground_truth(marker) if self.ground_truth else None
@@ -147,7 +147,9 @@ class TwinWorld:
                 None if before is None else bool(before != after),
             )
         )  # fmt: skip
-        return moved
+        if moved:
+            return TryResult("moved")
+        return TryResult("failed" if result.outcome == "failed" else "blocked", result.reason)
 
     def _sensed_moved(self, result: ToggleResult, marker: int, opening: bool) -> bool:
         if result.outcome == "blocked":

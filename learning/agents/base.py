@@ -6,7 +6,7 @@ from typing import Protocol
 
 import numpy as np
 
-from models import SceneObservation
+from models import SceneObservation, TryResult
 
 
 class Agent(Protocol):
@@ -22,8 +22,9 @@ class Agent(Protocol):
         """Index of the component to try next."""
         ...
 
-    def record(self, index: int, moved: bool, observation: SceneObservation) -> None:
-        """The outcome of trying ``index`` and the scene after it."""
+    def record(self, index: int, result: TryResult, observation: SceneObservation) -> None:
+        """The outcome of trying ``index`` and the scene after it. A ``failed`` try (the robot could
+        not make a proper try) is no evidence about locks: learners must not read it as ``blocked``."""
         ...
 
     def end_episode(self, solved: bool) -> None:

@@ -11,7 +11,7 @@ from learning.dual_controller import Decision, DualControllerConfig, decide, max
 from learning.memory.keys import relative_pose_keys
 from learning.memory.prior import MemoryConfig, episode_record, recall_prior
 from learning.memory.store import MemoryStore
-from models import SceneObservation
+from models import SceneObservation, TryResult
 
 
 class DualAgent:
@@ -51,9 +51,10 @@ class DualAgent:
         self.decisions.append(decision)
         return decision.action
 
-    def record(self, index: int, moved: bool, observation: SceneObservation) -> None:
+    def record(self, index: int, result: TryResult, observation: SceneObservation) -> None:
         assert self.belief is not None
-        self.belief.update(self._states, index, moved)  # the state in which the try was made
+        if result.informative:  # a failed try (no grasp, IK, marker lost) says nothing about locks
+            self.belief.update(self._states, index, result.moved)  # the state in which the try was made
 
     def end_episode(self, solved: bool) -> None:
         pass

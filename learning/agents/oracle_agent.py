@@ -11,7 +11,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from learning.errors import LearningError
-from models import LockTable, PuzzleSpec, SceneObservation
+from models import LockTable, PuzzleSpec, SceneObservation, TryResult
 
 KIND_MISMATCH_COST = 1.0
 """Matching cost of a kind mismatch [m-equivalent]: larger than any position error we expect."""
@@ -48,7 +48,7 @@ class OracleAgent:
             return 0
         return int(np.flatnonzero(self._spec_of_obs == plan[0])[0])
 
-    def record(self, index: int, moved: bool, observation: SceneObservation) -> None:
+    def record(self, index: int, result: TryResult, observation: SceneObservation) -> None:
         pass
 
     def end_episode(self, solved: bool) -> None:

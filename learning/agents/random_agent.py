@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from models import SceneObservation
+from models import SceneObservation, TryResult
 
 
 class RandomAgent:
@@ -19,7 +19,7 @@ class RandomAgent:
     def choose(self, observation: SceneObservation) -> int:
         return int(self._rng.integers(len(observation)))
 
-    def record(self, index: int, moved: bool, observation: SceneObservation) -> None:
+    def record(self, index: int, result: TryResult, observation: SceneObservation) -> None:
         pass
 
     def end_episode(self, solved: bool) -> None:

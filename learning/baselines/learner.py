@@ -14,7 +14,7 @@ import numpy as np
 import torch
 
 from learning.baselines.graph_network import GraphNetworkConfig, observation_tensors
-from models import SceneObservation
+from models import SceneObservation, TryResult
 
 
 @dataclass(frozen=True)
@@ -107,10 +107,10 @@ class EpsilonGreedyLearner:
         values = self.greedy_values(observation)
         return int(self._rng.choice(np.flatnonzero(values >= values.max() - 1e-9)))
 
-    def record(self, index: int, moved: bool, observation: SceneObservation) -> None:
-        if not self.training or self._last is None:
-            return
-        self.observe_outcome(index, moved, observation)
+    def record(self, index: int, result: TryResult, observation: SceneObservation) -> None:
+        if not self.training or self._last is None or not result.informative:
+            return  # a failed try (the robot could not try) is not an example of the task's dynamics
+        self.observe_outcome(index, result.moved, observation)
         for _ in range(self.config.updates_per_action):
             self.update()
 

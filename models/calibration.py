@@ -1,0 +1,173 @@
+"""A cell's camera calibration: what the robot's pipeline knows of its cameras, and nothing more.
+
+Perception never reads a camera's true intrinsics or pose (in the twin those carry the reality
+profile's errors); it reads this file, which a calibration procedure made from images of a ChArUco
+board (``scripts/calibrate.py``), as a real cell's would be.
+
+Conventions: OpenCV's pinhole model and pixel convention (integer coordinates at pixel centres),
+distortion ``[k1, k2, p1, p2, k3]``; camera frames are OpenCV's (x right, y down, z forward).
+A fixed camera has ``T_base_camera``; a camera on the arm has ``T_tcp_camera`` (hand-eye), composed
+at capture time with the TCP pose the arm reports.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from models.atomic import write_text_atomically
+from models.errors import ModelsError
+
+CALIBRATION_FORMAT = "puzzlebox-calibration/1"
+
+
+class CalibrationError(ModelsError):
+    """A calibration file that cannot be used, or a camera it does not calibrate."""
+
+
+@dataclass(frozen=True)
+class CameraCalibration:
+    """One camera's calibration (see the module docstring for conventions).
+
+    Attributes:
+        K: 3x3 intrinsics [px].
+        dist: ``(5,)`` distortion ``[k1, k2, p1, p2, k3]``.
+        image_size: ``(width, height)`` [px].
+        T_base_camera: 4x4 pose of a fixed camera in the base frame [m], or None.
+        T_tcp_camera: 4x4 pose of an arm camera in the TCP frame [m], or None.
+        reprojection_error_px: RMS reprojection error of the intrinsic calibration [px].
+        extra: figures of the procedure (pose errors, number of views, ...), for the record.
+    """
+
+    K: np.ndarray
+    dist: np.ndarray
+    image_size: tuple[int, int]
+    T_base_camera: np.ndarray | None = None
+    T_tcp_camera: np.ndarray | None = None
+    reprojection_error_px: float = float("nan")
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        K = np.asarray(self.K, dtype=float)
+        dist = np.asarray(self.dist, dtype=float).ravel()
+        if K.shape != (3, 3) or not np.all(np.isfinite(K)) or K[0, 0] <= 0 or K[1, 1] <= 0:
+            raise CalibrationError(f"K must be a finite 3x3 matrix with positive focal lengths, got {K.tolist()}")
+        if dist.shape != (5,) or not np.all(np.isfinite(dist)):
+            raise CalibrationError(f"dist must be 5 finite coefficients [k1, k2, p1, p2, k3], got {dist.tolist()}")
+        if (self.T_base_camera is None) == (self.T_tcp_camera is None):
+            raise CalibrationError("a camera is either fixed (T_base_camera) or on the arm (T_tcp_camera)")
+        for name in ("T_base_camera", "T_tcp_camera"):
+            T = getattr(self, name)
+            if T is not None:
+                T = np.asarray(T, dtype=float)
+                if T.shape != (4, 4) or not np.all(np.isfinite(T)):
+                    raise CalibrationError(f"{name} must be a finite 4x4 matrix")
+                object.__setattr__(self, name, T)
+        object.__setattr__(self, "K", K)
+        object.__setattr__(self, "dist", dist)
+        object.__setattr__(self, "image_size", (int(self.image_size[0]), int(self.image_size[1])))
+
+    @property
+    def on_arm(self) -> bool:
+        return self.T_tcp_camera is not None
+
+    def pose_in_base(self, T_base_tcp: np.ndarray | None = None) -> np.ndarray:
+        """The camera's pose in the base frame; an arm camera needs the TCP pose at capture [m]."""
+        if self.T_base_camera is not None:
+            return self.T_base_camera.copy()
+        if T_base_tcp is None:
+            raise CalibrationError("an arm camera's pose needs the TCP pose at capture")
+        return np.asarray(T_base_tcp, dtype=float) @ self.T_tcp_camera
+
+    def to_dict(self) -> dict[str, Any]:
+        def listed(T: np.ndarray | None) -> list | None:
+            return None if T is None else np.asarray(T).tolist()
+
+        return {
+            "K": self.K.tolist(),
+            "dist": self.dist.tolist(),
+            "image_size": list(self.image_size),
+            "T_base_camera": listed(self.T_base_camera),
+            "T_tcp_camera": listed(self.T_tcp_camera),
+            "reprojection_error_px": None
+            if math.isnan(self.reprojection_error_px)
+            else float(self.reprojection_error_px),
+            "extra": self.extra,
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> CameraCalibration:
+        known = {"K", "dist", "image_size", "T_base_camera", "T_tcp_camera", "reprojection_error_px", "extra"}
+        unknown = set(data) - known
+        if unknown:
+            raise CalibrationError(f"unknown camera calibration keys {sorted(unknown)}; known: {sorted(known)}")
+        try:
+            error = data.get("reprojection_error_px")
+            return cls(
+                K=np.array(data["K"], dtype=float),
+                dist=np.array(data["dist"], dtype=float),
+                image_size=tuple(data["image_size"]),
+                T_base_camera=None if data.get("T_base_camera") is None else np.array(data["T_base_camera"], float),
+                T_tcp_camera=None if data.get("T_tcp_camera") is None else np.array(data["T_tcp_camera"], float),
+                reprojection_error_px=float("nan") if error is None else float(error),
+                extra=dict(data.get("extra", {})),
+            )
+        except (KeyError, TypeError, ValueError) as err:
+            raise CalibrationError(f"bad camera calibration: {type(err).__name__}: {err}") from None
+
+
+@dataclass(frozen=True)
+class CellCalibration:
+    """The calibration of every camera of a cell, by camera name."""
+
+    cameras: dict[str, CameraCalibration]
+    source: str = ""
+    """How it was made (e.g. ``"charuco, profile realistic, cell seed 0"``), for the record."""
+
+    def camera(self, name: str) -> CameraCalibration:
+        try:
+            return self.cameras[name]
+        except KeyError:
+            raise CalibrationError(
+                f"camera {name!r} is not calibrated; calibrated cameras: {sorted(self.cameras)}"
+            ) from None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "format": CALIBRATION_FORMAT,
+            "source": self.source,
+            "cameras": {name: c.to_dict() for name, c in sorted(self.cameras.items())},
+        }
+
+    @classmethod
+    def from_dict(cls, data: Any) -> CellCalibration:
+        if not isinstance(data, dict) or data.get("format") != CALIBRATION_FORMAT:
+            found = data.get("format") if isinstance(data, dict) else type(data).__name__
+            raise CalibrationError(f"not a calibration file: format {found!r}, expected {CALIBRATION_FORMAT!r}")
+        cameras = data.get("cameras")
+        if not isinstance(cameras, dict) or not cameras:
+            raise CalibrationError("a calibration file needs at least one camera under 'cameras'")
+        return cls({str(k): CameraCalibration.from_dict(v) for k, v in cameras.items()}, str(data.get("source", "")))
+
+    def save(self, path: str | Path) -> Path:
+        return write_text_atomically(path, json.dumps(self.to_dict(), indent=1) + "\n")
+
+    @classmethod
+    def load(cls, path: str | Path) -> CellCalibration:
+        try:
+            text = Path(path).read_text(encoding="utf-8")
+        except OSError as err:
+            raise CalibrationError(f"cannot read calibration {path}: {err.strerror or err}") from None
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as err:
+            raise CalibrationError(f"calibration {path} is not JSON: {err}") from None
+        return cls.from_dict(data)
+
+
+__all__ = ["CALIBRATION_FORMAT", "CalibrationError", "CameraCalibration", "CellCalibration"]
