@@ -37,3 +37,23 @@ class IKFailure(SkillError):
 
 class GraspFailure(SkillError):
     """The gripper closed on nothing."""
+
+
+class CalibrationFailed(SkillError):
+    """A calibration step could not produce a trustworthy result (too few usable views, no board seen)."""
+
+
+class TooFewViews(CalibrationFailed):
+    """Fewer usable board views than a calibration step needs; the message says how many of which."""
+
+
+class BoardNotFound(CalibrationFailed):
+    """The calibration board was not seen (or too few of its corners) in an image that needs it."""
+
+
+class ForceLimitExceeded(SkillError):
+    """The wrist force passed the safety limit during a motion: the motion was stopped."""
+
+
+class SlipDetected(SkillError):
+    """The handle left the grasp during the motion (the gripper closed past the handle's width)."""
