@@ -183,7 +183,9 @@ DEFAULT_BOARD = CharucoBoardSpec()
 """The cell's calibration board."""
 
 
-def board_pose_flat(x: float, y: float, z: float, yaw: float = 0.0, board: CharucoBoardSpec = DEFAULT_BOARD) -> np.ndarray:
+def board_pose_flat(
+    x: float, y: float, z: float, yaw: float = 0.0, board: CharucoBoardSpec = DEFAULT_BOARD
+) -> np.ndarray:
     """``T_base_board`` of a board lying print up with its chessboard centred at ``(x, y)`` and its print
     at height ``z`` [m]; ``yaw`` turns the print's x axis about the base z [rad]. The board's z points down."""
     c, s = math.cos(yaw), math.sin(yaw)
@@ -213,7 +215,10 @@ def add_board_body(
 
     root = worldbody.root
     texture = root.asset.add(
-        "texture", name=f"{name}_texture", type="2d", file=mjcf.Asset(contents=board.png(pixels_per_square), extension=".png")
+        "texture",
+        name=f"{name}_texture",
+        type="2d",
+        file=mjcf.Asset(contents=board.png(pixels_per_square), extension=".png"),
     )
     material = root.asset.add(
         "material",
