@@ -54,6 +54,9 @@ class SceneConfig:
     """Farthest a handle may be from the robot's base axis, horizontally [m] (top-down grasps)."""
     with_markers: bool = True
     """Texture every component with its ArUco marker."""
+    calibration_board: bool = False
+    """Add the ChArUco calibration board as a mocap body, hidden in the table until a rig places it
+    (``models.charuco.add_board_body``, ``twin.calibration_rig``)."""
     robot: XArm7Config = field(default_factory=XArm7Config)
 
 
@@ -172,6 +175,10 @@ def build_scene(spec: PuzzleSpec, config: SceneConfig | None = None) -> Scene:
     box_model = build_puzzle_box(spec, with_markers=config.with_markers)
     x, y, yaw = box_pose
     world.add("site", name="box_mount", pos=[x, y, height], quat=yaw_quat(yaw), size=[0.001], group=4).attach(box_model)
+    if config.calibration_board:
+        from models.charuco import add_board_body
+
+        add_board_body(world)
     return Scene(spec, root, _names(spec), tuple(box_pose), T_world_lid, config)
 
 

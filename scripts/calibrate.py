@@ -1,0 +1,184 @@
+"""Calibrate the cell's cameras from rendered images of a ChArUco board and write the calibration file.
+
+    python scripts/calibrate.py --out FILE.json [--reality PROFILE] [--cell-seed S] [--spec SPEC]
+                                [--seed S] [--overview-views N] [--wrist-views N]
+
+The procedure a real cell runs (``twin.calibration_rig`` moves the board, ``skills.calibration`` does
+the math, the skills' IK moves the arm):
+
+1. the board held in front of the overview camera at varied distances and tilts: its intrinsics;
+2. the board laid flat at a known place: the overview camera's pose in the base frame;
+3. the board left there, the arm moving the wrist camera through varied viewpoints, recording the TCP
+   pose the arm reports at each capture: the wrist camera's intrinsics and its hand-eye pose.
+
+It writes a :class:`models.calibration.CellCalibration` atomically, with the resolved settings, and
+prints one line per camera: the reprojection error and, because this is the twin and the truth is
+known, the pose and focal-length errors against the truth.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+from _cli import fail
+
+
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", required=True, type=Path, help="calibration file to write (JSON)")
+    parser.add_argument("--reality", default="ideal", help="reality profile of the twin: a preset name or JSON file")
+    parser.add_argument("--cell-seed", type=int, default=None, help="seed of the cell's fixed imperfections")
+    parser.add_argument("--spec", type=Path, default=None, help="puzzle spec of the cell (default: paper test 0)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the session and of the procedure's poses")
+    parser.add_argument("--overview-views", type=int, default=20, help="board views for the overview intrinsics")
+    parser.add_argument("--wrist-views", type=int, default=16, help="arm viewpoints for the wrist camera")
+    args = parser.parse_args(argv)
+    if args.overview_views < 6:
+        fail(f"--overview-views must be at least 6, got {args.overview_views}")
+    if args.wrist_views < 6:
+        fail(f"--wrist-views must be at least 6, got {args.wrist_views}")
+    if args.cell_seed is not None and args.cell_seed < 0:
+        fail(f"--cell-seed must be >= 0, got {args.cell_seed}")
+    if args.out.exists() and args.out.is_dir():
+        fail(f"--out {args.out} is a directory; give a file name")
+    return args
+
+
+def load_inputs(args: argparse.Namespace):
+    from models import ModelsError, load_spec
+    from models.generator import paper_family
+
+    try:
+        spec = load_spec(args.spec) if args.spec is not None else paper_family("test", seed=0)[0]
+    except (ModelsError, OSError) as err:
+        fail(f"cannot use spec {args.spec}: {err}")
+    reality = args.reality
+    try:
+        from twin.reality import load_profile
+    except ImportError:
+        if reality != "ideal":
+            fail(f"--reality {reality!r}: this twin has no reality profiles yet; only 'ideal'")
+        return spec, None
+    from twin.errors import TwinError
+
+    try:
+        profile = load_profile(reality)
+    except TwinError as err:
+        fail(f"--reality: {err}")
+    return spec, profile
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
+    spec, profile = load_inputs(args)
+    start = time.perf_counter()
+
+    from models.calibration import CameraCalibration, CellCalibration
+    from skills.calibration import calibrate_intrinsics, fixed_camera_pose, hand_eye, pose_error
+    from skills.errors import CalibrationFailed, IKFailure
+    from skills.kinematics import ArmKinematics
+    from skills.primitives import Toggler
+    from twin.calibration_rig import CalibrationCell, RigError
+
+    rng = np.random.default_rng(args.seed)
+    try:
+        cell = CalibrationCell(spec, seed=args.seed, reality=profile, cell_seed=args.cell_seed)
+    except RigError as err:
+        fail(str(err))
+    with cell:
+        robot = cell.robot
+        overview, wrist = cell.overview_camera, cell.wrist_camera
+        try:
+            # 1. intrinsics of the overview camera: the board held in front of it
+            images = []
+            for T_base_board in cell.board_poses_in_front_of(overview, args.overview_views, rng):
+                cell.place_board(T_base_board)
+                images.append(cell.capture(overview).rgb)
+            overview_intrinsics = calibrate_intrinsics(images)
+
+            # 2. its pose: the board at the known place, a few still frames pooled
+            T_base_board = cell.table_place()
+            cell.place_board(T_base_board)
+            frames = []
+            for _ in range(4):
+                frames.append(cell.capture(overview).rgb)
+                robot.wait(0.02)
+            overview_pose = fixed_camera_pose(frames, overview_intrinsics.K, overview_intrinsics.dist, T_base_board)
+
+            # 3. the wrist camera: the board stays, the arm moves
+            toggler = Toggler(robot, kinematics=ArmKinematics())
+            wrist_images, tcp_poses, unreachable = [], [], 0
+            for T_base_tcp in cell.wrist_viewpoints(T_base_board, args.wrist_views, rng):
+                try:
+                    toggler.move_to(T_base_tcp, 1.5)
+                except IKFailure:
+                    unreachable += 1
+                    continue
+                robot.wait(0.3)  # still: no motion blur, the servos settled
+                wrist_images.append(cell.capture(wrist).rgb)
+                tcp_poses.append(robot.tcp_pose_in_base())
+            toggler.go_rest()
+            wrist_intrinsics = calibrate_intrinsics(wrist_images)
+            wrist_pose = hand_eye(wrist_images, tcp_poses, wrist_intrinsics.K, wrist_intrinsics.dist)
+        except (CalibrationFailed, RigError) as err:
+            fail(f"calibration failed: {err}", code=1)
+
+        truth = {name: cell.camera_truth(name) for name in (overview, wrist)}
+
+    source = f"charuco, profile {getattr(profile, 'name', 'ideal')}, cell seed {args.cell_seed}, seed {args.seed}"
+    figures = {}
+    cameras = {}
+    for name, intrinsics, pose_kind in (
+        (overview, overview_intrinsics, "fixed"),
+        (wrist, wrist_intrinsics, "arm"),
+    ):
+        t = truth[name]
+        if pose_kind == "fixed":
+            T_est, T_true, pose_rms = overview_pose.T_base_camera, t.T_base_camera, overview_pose.rms_px
+        else:
+            T_est, T_true, pose_rms = wrist_pose.T_tcp_camera, t.T_tcp_camera, wrist_pose.rms_px
+        position, angle = pose_error(T_est, T_true)
+        focal = (np.diag(intrinsics.K)[:2] / np.diag(t.K)[:2] - 1.0) * 100.0
+        principal = intrinsics.K[:2, 2] - t.K[:2, 2]
+        figures[name] = {
+            "reprojection_px": intrinsics.rms_px,
+            "pose_reprojection_px": pose_rms,
+            "views": len(intrinsics.views_used),
+            "views_dropped": len(intrinsics.views_dropped),
+            "truth_position_error_mm": position * 1000,
+            "truth_angle_error_deg": float(np.degrees(angle)),
+            "truth_focal_error_pct": focal.tolist(),
+            "truth_principal_error_px": principal.tolist(),
+        }
+        extra = {k: v for k, v in figures[name].items() if not k.startswith("truth")}
+        if pose_kind == "fixed":
+            cameras[name] = CameraCalibration(
+                intrinsics.K, intrinsics.dist, intrinsics.image_size, T_base_camera=T_est,
+                reprojection_error_px=intrinsics.rms_px, extra=extra,
+            )  # fmt: skip
+        else:
+            extra["unreachable_viewpoints"] = unreachable
+            cameras[name] = CameraCalibration(
+                intrinsics.K, intrinsics.dist, intrinsics.image_size, T_tcp_camera=T_est,
+                reprojection_error_px=intrinsics.rms_px, extra=extra,
+            )  # fmt: skip
+    path = CellCalibration(cameras, source=source).save(args.out)
+    wall = time.perf_counter() - start
+    for name, f in figures.items():
+        frame = "T_base_camera" if name == overview else "T_tcp_camera"
+        print(
+            f"{name}: reprojection {f['reprojection_px']:.3f} px ({f['views']} views), pose reprojection "
+            f"{f['pose_reprojection_px']:.3f} px; vs truth: {frame} {f['truth_position_error_mm']:.2f} mm "
+            f"{f['truth_angle_error_deg']:.3f} deg, focal {f['truth_focal_error_pct'][0]:+.3f}/"
+            f"{f['truth_focal_error_pct'][1]:+.3f} %, principal point {f['truth_principal_error_px'][0]:+.2f}/"
+            f"{f['truth_principal_error_px'][1]:+.2f} px"
+        )
+    print(f"wrote {path} in {wall:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
