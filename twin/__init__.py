@@ -1,7 +1,10 @@
 """puzzlebox twin: the simulated world — physics session, latches, sensors, cameras, rendering,
 video — and the robot interface, the only door the robot's pipeline may use (DESIGN.md, "Layers").
 
-The session, the robot interface and the sweep are imported on first use: they load dm_control,
+Reality profiles (:mod:`twin.reality`) make the simulated cell a realistic one: sensor noise, camera
+and TCP errors, physics draws, jams, placement; applied inside the session, invisible to the robot.
+
+The session, the robot interface, the profiles and the sweep are imported on first use: they load dm_control,
 which opens its GL backend at import, and a process that only renders or writes video should not
 pay for that (nor fail there when EGL is unavailable: the renderer reports that itself).
 """
@@ -12,9 +15,11 @@ from typing import Any
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # before mujoco/dm_control load: headless EGL by default
 
+from models.robot import CameraImage  # noqa: E402  (the Robot protocol's frame; kept here for old callers)
 from twin.component_states import ComponentStates, HysteresisConfig  # noqa: E402
 from twin.errors import (  # noqa: E402
     CommandError,
+    ProfileError,
     RenderingError,
     SimulationDiverged,
     TwinError,
@@ -25,7 +30,10 @@ from twin.rendering import RenderConfig, Renderer  # noqa: E402
 from twin.video import VideoWriter  # noqa: E402
 
 _LAZY = {
-    "CameraImage": "twin.robot_interface",
+    "PRESETS": "twin.reality",
+    "RealityProfile": "twin.reality",
+    "load_profile": "twin.reality",
+    "nominal_calibration": "twin.nominal_calibration",
     "RobotInterface": "twin.robot_interface",
     "TwinConfig": "twin.session",
     "TwinSession": "twin.session",
@@ -45,6 +53,9 @@ __all__ = [
     "CommandError",
     "ComponentStates",
     "HysteresisConfig",
+    "PRESETS",
+    "ProfileError",
+    "RealityProfile",
     "RenderConfig",
     "Renderer",
     "RenderingError",
@@ -57,5 +68,7 @@ __all__ = [
     "UnknownCamera",
     "VideoError",
     "VideoWriter",
+    "load_profile",
+    "nominal_calibration",
     "sweep_open",
 ]

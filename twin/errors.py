@@ -10,6 +10,7 @@ from collections.abc import Iterable
 
 __all__ = [
     "CommandError",
+    "ProfileError",
     "RenderingError",
     "SimulationDiverged",
     "TwinError",
@@ -48,3 +49,8 @@ class SimulationDiverged(TwinError):
 
 class CommandError(TwinError, ValueError):
     """A robot command that cannot be sent: wrong length, not finite, or outside the actuator's range."""
+
+
+class ProfileError(TwinError, ValueError):
+    """A reality profile that cannot be used: an unknown preset or key, or a value out of its range
+    (a negative noise, a probability outside [0, 1]); the message names the key and the known ones."""

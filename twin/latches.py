@@ -38,9 +38,12 @@ class Latches:
         held[self.locked[active]] = True
         return held
 
-    def apply(self, data: mujoco.MjData, states: np.ndarray) -> None:
-        """Engage newly held components where they stand and release the ones no rule holds."""
+    def apply(self, data: mujoco.MjData, states: np.ndarray, jammed: np.ndarray | None = None) -> None:
+        """Engage newly held components where they stand and release the ones no rule holds (nor a
+        jam, :mod:`twin.jams`: a jammed component is held by its latch like a locked one)."""
         held = self.held(states)
+        if jammed is not None:
+            held |= jammed
         for c in np.flatnonzero(held & ~self.engaged):
             e = self.eq_ids[c]
             self.model.eq_data[e, 0] = data.qpos[self.joint_qpos[c]]

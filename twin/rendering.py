@@ -49,6 +49,7 @@ __all__ = [
     "RenderConfig",
     "Renderer",
     "gl_backend",
+    "pinhole_intrinsics",
 ]
 
 GL_BACKENDS: tuple[str, ...] = ("egl", "osmesa", "glfw")
@@ -162,6 +163,27 @@ def _track(renderer: Renderer) -> None:
             atexit.register(_close_open_renderers)
             _atexit_registered = True
         _open_renderers.add(renderer)
+
+
+def pinhole_intrinsics(model: mujoco.MjModel, cam: int, width: int, height: int) -> np.ndarray:
+    """Pinhole matrix ``K`` [px] of camera ``cam`` of ``model`` rendered at ``width`` x ``height``
+    (see :meth:`Renderer.camera_intrinsics`; needs no OpenGL context)."""
+    sensor = model.cam_sensorsize[cam]
+    if sensor[1] > 0:
+        # The frustum mjv_updateScene builds on the near plane n (read back from MjvGLCamera with
+        # mujoco 3.17.0): centre n/fx * px, half-width n/fx * sx/2, bottom n/fy * (-sy/2 - py),
+        # top n/fy * (sy/2 - py), with focal lengths (fx, fy) and principal offsets (px, py) from
+        # cam_intrinsic and the sensor size (sx, sy), all in sensor units [m].
+        focal_x, focal_y, principal_x, principal_y = model.cam_intrinsic[cam]
+        fx = width * focal_x / sensor[0]
+        fy = height * focal_y / sensor[1]
+        cx = width * (0.5 - principal_x / sensor[0]) - 0.5
+        cy = height * (0.5 - principal_y / sensor[1]) - 0.5
+    else:
+        fy = 0.5 * height / math.tan(math.radians(model.cam_fovy[cam]) / 2)
+        fx = fy
+        cx, cy = (width - 1) / 2, (height - 1) / 2
+    return np.array([[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]])
 
 
 class Renderer:
@@ -297,25 +319,9 @@ class Renderer:
             RenderingError: for an orthographic camera, which has no pinhole model.
         """
         cam = self.camera_id(camera)
-        width, height = self._config.width, self._config.height
         if self._model.cam_projection[cam] == mujoco.mjtProjection.mjPROJ_ORTHOGRAPHIC:
             raise RenderingError(f"camera {camera!r} is orthographic: it has no pinhole intrinsics")
-        sensor = self._model.cam_sensorsize[cam]
-        if sensor[1] > 0:
-            # The frustum mjv_updateScene builds on the near plane n (read back from MjvGLCamera with
-            # mujoco 3.17.0): centre n/fx * px, half-width n/fx * sx/2, bottom n/fy * (-sy/2 - py),
-            # top n/fy * (sy/2 - py), with focal lengths (fx, fy) and principal offsets (px, py) from
-            # cam_intrinsic and the sensor size (sx, sy), all in sensor units [m].
-            focal_x, focal_y, principal_x, principal_y = self._model.cam_intrinsic[cam]
-            fx = width * focal_x / sensor[0]
-            fy = height * focal_y / sensor[1]
-            cx = width * (0.5 - principal_x / sensor[0]) - 0.5
-            cy = height * (0.5 - principal_y / sensor[1]) - 0.5
-        else:
-            fy = 0.5 * height / math.tan(math.radians(self._model.cam_fovy[cam]) / 2)
-            fx = fy
-            cx, cy = (width - 1) / 2, (height - 1) / 2
-        return np.array([[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]])
+        return pinhole_intrinsics(self._model, cam, self._config.width, self._config.height)
 
     def camera_pose_in_world(self, data: mujoco.MjData, camera: str) -> np.ndarray:
         """``T_world_camera`` of a named camera in state ``data``, OpenCV camera frame (x right, y down,

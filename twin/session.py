@@ -1,51 +1,74 @@
-"""A running twin: the compiled scene of a spec, stepped with latches, checked for divergence.
+"""A running twin: the compiled scene of a spec, stepped with latches, checked for divergence, with the
+cell's imperfections (a :class:`~twin.reality.RealityProfile`) built into its model and sensors.
 
-A :class:`TwinSession` is a pure function of (spec, seed, commands): two sessions given the same
-spec, seed and command sequence produce bit-identical trajectories. The seed drives the only
-randomness, the wrist F/T sensor noise. MuJoCo's autoreset is disabled in the model, and every MuJoCo
-warning raised while stepping becomes :class:`~twin.errors.SimulationDiverged` naming it — a session
-never resets itself silently.
+A :class:`TwinSession` is a pure function of (spec, seed, profile, commands): two sessions given the
+same spec, seed, reality profile and command sequence produce bit-identical trajectories, readings and
+images. The profile's fixed imperfections come from its ``cell_seed``; everything drawn per trial
+(placement, physics factors, sensor noise, bias and drift, command stalls, jams, frame effects) comes
+from ``seed``, each concern from its own stream (:class:`numpy.random.SeedSequence` children) so that,
+say, capturing one more image does not change the F/T noise. MuJoCo's autoreset is disabled in the
+model, and every MuJoCo warning raised while stepping becomes :class:`~twin.errors.SimulationDiverged`
+naming it: a session never resets itself silently.
 
-Ground truth (component joint positions and states) is available here for evaluation and logging;
-the robot's pipeline must go through :attr:`TwinSession.robot` (:class:`~twin.robot_interface.RobotInterface`),
-which offers only what a real xArm driver and camera give.
+The session owns its sensor models (:attr:`ft`, :attr:`encoders`, :attr:`cameras`) and servo interface
+(:attr:`servos`); :attr:`robot` (:class:`~twin.robot_interface.RobotInterface`, the ``models.robot.Robot``
+protocol) only asks them, and offers only what a real xArm driver and camera give. Ground truth
+(component joint positions and states, :meth:`camera_truth`, :attr:`box_pose`) is here for evaluation
+and logging.
+
+The default profile is ``ideal``: no imperfection at all, the nominal world (and noiseless sensors).
 """
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
 
 import mujoco
 import numpy as np
 
 from models import PuzzleSpec, get_kind
+from models.calibration import CameraCalibration
+from models.placement import placed, sample_reachable_pose
 from models.scene import Scene, SceneConfig, build_scene
 from models.xarm7 import HOME_QPOS
+from twin.cell import apply_cell, draw_cell
 from twin.component_states import ComponentStates, HysteresisConfig
 from twin.errors import SimulationDiverged
+from twin.jams import Jams
 from twin.latches import Latches
+from twin.physics_draws import apply_physics, draw_physics
+from twin.reality import RealityProfile, load_profile
+from twin.rendering import RenderConfig, pinhole_intrinsics
+from twin.robot_interface import RobotInterface
+from twin.sensors.cameras import Cameras, TrueLens, render_fovy, true_lens
+from twin.sensors.encoders import JointEncoders
+from twin.sensors.force_torque import ForceTorqueSensor
+from twin.servos import Servos
 
 # Every physics warning is a divergence (mujoco 3.17 lists: bad ctrl/qacc/qpos/qvel, full constraint
 # or contact buffers, bad inertia). Warnings outside the enum (future visual ones) are ignored.
 _PHYSICS_WARNINGS = {int(w) for w in mujoco.mjtWarning.__members__.values()}
 _STATE_SPEC = mujoco.mjtState.mjSTATE_INTEGRATION
+# Per-trial random streams, children of SeedSequence(seed) in this order (cameras follow, one each).
+_STREAMS = ("placement", "physics", "ft", "encoders", "servos", "jams")
 
 
 @dataclass(frozen=True)
 class TwinConfig:
-    """Settings of a twin session."""
+    """Settings of a twin session (the cell's imperfections are the separate reality profile)."""
 
     scene: SceneConfig = field(default_factory=SceneConfig)
     hysteresis: HysteresisConfig = field(default_factory=HysteresisConfig)
     latch_period: int = 10
     """Physics steps between latch updates and divergence checks (10 x 2 ms: a latch falls into place
     within 20 ms, as a spring latch would; checking every step would cost ~a third of the stepping speed)."""
-    force_noise_std: float = 0.05
-    """Standard deviation of the wrist force noise [N] (a 6-axis F/T sensor of the xArm class)."""
-    torque_noise_std: float = 0.002
-    """Standard deviation of the wrist torque noise [N·m]."""
     home_qpos: tuple[float, ...] = HOME_QPOS
     """Arm joint positions at reset [rad]."""
+    render: RenderConfig = field(default_factory=RenderConfig)
+    """Size of the cameras' images (and how they are rendered)."""
 
 
 @dataclass(frozen=True)
@@ -55,21 +78,44 @@ class TwinState:
     physics: np.ndarray
     latch_targets: np.ndarray
     component_states: np.ndarray
-    rng_state: dict
-    wrench_offset: np.ndarray
+    sensors: dict[str, Any]
+    """States of the sensor models, the servo queue and the jams (their generators included)."""
 
 
 class TwinSession:
-    """The simulated world of one puzzle-box spec (see the module docstring)."""
+    """The simulated world of one puzzle-box spec (see the module docstring).
 
-    def __init__(self, spec: PuzzleSpec, seed: int = 0, config: TwinConfig | None = None) -> None:
-        self.spec = spec
+    Args:
+        spec: the puzzle box (with ``reality.placement`` set, it is placed at a pose drawn from ``seed``;
+            :attr:`spec` is then the placed spec).
+        seed: the trial's seed.
+        config: the session's settings.
+        reality: a reality profile, a preset name (``ideal``, ``realistic``, ``harsh``) or a profile
+            JSON path (:func:`twin.reality.load_profile`); None is ``ideal``.
+    """
+
+    def __init__(
+        self,
+        spec: PuzzleSpec,
+        seed: int = 0,
+        config: TwinConfig | None = None,
+        reality: RealityProfile | str | Path | None = None,
+    ) -> None:
         self.seed = seed
         self.config = config or TwinConfig()
+        self.reality = load_profile(reality)
         if self.config.latch_period < 1:
             raise ValueError(f"latch_period must be >= 1, got {self.config.latch_period}")
+        streams = np.random.SeedSequence(seed).spawn(len(_STREAMS) + 2)
+        self._streams = dict(zip(_STREAMS, streams, strict=False))
+        if self.reality.placement is not None:
+            rng = np.random.default_rng(self._streams["placement"])
+            spec = placed(spec, sample_reachable_pose(spec, rng, self.reality.placement, self.config.scene))
+        self.spec = spec
         self.scene: Scene = build_scene(spec, self.config.scene)
         self.model = self.scene.compile()
+        self.nominal_model = copy.deepcopy(self.model)
+        """The model as designed: the nominal kinematics and cameras (what calibration starts from)."""
         self.data = mujoco.MjData(self.model)
         names = self.scene.names
         m = self.model
@@ -82,25 +128,104 @@ class TwinSession:
         self.travel = np.array([get_kind(c.kind).travel for c in spec.components])
         self.states = ComponentStates(self.travel, self.config.hysteresis)
         self.latches = Latches(m, spec, [c.latch for c in component_names], self.component_qpos)
-        self._robot = None
+        camera_names = (names.overview_camera, names.wrist_camera)
+        self._camera_streams = dict(zip(camera_names, streams[len(_STREAMS) :], strict=True))
+
+        # the cell (cell_seed) and this trial's physics (seed), built into the model
+        flange = m.body(names.flange).id
+        gripper_body = int(np.flatnonzero(m.body_parentid == flange)[0])
+        handle_geoms = np.array([m.geom(c.handle).id for c in component_names], dtype=np.int64)
+        self.cell = draw_cell(self.reality, camera_names)
+        """The cell's fixed imperfections (evaluation only)."""
+        changed = apply_cell(m, self.cell, gripper_body)
+        self.physics_draw = draw_physics(
+            self.reality.physics, len(spec.components), np.random.default_rng(self._streams["physics"])
+        )
+        """This trial's physics factors (evaluation only)."""
+        changed |= apply_physics(
+            m,
+            self.reality.physics,
+            self.physics_draw,
+            handle_geoms,
+            np.array([m.joint(c.joint).dofadr[0] for c in component_names], dtype=np.int64),
+            np.array([m.body(c.body).id for c in component_names], dtype=np.int64),
+            self.latches.eq_ids,
+            self.gripper_actuator,
+        )
+        lenses = {name: self._true_lens(name) for name in camera_names}
+        if changed:
+            mujoco.mj_setConst(m, self.data)  # masses, inertias and poses changed: recompute what depends on them
+
+        # the sensor models and the servo interface (the robot interface asks them)
+        r = self.reality
+        self.ft = ForceTorqueSensor(
+            self.data, m.sensor(names.wrist_force).adr[0], m.sensor(names.wrist_torque).adr[0], r.force_torque,
+            self.timestep,
+        )  # fmt: skip
+        self.encoders = JointEncoders(
+            self.data,
+            self.arm_qpos,
+            m.site(names.tcp_site).id,
+            self.nominal_model,
+            r.arm.encoder_noise,
+            exact=not self.cell.tcp_bias.any(),
+        )
+        self.cameras = Cameras(m, self.data, camera_names, lenses, r.camera, self.config.render)
+        self.servos = Servos(self.data, self.arm_actuators, self.gripper_actuator, r.arm, self.timestep)
+        self.jams: Jams | None = None
+        if r.physics.jam_probability > 0:
+            gripper_bodies = np.flatnonzero(self._subtree_mask(gripper_body))
+            self.jams = Jams(
+                m, handle_geoms, gripper_bodies, self.travel, r.physics.jam_probability, r.physics.jam_release_after
+            )
+        self._plain = self.ft.sample_steps == 0 and self.servos.immediate
+        self._robot: RobotInterface | None = None
         self.reset()
+
+    def _subtree_mask(self, root: int) -> np.ndarray:
+        inside = np.zeros(self.model.nbody, dtype=bool)
+        inside[root] = True
+        for b in range(root + 1, self.model.nbody):  # MuJoCo numbers a parent before its children
+            inside[b] = inside[self.model.body_parentid[b]]
+        return inside
+
+    def _true_lens(self, camera: str) -> TrueLens:
+        """The camera's true lens; widens the model's render field of view when the true camera sees more."""
+        width, height = self.config.render.width, self.config.render.height
+        cam = self.model.camera(camera).id
+        K_nominal = pinhole_intrinsics(self.nominal_model, cam, width, height)
+        errors = self.cell.cameras[camera]
+        K_true = errors.true_K(K_nominal)
+        if np.array_equal(K_true, K_nominal) and not errors.dist.any():
+            return TrueLens(K_true, errors.dist, None, None)
+        self.model.cam_fovy[cam] = render_fovy(K_nominal, K_true, errors.dist, (width, height))
+        return true_lens(K_true, errors.dist, pinhole_intrinsics(self.model, cam, width, height), (width, height))
 
     # -- life cycle --------------------------------------------------------------------------------
     def reset(self) -> None:
-        """Back to the initial state: box closed, arm at home, gripper open, noise re-seeded."""
+        """Back to the initial state: box closed, arm at home, gripper open, noise re-seeded, no tare."""
         m, d = self.model, self.data
         mujoco.mj_resetData(m, d)
         d.qpos[self.arm_qpos] = self.config.home_qpos
         d.ctrl[self.arm_actuators] = self.config.home_qpos
         d.ctrl[self.gripper_actuator] = 0.0
-        self.rng = np.random.default_rng(self.seed)
-        self.wrench_offset = np.zeros(6)
         self.latches.engaged[:] = False
         d.eq_active[self.latches.eq_ids] = 0
         mujoco.mj_forward(m, d)
-        self.states.reset(d.qpos[self.component_qpos])
-        self.latches.apply(d, self.states.states)
+        rng = {name: np.random.default_rng(s) for name, s in self._streams.items()}
+        self.ft.reset(rng["ft"])
+        self.encoders.reset(rng["encoders"])
+        self.servos.reset(rng["servos"])
+        self.cameras.reset({name: np.random.default_rng(s) for name, s in self._camera_streams.items()})
+        q = d.qpos[self.component_qpos]
+        if self.jams is not None:
+            self.jams.reset(rng["jams"], q)
+        self.states.reset(q)
+        self.latches.apply(d, self.states.states, self._jammed())
         self._warnings = d.warning.number.copy()
+
+    def _jammed(self) -> np.ndarray | None:
+        return None if self.jams is None else self.jams.jammed
 
     @property
     def time(self) -> float:
@@ -111,6 +236,11 @@ class TwinSession:
     def timestep(self) -> float:
         return float(self.model.opt.timestep)
 
+    @property
+    def box_pose(self) -> tuple[float, float, float]:
+        """Where the box stands ``(x, y, yaw)`` [m, m, rad]. Ground truth: not for skills."""
+        return self.scene.box_pose
+
     def step(self, n: int = 1) -> None:
         """Advance ``n`` physics steps, updating latches every ``latch_period`` steps.
 
@@ -120,7 +250,7 @@ class TwinSession:
         period = self.config.latch_period
         while n > 0:
             k = min(n, period)
-            mujoco.mj_step(self.model, self.data, nstep=k)
+            self._run(k)
             n -= k
             self._after_steps()
 
@@ -128,10 +258,33 @@ class TwinSession:
         """Advance by ``seconds`` of simulated time (rounded to whole steps) [s]."""
         self.step(max(1, round(seconds / self.timestep)))
 
+    def _run(self, k: int) -> None:
+        """``k`` physics steps, stopping at each F/T sample and queued command on the way."""
+        if self._plain:
+            mujoco.mj_step(self.model, self.data, nstep=k)
+            return
+        every = self.ft.sample_steps
+        while k > 0:
+            j = k
+            if every:
+                j = min(j, every - round(self.data.time / self.timestep) % every)
+            due = self.servos.steps_to_next()
+            if due is not None:
+                j = min(j, due)
+            mujoco.mj_step(self.model, self.data, nstep=j)
+            k -= j
+            self.servos.apply_due()
+            if every and round(self.data.time / self.timestep) % every == 0:
+                self.ft.sample()
+
     def _after_steps(self) -> None:
         d = self.data
-        if self.states.update(d.qpos[self.component_qpos]):
-            self.latches.apply(d, self.states.states)  # rules change only when a state does
+        q = d.qpos[self.component_qpos]
+        changed = self.states.update(q)
+        if self.jams is not None:
+            changed |= self.jams.update(d, q, self.latches.held(self.states.states))
+        if changed:
+            self.latches.apply(d, self.states.states, self._jammed())  # rules change only when a state does
         counts = d.warning.number
         if np.any(counts > self._warnings):
             new = [i for i in np.flatnonzero(counts > self._warnings) if i in _PHYSICS_WARNINGS]
@@ -143,16 +296,21 @@ class TwinSession:
                 )
 
     # -- state -------------------------------------------------------------------------------------
+    def _sensor_models(self) -> dict[str, Any]:
+        models = {"ft": self.ft, "encoders": self.encoders, "servos": self.servos, "cameras": self.cameras}
+        if self.jams is not None:
+            models["jams"] = self.jams
+        return models
+
     def get_state(self) -> TwinState:
-        """A snapshot of the full state (physics, latches, hysteresis, noise generator, tare)."""
+        """A snapshot of the full state (physics, latches, hysteresis, sensor models and their generators)."""
         physics = np.empty(mujoco.mj_stateSize(self.model, _STATE_SPEC))
         mujoco.mj_getState(self.model, self.data, physics, _STATE_SPEC)
         return TwinState(
             physics=physics,
             latch_targets=self.latches.targets(),
             component_states=self.states.states.copy(),
-            rng_state=self.rng.bit_generator.state,
-            wrench_offset=self.wrench_offset.copy(),
+            sensors={name: copy.deepcopy(model.get_state()) for name, model in self._sensor_models().items()},
         )
 
     def set_state(self, state: TwinState) -> None:
@@ -160,8 +318,8 @@ class TwinSession:
         mujoco.mj_setState(self.model, self.data, state.physics, _STATE_SPEC)
         self.latches.restore(self.data, state.latch_targets)
         self.states.states = state.component_states.copy()
-        self.rng.bit_generator.state = state.rng_state
-        self.wrench_offset = state.wrench_offset.copy()
+        for name, model in self._sensor_models().items():
+            model.set_state(copy.deepcopy(state.sensors[name]))
         mujoco.mj_forward(self.model, self.data)
 
     # -- ground truth (evaluation only) ------------------------------------------------------------
@@ -173,18 +331,34 @@ class TwinSession:
         """State (0/1) of every component, in spec order. Ground truth: not for skills."""
         return self.states.states.copy()
 
+    def camera_truth(self, camera: str) -> CameraCalibration:
+        """The TRUE calibration of a camera: its intrinsics with the profile's errors, its true lens
+        distortion, its true mounting pose (a wrist camera's relative to the TCP the arm reports).
+        Evaluation only: for testing calibration procedures, never for skills."""
+        lens = self.cameras.lens(camera)
+        scratch = mujoco.MjData(self.model)
+        scratch.qpos[:] = self.data.qpos
+        mujoco.mj_kinematics(self.model, scratch)
+        mujoco.mj_camlight(self.model, scratch)  # camera poses are not part of mj_kinematics
+        T_world_camera = self.cameras.pose_in_world(camera, scratch)
+        size = (self.config.render.width, self.config.render.height)
+        extra = {"profile": self.reality.name, "cell_seed": self.reality.cell_seed}
+        if self.model.cam_bodyid[self.model.camera(camera).id] == 0:
+            return CameraCalibration(lens.K.copy(), lens.dist.copy(), size, T_base_camera=T_world_camera, extra=extra)
+        T_base_tcp = self.encoders.nominal_tcp_pose(self.data.qpos[self.arm_qpos])
+        T_tcp_camera = np.linalg.solve(T_base_tcp, T_world_camera)
+        return CameraCalibration(lens.K.copy(), lens.dist.copy(), size, T_tcp_camera=T_tcp_camera, extra=extra)
+
     # -- the robot ---------------------------------------------------------------------------------
     @property
-    def robot(self):  # -> RobotInterface (imported lazily: it pulls in the renderer)
+    def robot(self) -> RobotInterface:
+        """The robot as its pipeline sees it (the ``models.robot.Robot`` protocol)."""
         if self._robot is None:
-            from twin.robot_interface import RobotInterface
-
             self._robot = RobotInterface(self)
         return self._robot
 
     def close(self) -> None:
-        if self._robot is not None:
-            self._robot.close()
+        self.cameras.close()
 
     def __enter__(self) -> TwinSession:
         return self

@@ -1,5 +1,5 @@
 """cv2.aruco finds every component's marker in the overview image with the right id, where the
-component is (the robot interface's camera calibration turns pixels into base-frame positions)."""
+component is (the cell's nominal calibration, exact in the ideal twin, turns pixels into base-frame positions)."""
 
 from dataclasses import replace
 
@@ -9,6 +9,7 @@ import pytest
 
 from models.generator import paper_family
 from models.markers import aruco_dictionary
+from twin.nominal_calibration import nominal_calibration
 from twin.session import TwinSession
 
 
@@ -36,10 +37,11 @@ def test_overview_camera_reads_every_marker_with_its_id_where_the_component_is(i
         spec = replace(spec, box=replace(spec.box, pose=box_pose))
     with TwinSession(spec, seed=0) as session:
         image = session.robot.capture("overview")
+        calibration = nominal_calibration(session).camera("overview")
         found = detect(image.rgb)
         assert sorted(found) == sorted(c.marker for c in spec.components)
         for c in spec.components:
             centre = found[c.marker].mean(axis=0)
             truth = session.data.site(session.scene.names.components[c.name].frame_site).xpos
-            seen = pixel_to_table(image.K, image.T_base_camera, centre, truth[2])
+            seen = pixel_to_table(calibration.K, calibration.T_base_camera, centre, truth[2])
             assert np.linalg.norm(seen[:2] - truth[:2]) < 0.003, c.name

@@ -116,8 +116,8 @@ def test_wrist_sensor_reads_a_known_applied_wrench():
         np.testing.assert_allclose(measured, applied, atol=0.15)
 
 
-def scripted_run(seed: int) -> tuple[np.ndarray, np.ndarray]:
-    with TwinSession(paper_family("test")[1], seed=seed) as session:
+def scripted_run(seed: int, reality: str = "ideal") -> tuple[np.ndarray, np.ndarray]:
+    with TwinSession(paper_family("test")[1], seed=seed, reality=reality) as session:
         robot = session.robot
         rng = np.random.default_rng(123)
         home = robot.joint_positions()
@@ -131,15 +131,20 @@ def scripted_run(seed: int) -> tuple[np.ndarray, np.ndarray]:
         return np.array(trajectory), np.array(wrenches)
 
 
-def test_same_seed_and_commands_give_bit_identical_runs():
-    (q1, w1), (q2, w2) = scripted_run(7), scripted_run(7)
+@pytest.mark.parametrize("reality", ["ideal", "harsh"])
+def test_same_seed_and_commands_give_bit_identical_runs(reality):
+    (q1, w1), (q2, w2) = scripted_run(7, reality), scripted_run(7, reality)
     assert np.array_equal(q1, q2) and np.array_equal(w1, w2)
-    _, w3 = scripted_run(8)
-    assert not np.array_equal(w1, w3)  # the seed drives the sensor noise
+    q3, w3 = scripted_run(8, reality)
+    if reality == "ideal":
+        assert np.array_equal(q1, q3) and np.array_equal(w1, w3)  # nothing random in the ideal cell
+    else:
+        assert not np.array_equal(w1, w3)  # the seed drives the sensor noise (and the placement)
 
 
-def test_state_round_trip_reproduces_the_future_exactly():
-    with TwinSession(paper_family("test")[2], seed=3) as session:
+@pytest.mark.parametrize("reality", ["ideal", "harsh"])
+def test_state_round_trip_reproduces_the_future_exactly(reality):
+    with TwinSession(paper_family("test")[2], seed=3, reality=reality) as session:
         robot = session.robot
         robot.command_joint_positions(robot.joint_positions() + 0.1)
         session.advance(0.2)
