@@ -22,6 +22,7 @@ in the twin only.
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import math
 from dataclasses import dataclass, field
 
@@ -82,14 +83,14 @@ class CameraTruth:
     Attributes:
         K: 3x3 true intrinsics [px].
         dist: ``(5,)`` true distortion ``[k1, k2, p1, p2, k3]``.
-        T_base_camera: 4x4 pose in the base frame now [m] (OpenCV camera frame).
-        T_tcp_camera: 4x4 pose in the true TCP frame for a camera on the arm, else None [m].
+        T_base_camera: 4x4 pose of a fixed camera in the base frame [m] (OpenCV camera frame), else None.
+        T_tcp_camera: 4x4 pose of an arm camera in the TCP frame the arm reports [m], else None.
     """
 
     K: np.ndarray
     dist: np.ndarray
-    T_base_camera: np.ndarray
-    T_tcp_camera: np.ndarray | None = None
+    T_base_camera: np.ndarray | None
+    T_tcp_camera: np.ndarray | None
 
 
 @dataclass
@@ -118,8 +119,7 @@ class CalibrationCell:
     def __post_init__(self) -> None:
         base = self.twin_config or TwinConfig()
         twin_config = dataclasses.replace(base, scene=dataclasses.replace(base.scene, calibration_board=True))
-        twin_config = _with_reality(twin_config, self.reality, self.cell_seed)
-        self.session = TwinSession(self.spec, seed=self.seed, config=twin_config)
+        self.session = _session(self.spec, self.seed, twin_config, self.reality, self.cell_seed)
         self.model, self.data = self.session.model, self.session.data
         self._mocap = int(self.model.body(BOARD_BODY).mocapid[0])
         names = self.session.scene.names
@@ -150,13 +150,18 @@ class CalibrationCell:
         x, y, z, w = Rotation.from_matrix(T[:3, :3]).as_quat()
         self.data.mocap_pos[self._mocap] = T[:3, 3]
         self.data.mocap_quat[self._mocap] = (w, x, y, z)
-        mujoco.mj_kinematics(self.model, self.data)  # the renderer reads body and camera poses
+        self._update_poses()
 
     def hide_board(self) -> None:
         """Put the board away (inside the table, out of every camera's view)."""
         self.data.mocap_pos[self._mocap] = BOARD_HIDDEN_POS
         self.data.mocap_quat[self._mocap] = (1.0, 0.0, 0.0, 0.0)
+        self._update_poses()
+
+    def _update_poses(self) -> None:
+        # The renderer reads body and camera poses; mj_kinematics alone leaves the cameras where they were.
         mujoco.mj_kinematics(self.model, self.data)
+        mujoco.mj_camlight(self.model, self.data)
 
     def capture(self, camera: str) -> CameraImage:
         """A frame of a camera through the robot interface, retried when the camera drops a frame."""
@@ -181,7 +186,7 @@ class CalibrationCell:
         return np.array([[fy, 0.0, (width - 1) / 2], [0.0, fy, (height - 1) / 2], [0.0, 0.0, 1.0]])
 
     def _image_size(self) -> tuple[int, int]:
-        render = getattr(self.robot, "_render_config", None)
+        render = getattr(self.session.config, "render", None) or getattr(self.robot, "_render_config", None)
         return (render.width, render.height) if render is not None else (640, 480)
 
     def _T_base_tcp(self) -> np.ndarray:
@@ -285,37 +290,37 @@ class CalibrationCell:
 
     # -- truth (evaluation only) -------------------------------------------------------------------
     def camera_truth(self, camera: str) -> CameraTruth:
-        """A camera's true intrinsics, distortion and pose now (the session's, when it models camera
-        errors; else the nominal model's, which is then the truth). Never for the calibration itself."""
+        """A camera's true intrinsics, distortion and pose now. Intrinsics and lens: the session's
+        (``TwinSession.camera_truth``) when it models camera errors, else the nominal model's, which is
+        then the truth. Pose: the camera in the session's model (mounting errors included), an arm
+        camera's relative to the TCP pose the arm reports. Never for the calibration itself."""
         truth = getattr(self.session, "camera_truth", None)
-        T_base_tcp = self._T_base_tcp()
         if truth is not None:
             t = truth(camera)
-            K = np.asarray(t.K, float)
-            dist = np.asarray(getattr(t, "dist", np.zeros(5)), float).ravel()
-            T_base_camera = np.asarray(t.T_base_camera, float)
+            K, dist = np.asarray(t.K, float), np.asarray(t.dist, float)
         else:
-            K, dist, T_base_camera = self._model_intrinsics(camera), np.zeros(5), self._model_camera_pose(camera)
-        on_arm = camera == self.wrist_camera
-        return CameraTruth(
-            K=K,
-            dist=np.pad(dist, (0, max(0, 5 - dist.size)))[:5],
-            T_base_camera=T_base_camera,
-            T_tcp_camera=np.linalg.inv(T_base_tcp) @ T_base_camera if on_arm else None,
-        )
+            K, dist = self._model_intrinsics(camera), np.zeros(5)
+        T_base_camera = self._model_camera_pose(camera)
+        if camera == self.wrist_camera:
+            return CameraTruth(K, dist, None, np.linalg.inv(self.robot.tcp_pose_in_base()) @ T_base_camera)
+        return CameraTruth(K, dist, T_base_camera, None)
 
 
-def _with_reality(twin_config: TwinConfig, reality: object, cell_seed: int | None) -> TwinConfig:
-    """The session settings with a reality profile, if the twin applies them (``TwinConfig.reality``)."""
-    if reality is None:
-        return twin_config
-    from twin.reality import load_profile  # the reality profiles live beside the session
-
+def _session(
+    spec: PuzzleSpec, seed: int, twin_config: TwinConfig, reality: object, cell_seed: int | None
+) -> TwinSession:
+    """The twin session, with the reality profile when the twin applies them (``TwinSession(reality=)``)."""
+    if reality is None and cell_seed is None:
+        return TwinSession(spec, seed=seed, config=twin_config)
+    try:
+        from twin.reality import load_profile  # the reality profiles live beside the session
+    except ImportError:
+        load_profile = None
+    if load_profile is None or "reality" not in inspect.signature(TwinSession).parameters:
+        if reality in (None, "ideal") or getattr(reality, "name", None) == "ideal":
+            return TwinSession(spec, seed=seed, config=twin_config)
+        raise RigError(f"this twin does not apply reality profiles yet: {getattr(reality, 'name', reality)!r}")
     profile = load_profile(reality)
-    if cell_seed is not None and hasattr(profile, "cell_seed"):
+    if cell_seed is not None:
         profile = dataclasses.replace(profile, cell_seed=cell_seed)
-    if "reality" in {f.name for f in dataclasses.fields(twin_config)}:
-        return dataclasses.replace(twin_config, reality=profile)
-    if profile.name != "ideal":
-        raise RigError(f"this twin does not apply reality profiles yet (no TwinConfig.reality): {profile.name!r}")
-    return twin_config
+    return TwinSession(spec, seed=seed, config=twin_config, reality=profile)
