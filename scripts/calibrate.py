@@ -54,7 +54,7 @@ def load_inputs(args: argparse.Namespace):
     try:
         spec = load_spec(args.spec) if args.spec is not None else paper_family("test", seed=0)[0]
     except (ModelsError, OSError) as err:
-        fail(f"cannot use spec {args.spec}: {err}")
+        fail(f"cannot use spec {args.spec}: " + " ".join(line.strip() for line in str(err).splitlines()))
     reality = args.reality
     try:
         from twin.reality import load_profile
@@ -67,7 +67,7 @@ def load_inputs(args: argparse.Namespace):
     try:
         profile = load_profile(reality)
     except TwinError as err:
-        fail(f"--reality: {err}")
+        fail("--reality: " + " ".join(line.strip() for line in str(err).splitlines()))
     return spec, profile
 
 
