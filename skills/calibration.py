@@ -39,6 +39,7 @@ from skills.errors import BoardNotFound, TooFewViews
 
 __all__ = [
     "BoardView",
+    "board_pose_in_camera",
     "CalibrationConfig",
     "FixedPoseResult",
     "HandEyeResult",
@@ -216,8 +217,12 @@ def _board_views(images: Sequence, config: CalibrationConfig) -> list[tuple[int,
     return [(i, v) for i, v in views if v is not None]
 
 
-def _view_pose(view: BoardView, K: np.ndarray, dist: np.ndarray) -> np.ndarray:
-    """``T_camera_board`` of one view: IPPE (planar target) then LM on every corner."""
+def board_pose_in_camera(view: BoardView, K: np.ndarray, dist: np.ndarray) -> np.ndarray:
+    """``T_camera_board`` of one view [m]: IPPE (planar target) then Levenberg-Marquardt on every corner.
+
+    Raises:
+        BoardNotFound: solvePnP found no pose.
+    """
     obj = view.object_points.astype(np.float64)
     img = view.image_points.reshape(-1, 1, 2)
     ok, rvec, tvec = cv2.solvePnP(obj, img, K, dist, flags=cv2.SOLVEPNP_IPPE)
@@ -321,7 +326,7 @@ def fixed_camera_pose(
         image_size=views[0].image_size,
     )
     K, dist = np.asarray(K, float), np.asarray(dist, float)
-    T_camera_board = _view_pose(pooled, K, dist)
+    T_camera_board = board_pose_in_camera(pooled, K, dist)
     rvec, tvec = _rvec_tvec(T_camera_board)
     projected, _ = cv2.projectPoints(pooled.object_points, rvec, tvec, K, dist)
     return FixedPoseResult(
@@ -413,7 +418,7 @@ def hand_eye(
     views = _board_views(images, config)
     _require_views(len(views), len(images), config.min_views_hand_eye, "hand-eye calibration", config)
     G = [np.asarray(T_base_tcp[i], float) for i, _ in views]
-    C = [_view_pose(v, K, dist) for _, v in views]
+    C = [board_pose_in_camera(v, K, dist) for _, v in views]
     X0 = solve_hand_eye_closed_form(G, C)
     # The board's pose: the mean of what each view says, rotations averaged by their chordal mean.
     boards = [g @ X0 @ c for g, c in zip(G, C, strict=True)]

@@ -16,7 +16,7 @@ from models.generator import paper_family
 from models.scene import SceneConfig, build_scene
 from skills.calibration import (
     CalibrationConfig,
-    _view_pose,
+    board_pose_in_camera,
     calibrate_intrinsics,
     detect_board,
     fixed_camera_pose,
@@ -42,7 +42,7 @@ def test_a_rendered_board_is_found_exactly_where_it_was_placed(cell):
     cell.place_board(T_base_board)
     view = detect_board(cell.capture(cell.overview_camera).rgb)
     assert view is not None and len(view.ids) >= 20
-    T_camera_board = _view_pose(view, truth.K, truth.dist)
+    T_camera_board = board_pose_in_camera(view, truth.K, truth.dist)
     position, angle = pose_error(truth.T_base_camera @ T_camera_board, T_base_board)
     assert position < 0.001 and np.degrees(angle) < 0.1
 
