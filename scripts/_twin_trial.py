@@ -11,12 +11,16 @@ from typing import Any
 import cv2
 import numpy as np
 
-from learning import make_agent, run_episode
+from learning import RunResult, make_agent, run_episode
 from learning.memory import MemoryStore
 from models import PuzzleSpec
-from skills import MarkerDetector
+from models.calibration import CellCalibration
+from skills import MarkerDetector, SkillError
 from skills.twin_world import TwinWorld
 from twin import Renderer, VideoWriter
+from twin.errors import SimulationDiverged
+from twin.nominal_calibration import nominal_calibration
+from twin.reality import RealityProfile
 from twin.session import TwinSession
 
 VIDEO_PERIOD = 0.1
@@ -42,6 +46,32 @@ class RecordingRobot:
             self._writer.append(annotate(frame, self._detector))
 
 
+class TrueForceWatch:
+    """Evaluation only: the largest true external force on the wrist over a trial [N], sampled after
+    every robot wait (each 10 ms control tick) from the simulator's noiseless sensor, less the gripper's
+    weight — what the safety-limit target is checked against, whatever the robot sensed."""
+
+    GRIPPER_WEIGHT_N = 7.37  # DESIGN.md: the wrist sensor reads the gripper's weight at rest
+
+    def __init__(self, robot, session: TwinSession) -> None:
+        self._robot, self._session = robot, session
+        names = session.scene.names
+        self._force = session.model.sensor(names.wrist_force).adr[0]
+        self._site = session.model.site(names.ft_site).id
+        self.peak = 0.0
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._robot, name)
+
+    def wait(self, seconds: float) -> None:
+        self._robot.wait(seconds)
+        d = self._session.data
+        load_in_sensor = -d.sensordata[self._force : self._force + 3]
+        load_in_base = d.site_xmat[self._site].reshape(3, 3) @ load_in_sensor
+        external = load_in_base - (0.0, 0.0, -self.GRIPPER_WEIGHT_N)
+        self.peak = max(self.peak, float(np.linalg.norm(external)))
+
+
 def annotate(frame: np.ndarray, detector: MarkerDetector) -> np.ndarray:
     """The frame with every detected marker outlined and labelled with its id."""
     out = np.ascontiguousarray(frame.copy())
@@ -62,32 +92,45 @@ def run_twin_trial(
     max_actions: int,
     video: Path | None,
     checkpoint: str | None = None,
+    reality: RealityProfile | str | None = None,
+    calibration: CellCalibration | None = None,
 ) -> dict[str, Any]:
-    """One end-to-end trial; returns the contract's run entry plus a ``timeline`` and figures."""
+    """One end-to-end trial; returns the contract's run entry plus a ``timeline`` and figures.
+
+    ``reality`` is the twin's reality profile (default ``ideal``); ``calibration`` the cell's camera
+    calibration (default: the twin's nominal, datasheet calibration — exact only under ``ideal``)."""
     wall = time.perf_counter()
     by_marker = {c.marker: i for i, c in enumerate(spec.components)}
-    with TwinSession(spec, seed=seed) as session:
+    with TwinSession(spec, seed=seed, reality=reality) as session:
+        spec = session.spec  # placed by the profile, if it places boxes
         robot = session.robot
         renderer = writer = None
         if video is not None:
             renderer = Renderer(session.model)
             writer = VideoWriter(video, fps=1 / VIDEO_PERIOD)
             robot = RecordingRobot(robot, renderer, writer, session)
+        robot = watch = TrueForceWatch(robot, session)
+        world = None
+        pose_errors: dict[str, float] = {}
         try:
             world = TwinWorld(
                 robot,
+                calibration if calibration is not None else nominal_calibration(session),
                 {c.marker: c.kind for c in spec.components},
                 spec.components[spec.index_of(spec.goal.component)].marker,
+                goal_state=spec.goal.state,
                 seed=seed,
                 ground_truth=lambda m: int(session.component_states()[by_marker[m]]),
                 names={c.marker: c.name for c in spec.components},
             )
-            pose_errors = {}
             for c in spec.components:  # perceived closed pose against the simulator's (evaluation only)
                 truth = session.data.site(session.scene.names.components[c.name].frame_site).xpos
                 pose_errors[c.name] = float(np.linalg.norm(world.closed_poses[c.marker][:2] - truth[:2]))
             agent = make_agent(agent_name, spec, memory, checkpoint)
             result = run_episode(agent, world, spec.name, seed, max_actions)
+        except (SkillError, SimulationDiverged) as err:  # the cell could not run this trial: say why
+            result = RunResult(spec.name, seed, False, len(world.log) if world else 0, 0.0,
+                               ended=f"{type(err).__name__}: {err}")  # fmt: skip
         finally:
             if writer is not None:
                 writer.close()
@@ -98,9 +141,12 @@ def run_twin_trial(
     entry["wall_time_s"] = time.perf_counter() - wall
     entry["sim_time_s"] = sim_time
     entry["perceived_position_error_m"] = pose_errors
+    entry["box_pose"] = list(session.box_pose)
+    entry["reality"] = session.reality.name
+    entry["peak_true_wrist_force_n"] = watch.peak
     entry["timeline"] = [
         {**asdict(a), "component": spec.components[by_marker[a.marker]].name,
-         "pose_error_m": pose_errors[spec.components[by_marker[a.marker]].name]}
-        for a in world.log
+         "pose_error_m": pose_errors.get(spec.components[by_marker[a.marker]].name)}
+        for a in (world.log if world else [])
     ]  # fmt: skip
     return entry

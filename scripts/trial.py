@@ -1,13 +1,17 @@
 """Run seeded trials of an agent on puzzle specs and write ``DIR/results.json``.
 
     python scripts/trial.py --specs FILE... [--memory MEM.sqlite] --sim {symbolic,twin} --runs K --seed S \
-                            --max-actions M --out DIR [--agent NAME] [--video]
+                            --max-actions M --out DIR [--agent NAME] [--video] \
+                            [--reality ideal|realistic|harsh|FILE.json] [--calibration FILE.json]
 
 ``--sim twin`` runs each trial end to end in the MuJoCo twin (ArUco perception, the agent, mink
 primitives, F/T outcomes) and adds a per-action ``timeline`` to each run (sensed outcome beside the
 simulator's truth, F/T peak, perceived position error, simulated and wall time) and summary figures;
 ``--video`` writes the overview camera's rollout with marker detections drawn (``rollout.mp4`` for a
-single run).
+single run). ``--reality`` picks the twin's reality profile (sensor noise, calibration error,
+friction, jams, slips, the box placed anywhere reachable; default ``ideal``), ``--calibration`` the
+cell's camera calibration made by ``scripts/calibrate.py`` (default: the nominal, datasheet
+calibration, exact only under ``ideal``).
 
 Run ``r`` on every spec uses seed ``S + r`` for the world (component order, faults) and the agent.
 ``DIR/config.json`` records the resolved arguments and package versions, so the result can be re-run.
@@ -33,6 +37,11 @@ SIMS = ("symbolic", "twin")
 def twin_figures(runs: list) -> dict:
     """Outcome agreement with ground truth, perception error and speed over all twin runs."""
     actions = [a for r in runs for a in r["timeline"]]
+    reasons: dict[str, int] = {}
+    for a in actions:
+        if a["outcome"] == "failed":
+            key = a["reason"].split(":")[0] or "unknown"
+            reasons[key] = reasons.get(key, 0) + 1
     errors = [e for r in runs for e in r["perceived_position_error_m"].values()]
     sim, wall = sum(r["sim_time_s"] for r in runs), sum(r["wall_time_s"] for r in runs)
     return {
@@ -43,6 +52,11 @@ def twin_figures(runs: list) -> dict:
         "wall_time_per_trial_s_max": max((r["wall_time_s"] for r in runs), default=0.0),
         "wall_time_per_trial_s_mean": wall / max(len(runs), 1),
         "sim_over_wall": sim / wall if wall else 0.0,
+        "failed_tries_by_reason": reasons,
+        "unsolved_reasons": [
+            f"{r['spec']} seed {r['seed']}: {r.get('ended') or 'out of actions'}" for r in runs if not r["solved"]
+        ],  # fmt: skip
+        "peak_true_wrist_force_n": max((r["peak_true_wrist_force_n"] for r in runs), default=0.0),
     }
 
 
@@ -58,6 +72,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--agent", default="memory", help=f"one of {list(AGENT_NAMES)} (default: memory)")
     parser.add_argument("--checkpoint", default=None, help="checkpoint from train.py (deep agents)")
     parser.add_argument("--video", action="store_true", help="record rollout videos (twin only)")
+    parser.add_argument(
+        "--reality", default="ideal", help="twin reality profile: ideal, realistic, harsh or a JSON file"
+    )
+    parser.add_argument("--calibration", default=None, help="camera calibration from scripts/calibrate.py (twin)")
     args = parser.parse_args(argv)
     # The memory is read, never written, during trials: evaluation does not change what was learned.
 
@@ -69,6 +87,18 @@ def main(argv: list[str] | None = None) -> int:
         fail("--memory goes with --agent memory (and only with it): train one with scripts/train.py")
     if args.video and args.sim != "twin":
         fail("--video needs --sim twin")
+    if args.sim != "twin" and (args.reality != "ideal" or args.calibration):
+        fail("--reality and --calibration need --sim twin")
+    reality = calibration = None
+    if args.sim == "twin":
+        from models.calibration import CalibrationError, CellCalibration
+        from twin.reality import load_profile
+
+        try:
+            reality = load_profile(args.reality)
+            calibration = CellCalibration.load(args.calibration) if args.calibration else None
+        except (TwinError, CalibrationError) as err:
+            fail(str(err))
     try:
         specs = [load_spec(path) for path in args.specs]
     except SpecError as err:
@@ -90,7 +120,11 @@ def main(argv: list[str] | None = None) -> int:
 
                 name = "rollout.mp4" if len(jobs) == 1 else f"rollout-{spec.name}-s{seed}.mp4"
                 video = out / name if args.video else None
-                runs.append(run_twin_trial(spec, seed, args.agent, memory, args.max_actions, video, args.checkpoint))
+                runs.append(
+                    run_twin_trial(
+                        spec, seed, args.agent, memory, args.max_actions, video, args.checkpoint, reality, calibration
+                    )
+                )
             else:
                 agent = make_agent(args.agent, spec, memory, args.checkpoint)
                 runs.append(run_episode(agent, SymbolicWorld(spec, seed), spec.name, seed, args.max_actions))
@@ -109,8 +143,11 @@ def main(argv: list[str] | None = None) -> int:
             f"outcome agreement {results['outcome_agreement']:.1%} over {results['actions_total']} actions; "
             f"perceived position error max {1000 * results['perceived_position_error_max_m']:.1f} mm; "
             f"wall time per trial max {results['wall_time_per_trial_s_max']:.1f} s; "
-            f"simulated/wall x{results['sim_over_wall']:.1f}"
+            f"simulated/wall x{results['sim_over_wall']:.1f}; "
+            f"peak true wrist force {results['peak_true_wrist_force_n']:.0f} N"
         )
+        for line in results["unsolved_reasons"]:
+            print(f"unsolved: {line}")
     return 0
 
 

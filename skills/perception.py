@@ -1,8 +1,12 @@
 """ArUco perception: marker detections in camera images -> component poses in the robot base frame.
 
 Detection uses OpenCV's ArUco detector with sub-pixel corner refinement; each marker's pose comes from
-``solvePnP`` with ``SOLVEPNP_IPPE_SQUARE`` and the camera intrinsics, and goes to the base frame with
-the camera's calibrated extrinsics (DESIGN.md: 0.7-2 mm error at 0.3-0.6 m). A marker map — as a
+``solvePnP`` with ``SOLVEPNP_IPPE_SQUARE`` and the *calibrated* intrinsics and distortion
+(:class:`models.calibration.CameraCalibration`, never the camera's truth), and goes to the base frame
+with the calibrated extrinsics — for the wrist camera composed with the TCP pose the arm reported at
+capture (DESIGN.md: 0.7-2 mm error at 0.3-0.6 m). A pose is only trusted when the marker's corners
+reproject within ``max_reprojection_error_px`` and the camera sees the marker no more obliquely than
+``max_view_angle``: a grazing view gives a foreshortened, ill-conditioned pose. A marker map — as a
 real cell has — gives each id's kind. By construction of the puzzle box (``models.kinds``), a
 component's frame is its marker's frame in state 0, so a marker seen on a closed component gives the
 component pose directly.
@@ -19,8 +23,10 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from models.calibration import CameraCalibration
 from models.kinds import MARKER_SIZE
 from models.markers import aruco_dictionary
+from models.robot import CameraImage
 from skills.errors import MarkersNotFound, UnknownMarker
 
 
@@ -32,6 +38,11 @@ class PerceptionConfig:
     """Side of the markers' black square [m]."""
     min_marker_pixels: float = 12.0
     """Smaller detections (side in pixels) are ignored: too few pixels per bit to trust the id."""
+    max_reprojection_error_px: float = 1.5
+    """RMS corner reprojection error above which a marker's pose is not trusted [px] (sub-pixel corners
+    reproject within ~0.3 px; a marker half occluded, blurred or mis-decoded does not)."""
+    max_view_angle_deg: float = 55.0
+    """Largest angle between the marker's normal and the line of sight for a trusted pose [deg]."""
 
 
 @dataclass(frozen=True)
@@ -50,6 +61,10 @@ class MarkerDetection:
     camera: str
     corners_px: np.ndarray
     T_base_marker: np.ndarray
+    reprojection_error_px: float = 0.0
+    """RMS reprojection error of the four corners [px]."""
+    view_angle: float = 0.0
+    """Angle between the marker's normal and the line of sight [rad]."""
 
     @property
     def planar_pose(self) -> np.ndarray:
@@ -93,8 +108,28 @@ class MarkerDetector:
             return []
         return [(c.reshape(4, 2), int(i)) for c, i in zip(corners, ids.ravel(), strict=True)]
 
-    def detect(self, image) -> list[MarkerDetection]:  # image: twin.robot_interface.CameraImage-like
-        """All markers in ``image`` (an object with ``rgb``, ``K``, ``T_base_camera``, ``camera``)."""
+    def detect(
+        self, image: CameraImage | None, camera: CameraCalibration, T_base_tcp: np.ndarray | None = None
+    ) -> list[MarkerDetection]:
+        """The trusted markers in ``image`` (see the module docstring), posed with the calibration
+        ``camera``; an arm camera needs ``T_base_tcp``, the TCP pose the arm reported at capture [m].
+        A dropped frame (``None``) has no markers."""
+        return [d for d in self.detect_all(image, camera, T_base_tcp) if self.trusted(d)]
+
+    def trusted(self, detection: MarkerDetection) -> bool:
+        """Whether a detection's pose may be used (reprojection error and viewing angle in bounds)."""
+        return (
+            detection.reprojection_error_px <= self.config.max_reprojection_error_px
+            and detection.view_angle <= math.radians(self.config.max_view_angle_deg)
+        )
+
+    def detect_all(
+        self, image: CameraImage | None, camera: CameraCalibration, T_base_tcp: np.ndarray | None = None
+    ) -> list[MarkerDetection]:
+        """Every marker in ``image`` with its pose, reprojection error and viewing angle, trusted or not."""
+        if image is None:
+            return []
+        T_base_camera = camera.pose_in_base(T_base_tcp)
         gray = cv2.cvtColor(image.rgb, cv2.COLOR_RGB2GRAY)
         corners, ids, _ = self._detector.detectMarkers(gray)
         if ids is None:
@@ -104,13 +139,19 @@ class MarkerDetector:
             c = c.reshape(4, 2).astype(np.float64)
             if np.linalg.norm(c[0] - c[1]) < self.config.min_marker_pixels:
                 continue
-            ok, rvec, tvec = cv2.solvePnP(self._object_points, c, image.K, None, flags=cv2.SOLVEPNP_IPPE_SQUARE)
+            ok, rvec, tvec = cv2.solvePnP(self._object_points, c, camera.K, camera.dist, flags=cv2.SOLVEPNP_IPPE_SQUARE)
             if not ok:
                 continue
+            projected, _ = cv2.projectPoints(self._object_points, rvec, tvec, camera.K, camera.dist)
+            error = float(np.sqrt(np.mean(np.sum((projected.reshape(4, 2) - c) ** 2, axis=1))))
             T_camera_marker = np.eye(4)
             T_camera_marker[:3, :3] = cv2.Rodrigues(rvec)[0]
             T_camera_marker[:3, 3] = tvec.ravel()
-            detections.append(MarkerDetection(int(marker_id), image.camera, c, image.T_base_camera @ T_camera_marker))
+            sight = T_camera_marker[:3, 3] / np.linalg.norm(T_camera_marker[:3, 3])
+            angle = math.acos(min(1.0, abs(float(np.dot(sight, T_camera_marker[:3, 2])))))
+            detections.append(
+                MarkerDetection(int(marker_id), image.camera, c, T_base_camera @ T_camera_marker, error, angle)
+            )
         return detections
 
 

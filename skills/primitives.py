@@ -4,15 +4,21 @@ whether it was latched.
 A toggle approaches the handle from above, descends, closes the gripper, drives the grasp point
 along the perceived joint (arc for hinges, line for slides) towards the other state, then releases
 and retreats. Motion is differential IK on the robot-only model at a 10 ms control tick, targets
-sent to the position servos. While actuating, the wrist force — rotated into the base frame, tared
-with the fingers open — is projected on the handle's direction of motion: if the force opposing the
-motion exceeds ``blocked_force`` while the measured progress is below ``blocked_progress``, the
-component is latched: the arm backs off to where it started and lets go (DESIGN.md: this rule made no
-error in 36 randomized attempts and stopped every latched attempt within 0.13-1.2 s; without a stop
-the grasp is torn off at 100-300 N).
+sent to the position servos. The wrist wrench is read every tick and filtered (a running median over
+``force_filter_samples`` ticks, so no single noisy sample decides anything). While actuating, the
+filtered force — rotated into the base frame, tared with the fingers open — is projected on the
+handle's direction of motion: if the force opposing the motion exceeds ``blocked_force`` while the
+measured progress is below ``blocked_progress``, the component is latched: the arm backs off to where
+it started and lets go (DESIGN.md: this rule made no error in 36 randomized attempts and stopped every
+latched attempt within 0.13-1.2 s; without a stop the grasp is torn off at 100-300 N).
 
-Outcomes are ``moved``, ``blocked`` or ``failed`` (with a reason); IK failures and empty grasps are
-typed errors underneath and reported as ``failed``.
+Whatever the motion (approach, descent, actuation, retreat), a filtered force above ``force_limit``
+stops it at once: the gripper opens and the arm withdraws, and the try ends ``failed: force limit``
+— a real arm's collision detection does the same. A handle that leaves the fingers during the motion
+(the gripper closes past the handle's width) ends the try ``failed`` too: a slip is not a move.
+
+Outcomes are ``moved``, ``blocked`` or ``failed`` (with a reason); IK failures, empty grasps, slips and
+the force limit are typed errors underneath and reported as ``failed``.
 """
 
 from __future__ import annotations
@@ -24,7 +30,7 @@ from typing import Literal
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
-from skills.errors import GraspFailure, IKFailure
+from skills.errors import ForceLimitExceeded, GraspFailure, IKFailure, SlipDetected
 from skills.joint_model import JointModel
 from skills.kinematics import ArmKinematics, top_down
 
@@ -52,6 +58,11 @@ class PrimitiveConfig:
     rest_time: float = 1.5
     """Time to return to the rest posture after a toggle [s]: out of the overview camera's view, and
     every toggle starts from the same arm configuration."""
+    transit_height: float = 0.35
+    """TCP height of the waypoint of a move from afar (``Toggler.travel_to``) [m]: well above the 8 cm box
+    and its 3.5 cm handles."""
+    transit_xy: tuple[float, float] = (0.42, 0.0)
+    """Where that waypoint is, in the base frame [m]: over the middle of the reachable workspace."""
     settle_time: float = 0.6
     """Extra time allowed at the end of a move for the servos to catch up [s]."""
     lead: float = 0.02
@@ -64,10 +75,30 @@ class PrimitiveConfig:
     """Force opposing the motion that, with little progress, means a latch [N]."""
     blocked_progress: float = 0.10
     """Progress (fraction of the travel) below which a large opposing force means a latch."""
+    blocked_magnitude: float = 35.0
+    """Force magnitude (any direction) that, with little progress, also means a latch [N]: a latched wheel
+    or a part pulled along a slightly wrong direction loads the grasp sideways more than along the path."""
     moved_fraction: float = 0.75
     """Progress that counts as reaching the other state (the twin's hysteresis threshold)."""
     empty_grasp_closure: float = 0.95
     """Gripper closure at or above which nothing is between the fingers."""
+    force_filter_samples: int = 5
+    """Ticks in the running median of the wrench (5 x 10 ms: a 50 ms window, short beside the 0.13 s
+    it took the fastest latched attempt to build up force, long enough that no single sample decides)."""
+    force_limit: float = 60.0
+    """Safety limit on the filtered wrist force, whatever the motion [N]. A toggle needs 8-9 N, a latch is
+    felt at 20 N (``blocked_force``); UFACTORY publishes no newton threshold for its collision detection
+    (REALITY_NOTES.md §1), so this sits where a latched pull is already decided and far below the
+    100-300 N that tore grasps off, and below the F/T range (150 N)."""
+
+    def __post_init__(self) -> None:
+        if self.force_filter_samples < 1:
+            raise ValueError(f"force_filter_samples must be >= 1, got {self.force_filter_samples}")
+        if not 0.0 < self.blocked_force < self.blocked_magnitude < self.force_limit:
+            raise ValueError(
+                "need 0 < blocked_force < blocked_magnitude < force_limit [N], got "
+                f"{self.blocked_force}, {self.blocked_magnitude}, {self.force_limit}"
+            )
 
 
 @dataclass
@@ -83,6 +114,8 @@ class ToggleResult:
     sim_time: float = 0.0
     wall_time: float = 0.0
     forces: list[float] = field(default_factory=list)
+    peak_force: float = 0.0
+    """Largest filtered force magnitude over the whole try [N] (what the safety limit watches)."""
 
 
 class Toggler:
@@ -93,12 +126,50 @@ class Toggler:
         self.config = config or PrimitiveConfig()
         self.ik = kinematics or ArmKinematics()
         self.rest_posture = robot.joint_positions()  # where the robot was handed over: out of view
+        self._force_window: list[np.ndarray] = []
+        self.phase = "moving"
+        """What the arm is doing (for the reasons of failed tries)."""
+        self.peak_force = 0.0
+        """Largest filtered force magnitude since the last :meth:`reset_force_watch` [N]."""
+        self.guard = True
+        """Stop motions at ``force_limit`` (off only while withdrawing from a stop)."""
+
+    # -- force -------------------------------------------------------------------------------------
+    def reset_force_watch(self) -> None:
+        """Forget the force history (after a tare: older samples have another zero)."""
+        self._force_window = []
+        self.peak_force = 0.0
+
+    def filtered_force_in_base(self) -> np.ndarray:
+        """The running median of the wrist force over the last ticks, in the base frame [N]."""
+        if not self._force_window:
+            return np.zeros(3)
+        return np.median(np.stack(self._force_window), axis=0)
+
+    def _sense(self) -> np.ndarray:
+        """Read the wrench into the filter window and enforce the safety limit; the filtered force [N]."""
+        force = self.robot.ft_rotation_in_base() @ self.robot.wrench()[:3]
+        self._force_window.append(force)
+        if len(self._force_window) > self.config.force_filter_samples:
+            self._force_window.pop(0)
+        filtered = self.filtered_force_in_base()
+        magnitude = float(np.linalg.norm(filtered))
+        self.peak_force = max(self.peak_force, magnitude)
+        if self.guard and magnitude > self.config.force_limit:
+            raise ForceLimitExceeded(
+                f"force limit: {magnitude:.0f} N > {self.config.force_limit:.0f} N while {self.phase}, motion stopped"
+            )
+        return filtered
+
+    def _wait_tick(self) -> np.ndarray:
+        self.robot.wait(self.config.tick)
+        return self._sense()
 
     # -- motion ------------------------------------------------------------------------------------
     def _tick(self, target: np.ndarray) -> tuple[float, float]:
         q, position_error, orientation_error = self.ik.step_towards(target, self.config.ik_iterations_per_tick)
         self.robot.command_joint_positions(np.clip(q, *self.robot.joint_limits().T))
-        self.robot.wait(self.config.tick)
+        self._wait_tick()
         return position_error, orientation_error
 
     def move_to(self, target: np.ndarray, duration: float) -> None:
@@ -122,6 +193,25 @@ class Toggler:
         if position_error > 0.01:
             raise IKFailure(f"TCP target {np.round(target[:3, 3], 3).tolist()} not reached: out of reach")
 
+    def travel_to(self, target: np.ndarray, duration: float) -> None:
+        """Reach ``target`` (4x4) from afar through a waypoint ``transit_height`` above the middle of the
+        workspace: from the rest posture a straight TCP line to a box near the robot passes by the base
+        and folds the arm onto itself (the gripper hit links 1, 4 and 5 at ~200 N). (A joint-space move
+        to an IK solution avoided that but reached postures whose forearm then met the box.)"""
+        via = target.copy()
+        via[:3, 3] = (*self.config.transit_xy, max(target[2, 3], self.config.transit_height))
+        self.move_to(via, 0.5 * duration)
+        self.move_to(target, duration)
+
+    def _joint_move(self, q_goal: np.ndarray, duration: float) -> None:
+        start = self.robot.joint_positions()
+        ticks = max(1, round(duration / self.config.tick))
+        for k in range(1, ticks + 1):
+            s = k / ticks
+            s = s * s * (3 - 2 * s)
+            self.robot.command_joint_positions(np.clip((1 - s) * start + s * q_goal, *self.robot.joint_limits().T))
+            self._wait_tick()
+
     def _gripper(self, closure: float, duration: float) -> None:
         self.robot.command_gripper(closure)
         ticks = round(duration / self.config.tick)
@@ -141,11 +231,14 @@ class Toggler:
         """Try to move the component of joint model ``jm`` to its other state (see the module docstring)."""
         wall = time.perf_counter()
         start_time = self.robot.time
+        self.reset_force_watch()
         try:
             result = self._toggle(jm, 1.0 if opening else -1.0)
-        except (IKFailure, GraspFailure) as err:
+        except (IKFailure, GraspFailure, SlipDetected, ForceLimitExceeded) as err:
             result = ToggleResult("failed", reason=f"{type(err).__name__}: {err}")
-            self._let_go_and_retreat()
+            result.peak_force = self.peak_force
+            self.withdraw()
+        result.peak_force = max(result.peak_force, self.peak_force)
         result.sim_time = self.robot.time - start_time
         result.wall_time = time.perf_counter() - wall
         return result
@@ -158,16 +251,22 @@ class Toggler:
         above = at_grasp.copy()
         above[2, 3] += c.approach_height
         self.robot.command_gripper(c.pregrasp_closure)
-        self.move_to(above, c.approach_time)
+        self.phase = "approaching"
+        self.travel_to(above, c.approach_time)
         self.robot.tare()  # fingers open, arm still: the load of the gripper alone
+        self._force_window = []  # older samples were taken with another zero
+        self.phase = "descending"
         self.move_to(at_grasp, c.descend_time)
+        self.phase = "grasping"
         self._gripper(1.0, c.close_time)
         if self.robot.gripper_opening() >= c.empty_grasp_closure:
             raise GraspFailure(f"the gripper closed on nothing at {np.round(at_grasp[:3, 3], 3).tolist()}")
 
+        self.phase = "actuating"
         result = self._actuate(jm, sign, begin, at_grasp)
-        self._gripper(0.0, c.release_time)
+        self.phase = "retreating"
         self._let_go_and_retreat()
+        self.phase = "moving"
         return result
 
     def _actuate(self, jm: JointModel, sign: float, begin: float, at_grasp: np.ndarray) -> ToggleResult:
@@ -189,11 +288,12 @@ class Toggler:
             target = self._pose_along(jm, fraction, at_grasp, begin)
             self._tick(target)
             direction = sign * jm.motion_direction(fraction)
-            load = self.robot.ft_rotation_in_base() @ self.robot.wrench()[:3]
-            opposing = float(-np.dot(load, direction))
+            opposing = float(-np.dot(self.filtered_force_in_base(), direction))
             forces.append(opposing)
             progress = self._progress(jm, sign, begin)
-            if opposing > c.blocked_force and progress < c.blocked_progress:
+            self._check_grip(progress)
+            magnitude = float(np.linalg.norm(self.filtered_force_in_base()))
+            if (opposing > c.blocked_force or magnitude > c.blocked_magnitude) and progress < c.blocked_progress:
                 self.move_to(at_grasp, 0.5)  # back off to where the handle was grasped
                 return ToggleResult(
                     "blocked", "latched: force rose without progress", progress, max(forces), forces=forces
@@ -202,6 +302,7 @@ class Toggler:
             progress = self._progress(jm, sign, begin)
             self._tick(self._pose_along(jm, begin + sign * min(1.0, max(progress, 0.0) + lead), at_grasp, begin))
         progress = self._progress(jm, sign, begin)
+        self._check_grip(progress)
         peak = max(forces)
         if progress >= c.moved_fraction:
             return ToggleResult("moved", "", progress, peak, forces=forces)
@@ -211,6 +312,10 @@ class Toggler:
         return ToggleResult(
             "failed", f"only {progress:.0%} of the travel covered (slip?)", progress, peak, forces=forces
         )
+
+    def _check_grip(self, progress: float) -> None:
+        if self.robot.gripper_opening() >= self.config.empty_grasp_closure:
+            raise SlipDetected(f"the handle slipped out of the grasp after {progress:.0%} of the travel")
 
     def _pose_along(self, jm: JointModel, fraction: float, at_grasp: np.ndarray, begin: float) -> np.ndarray:
         T = at_grasp.copy()
@@ -232,25 +337,49 @@ class Toggler:
         angle = np.arctan2(np.dot(jm.axis, np.cross(a, b)), np.dot(a, b))
         return float(sign * angle / jm.travel)
 
-    def _let_go_and_retreat(self) -> None:
+    def withdraw(self) -> None:
+        """After a stop: open the gripper, move up and go to rest with the force guard off (the load
+        that tripped it is what the withdrawal relieves)."""
+        self._let_go_and_retreat(guarded=False)
+
+    def _let_go_and_retreat(self, guarded: bool = True) -> None:
+        """Open, move up and go to rest; a force stop on the way withdraws unguarded."""
+        try:
+            self.guard = guarded
+            self._retreat_moves()
+        except ForceLimitExceeded:
+            self.guard = False
+            self._retreat_moves()
+        finally:
+            self.guard = True
+
+    def _retreat_moves(self) -> None:
         c = self.config
         self.robot.command_gripper(0.0)
+        self._gripper(0.0, c.release_time)
         try:
             self.ik.set_joints(self.robot.joint_positions())
             up = self.robot.tcp_pose_in_base()
             up[2, 3] += c.approach_height
             self.move_to(up, c.retreat_time)
         except IKFailure:
-            pass  # already as high as the arm goes: nothing more to do
-        self.go_rest()
+            pass  # already as high as the arm goes
+        self._interpolate_to_rest()
 
     def go_rest(self) -> None:
-        """Back to the rest posture by joint interpolation (no IK: always feasible)."""
+        """Back to the rest posture by joint interpolation (no IK: always feasible); a force stop on the
+        way withdraws upwards first."""
+        try:
+            self._interpolate_to_rest()
+        except ForceLimitExceeded:
+            self.withdraw()
+
+    def _interpolate_to_rest(self) -> None:
         start, goal = self.robot.joint_positions(), np.asarray(self.rest_posture)
         ticks = max(1, round(self.config.rest_time / self.config.tick))
         for k in range(1, ticks + 1):
             s = k / ticks
             s = s * s * (3 - 2 * s)
             self.robot.command_joint_positions(np.clip((1 - s) * start + s * goal, *self.robot.joint_limits().T))
-            self.robot.wait(self.config.tick)
+            self._wait_tick()
         self.robot.wait(self.config.settle_time)

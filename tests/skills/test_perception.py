@@ -17,7 +17,13 @@ from skills import (
     select_markers,
     upright_pose,
 )
+from twin.nominal_calibration import nominal_calibration
 from twin.session import TwinSession
+
+
+def overview_calibration(session: TwinSession):
+    return nominal_calibration(session).camera("overview")
+
 
 POSITION_TOLERANCE = 0.005  # [m] (issue: perceived positions within 5 mm)
 YAW_TOLERANCE = np.radians(2.0)
@@ -42,7 +48,9 @@ def test_every_marker_gives_its_kind_and_pose_in_the_base_frame(session):
     spec = session.spec
     marker_map = {c.marker: c.kind for c in spec.components}  # the cell's marker map
     detections = select_markers(
-        MarkerDetector().detect(session.robot.capture("overview")), set(marker_map), ("overview",)
+        MarkerDetector().detect(session.robot.capture("overview"), overview_calibration(session)),
+        set(marker_map),
+        ("overview",),
     )
     for c in spec.components:
         detection = detections[c.marker]
@@ -56,7 +64,9 @@ def test_every_marker_gives_its_kind_and_pose_in_the_base_frame(session):
 def test_joint_models_put_the_grasp_point_on_the_handle_and_the_axis_on_the_joint(session):
     spec = session.spec
     detections = select_markers(
-        MarkerDetector().detect(session.robot.capture("overview")), {c.marker for c in spec.components}, ("o",)
+        MarkerDetector().detect(session.robot.capture("overview"), overview_calibration(session)),
+        {c.marker for c in spec.components},
+        ("o",),
     )
     model = session.model
     height = lid_height(detections)
@@ -81,7 +91,9 @@ def test_moving_along_the_joint_model_follows_the_real_grasp_point(fraction):
     spec = paper_family("test")[0]
     with TwinSession(spec, seed=0) as session:
         detections = select_markers(
-            MarkerDetector().detect(session.robot.capture("overview")), {c.marker for c in spec.components}, ("o",)
+            MarkerDetector().detect(session.robot.capture("overview"), overview_calibration(session)),
+            {c.marker for c in spec.components},
+            ("o",),
         )
         height = lid_height(detections)
         for c in spec.components:
@@ -100,7 +112,7 @@ def test_moving_along_the_joint_model_follows_the_real_grasp_point(fraction):
 def test_a_hidden_marker_is_reported_missing_never_invented():
     spec = paper_family("test")[1]
     with TwinSession(spec, seed=0) as session:
-        detections = MarkerDetector().detect(session.robot.capture("overview"))
+        detections = MarkerDetector().detect(session.robot.capture("overview"), overview_calibration(session))
         expected = {c.marker for c in spec.components} | {42}  # the map lists one more component
         with pytest.raises(MarkersNotFound, match=r"missing marker ids \[42\]"):
             select_markers(detections, expected, ("overview",))
@@ -113,6 +125,6 @@ def test_a_duplicated_marker_id_is_refused():
     spec = replace(spec, components=(spec.components[0], replace(spec.components[1], marker=spec.components[0].marker),
                                      *spec.components[2:]))  # fmt: skip
     with TwinSession(spec, seed=0) as session:
-        detections = MarkerDetector().detect(session.robot.capture("overview"))
+        detections = MarkerDetector().detect(session.robot.capture("overview"), overview_calibration(session))
         with pytest.raises(MarkersNotFound, match="more than once"):
             select_markers(detections, {c.marker for c in spec.components}, ("overview",))

@@ -9,13 +9,18 @@ from skills import MarkerDetector, joint_model, lid_height, select_markers, upri
 from skills.errors import IKFailure
 from skills.kinematics import ArmKinematics, top_down
 from skills.primitives import Toggler
+from twin.nominal_calibration import nominal_calibration
 from twin.session import TwinSession
 
 
 def perceived_joint_models(session: TwinSession) -> dict:
     spec = session.spec
     image = session.robot.capture("overview")
-    detections = select_markers(MarkerDetector().detect(image), {c.marker for c in spec.components}, ("overview",))
+    detections = select_markers(
+        MarkerDetector().detect(image, nominal_calibration(session).camera("overview")),
+        {c.marker for c in spec.components},
+        ("overview",),
+    )
     height = lid_height(detections)
     return {
         c.name: joint_model(c.kind, upright_pose(detections[c.marker].planar_pose, height)) for c in spec.components

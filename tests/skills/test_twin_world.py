@@ -11,6 +11,7 @@ from learning import DualAgent, OracleAgent, run_episode
 from models import World
 from models.generator import generate_chain
 from skills.twin_world import TwinWorld
+from twin.nominal_calibration import nominal_calibration
 from twin.session import TwinSession
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -21,6 +22,7 @@ def twin_world(session: TwinSession, seed: int = 0) -> TwinWorld:
     by_marker = {c.marker: i for i, c in enumerate(spec.components)}
     return TwinWorld(
         session.robot,
+        nominal_calibration(session),
         {c.marker: c.kind for c in spec.components},
         spec.components[spec.index_of(spec.goal.component)].marker,
         seed=seed,
@@ -86,7 +88,10 @@ def test_markers_the_overview_camera_misses_are_found_from_the_wrist_camera():
     spec = generate_chain(["door", "slide", "wheel"], seed=4)
     spec = replace(spec, box=replace(spec.box, pose=(0.25, 0.36, 0.0)))  # beyond the overview's view
     with TwinSession(spec, seed=0) as session:
-        assert MarkerDetector().detect(session.robot.capture("overview")) == []
+        assert (
+            MarkerDetector().detect(session.robot.capture("overview"), nominal_calibration(session).camera("overview"))
+            == []
+        )
         world = twin_world(session)
         truth = spec.poses_in_world()
         for i, c in enumerate(spec.components):
@@ -101,4 +106,6 @@ def test_a_marker_nobody_can_see_is_reported_missing():
 
     spec = generate_chain(["door", "slide"], seed=1)
     with TwinSession(spec, seed=0) as session, pytest.raises(MarkersNotFound, match=r"missing marker ids \[9\]"):
-        TwinWorld(session.robot, {**{c.marker: c.kind for c in spec.components}, 9: "wheel"}, 1)
+        TwinWorld(
+            session.robot, nominal_calibration(session), {**{c.marker: c.kind for c in spec.components}, 9: "wheel"}, 1
+        )

@@ -1,0 +1,185 @@
+"""Finding every marker of a box wherever it stands on the table, and measuring each pose well enough
+to grasp by.
+
+The overview camera sees the whole box only near the spot it hangs over; elsewhere it misses part of
+the lid or sees markers at a grazing angle, where a 36 mm marker's pose is ill-conditioned. So a
+survey (:meth:`SceneSurvey.locate`):
+
+1. reads the markers the overview camera poses within the perception bounds (reprojection error,
+   viewing angle: :class:`skills.perception.PerceptionConfig`);
+2. searches for the missing ones with the wrist camera from a few viewpoints around what was found
+   (or over the whole workspace when nothing was);
+3. measures close up every marker not posed by the overview: the wrist camera straight above the
+   marker, where its pose is best conditioned (REALITY_NOTES.md §4: ~1 mm at 0.3 m);
+4. reports what is still missing (:class:`skills.errors.MarkersNotFound`) — it never invents a pose.
+
+Arm-camera poses compose the calibrated hand-eye transform with the TCP pose the arm reports at
+capture; the arm holds still while capturing.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from models.calibration import CellCalibration
+from models.robot import Robot
+from skills.errors import ForceLimitExceeded, IKFailure, MarkersNotFound
+from skills.kinematics import top_down
+from skills.perception import MarkerDetection, MarkerDetector, select_markers
+from skills.primitives import Toggler
+
+OVERVIEW_CAMERA = "overview"
+WRIST_CAMERA = "xarm7/gripper/wrist_camera"
+
+
+@dataclass(frozen=True)
+class SurveyConfig:
+    """Where the wrist camera looks from, and how hard to try."""
+
+    close_up_height: float = 0.25
+    """Height of the wrist camera above a marker it measures close up [m] (the TCP is then ~12 cm above
+    the lid, clear of the 3.5 cm handles)."""
+    search_height: float = 0.40
+    """Height of the wrist camera above the markers while searching for missing ones [m]."""
+    search_offsets: tuple[tuple[float, float], ...] = ((0.0, 0.0), (0.12, 0.0), (-0.12, 0.0), (0.0, 0.12),
+                                                       (0.0, -0.12), (0.2, 0.2), (0.2, -0.2), (-0.2, 0.2),
+                                                       (-0.2, -0.2))  # fmt: skip
+    """Search viewpoints relative to the centre of the markers found so far [m]."""
+    workspace_viewpoints: tuple[tuple[float, float], ...] = ((0.45, 0.0), (0.35, 0.25), (0.35, -0.25), (0.55, 0.2),
+                                                             (0.55, -0.2), (0.3, 0.0))  # fmt: skip
+    """Search viewpoints in the base frame when nothing was found at all [m]."""
+    table_height: float = 0.08
+    """Assumed marker height when nothing was found yet [m] (the paper boxes' lid)."""
+    move_time: float = 1.2
+    """Time for each move between viewpoints [s]."""
+    transit_clearance: float = 0.30
+    """Lowest TCP height above the markers while travelling to a viewpoint [m]."""
+    capture_attempts: int = 3
+    """Frames tried before a camera counts as giving nothing (a camera drops frames now and then)."""
+    close_up_all: bool = False
+    """Measure every marker close up, even those the overview posed within bounds."""
+
+
+class SceneSurvey:
+    """See the module docstring."""
+
+    def __init__(
+        self,
+        robot: Robot,
+        calibration: CellCalibration,
+        toggler: Toggler,
+        detector: MarkerDetector | None = None,
+        config: SurveyConfig | None = None,
+    ) -> None:
+        self.robot, self.calibration, self.toggler = robot, calibration, toggler
+        self.detector = detector or MarkerDetector()
+        self.config = config or SurveyConfig()
+
+    # -- single looks ------------------------------------------------------------------------------
+    def look(self, camera: str) -> list[MarkerDetection]:
+        """Trusted detections from one camera, with a few tries if frames are dropped."""
+        calibration = self.calibration.camera(camera)
+        for _ in range(self.config.capture_attempts):
+            image = self.robot.capture(camera)
+            if image is None:
+                self.robot.wait(0.05)
+                continue
+            T_base_tcp = self.robot.tcp_pose_in_base() if calibration.on_arm else None
+            return self.detector.detect(image, calibration, T_base_tcp)
+        return []
+
+    def overview(self) -> list[MarkerDetection]:
+        return self.look(OVERVIEW_CAMERA)
+
+    def _wrist_from_above(self, point: np.ndarray, height: float) -> bool:
+        """Put the wrist camera ``height`` above ``point`` looking down, arriving from above (a straight
+        line from the rest posture could sweep the fingers through the handles); False if the arm
+        cannot, or if the force limit stopped it (it then withdraws)."""
+        T_tcp_camera = self.calibration.camera(WRIST_CAMERA).T_tcp_camera
+        for yaw in (0.0, np.pi / 2, -np.pi / 2, np.pi):
+            target = top_down(np.zeros(3), yaw)
+            target[:3, 3] = np.asarray(point, float) + (0.0, 0.0, height) - target[:3, :3] @ T_tcp_camera[:3, 3]
+            transit = target.copy()
+            transit[2, 3] = max(transit[2, 3], point[2] + self.config.transit_clearance)
+            try:
+                self.toggler.travel_to(transit, self.config.move_time)
+                if transit[2, 3] > target[2, 3]:
+                    self.toggler.move_to(target, 0.5 * self.config.move_time)
+                return True
+            except IKFailure:
+                continue
+            except ForceLimitExceeded:
+                self.toggler.withdraw()
+                return False
+        return False
+
+    def close_up(self, marker: int, planar_pose: np.ndarray, height: float | None = None) -> MarkerDetection | None:
+        """``marker`` measured from straight above its believed ``[x, y, yaw]``; None if not seen."""
+        z = height if height is not None else self.config.table_height
+        found = None
+        if self._wrist_from_above(np.array([planar_pose[0], planar_pose[1], z]), self.config.close_up_height):
+            seen = [d for d in self.look(WRIST_CAMERA) if d.marker_id == marker]
+            found = min(seen, key=lambda d: d.view_angle) if seen else None
+        self.toggler.go_rest()
+        return found
+
+    # -- the survey --------------------------------------------------------------------------------
+    def locate(self, expected: set[int]) -> dict[int, MarkerDetection]:
+        """One detection per expected marker id (see the module docstring), the arm back at rest."""
+        found = self._unique(self.overview(), expected)
+        if not self.config.close_up_all and set(found) == expected:
+            return found
+        moved_arm = False
+        try:
+            missing = expected - set(found)
+            if missing:
+                moved_arm = True
+                for d in self._search(found, missing):
+                    found.setdefault(d.marker_id, d)
+            height = float(np.median([d.T_base_marker[2, 3] for d in found.values()])) if found else None
+            for marker in sorted(found):
+                d = found[marker]
+                if d.camera == OVERVIEW_CAMERA and not self.config.close_up_all:
+                    continue
+                moved_arm = True
+                z = height if height is not None else self.config.table_height
+                if self._wrist_from_above(np.array([*d.T_base_marker[:2, 3], z]), self.config.close_up_height):
+                    seen = [s for s in self.look(WRIST_CAMERA) if s.marker_id == marker]
+                    if seen:
+                        found[marker] = min(seen, key=lambda s: s.view_angle)
+        finally:
+            if moved_arm:
+                self.toggler.go_rest()
+        missing = expected - set(found)
+        if missing:
+            raise MarkersNotFound(missing, (), (OVERVIEW_CAMERA, WRIST_CAMERA))
+        return found
+
+    def _search(self, found: dict[int, MarkerDetection], missing: set[int]) -> list[MarkerDetection]:
+        c = self.config
+        if found:
+            centre = np.mean([d.T_base_marker[:3, 3] for d in found.values()], axis=0)
+            points = [centre + (dx, dy, 0.0) for dx, dy in c.search_offsets]
+        else:
+            points = [np.array([x, y, c.table_height]) for x, y in c.workspace_viewpoints]
+        seen: dict[int, MarkerDetection] = {}
+        for point in points:
+            if not self._wrist_from_above(point, c.search_height):
+                continue
+            for d in self.look(WRIST_CAMERA):
+                if d.marker_id in missing and (d.marker_id not in seen or d.view_angle < seen[d.marker_id].view_angle):
+                    seen[d.marker_id] = d
+            if missing <= set(seen):
+                break
+        return list(seen.values())
+
+    @staticmethod
+    def _unique(detections: list[MarkerDetection], expected: set[int]) -> dict[int, MarkerDetection]:
+        """Expected ids seen exactly once (an id seen twice in one image is ambiguous: dropped)."""
+        try:
+            return select_markers(detections, expected, (OVERVIEW_CAMERA,))
+        except MarkersNotFound as err:
+            ambiguous = set(err.duplicated)
+            return {d.marker_id: d for d in detections if d.marker_id in expected and d.marker_id not in ambiguous}
