@@ -198,7 +198,9 @@ class TwinSession:
         K_true = errors.true_K(K_nominal)
         if np.array_equal(K_true, K_nominal) and not errors.dist.any():
             return TrueLens(K_true, errors.dist, None, None)
-        self.model.cam_fovy[cam] = render_fovy(K_nominal, K_true, errors.dist, (width, height))
+        fovy = render_fovy(K_nominal, K_true, errors.dist, (width, height))
+        if fovy is not None:
+            self.model.cam_fovy[cam] = fovy
         return true_lens(K_true, errors.dist, pinhole_intrinsics(self.model, cam, width, height), (width, height))
 
     # -- life cycle --------------------------------------------------------------------------------

@@ -53,15 +53,16 @@ def undistorted_rays(K: np.ndarray, dist: np.ndarray, size: tuple[int, int]) -> 
     return rays.reshape(height, width, 2)
 
 
-def render_fovy(K_nominal: np.ndarray, K_true: np.ndarray, dist: np.ndarray, size: tuple[int, int]) -> float:
+def render_fovy(K_nominal: np.ndarray, K_true: np.ndarray, dist: np.ndarray, size: tuple[int, int]) -> float | None:
     """Vertical field of view [deg] to render at so the true camera's every pixel lies inside the render
-    (the nominal one's when it already does; a centred pinhole, as MuJoCo renders a ``fovy`` camera)."""
+    (a centred pinhole, as MuJoCo renders a ``fovy`` camera); None when the nominal one already does."""
     width, height = size
     rays = undistorted_rays(K_true, dist, size)
     # a centred render of focal f keeps x·f + (W-1)/2 inside [0, W-1]: f <= (W-1)/2 / max|x|
     limit = min((width - 1) / 2 / np.abs(rays[..., 0]).max(), (height - 1) / 2 / np.abs(rays[..., 1]).max())
-    f = K_nominal[1, 1] if K_nominal[1, 1] <= limit else 0.995 * limit
-    return math.degrees(2 * math.atan(0.5 * height / f))
+    if K_nominal[1, 1] <= limit:
+        return None
+    return math.degrees(2 * math.atan(0.5 * height / (0.995 * limit)))  # a half-percent margin
 
 
 def true_lens(K_true: np.ndarray, dist: np.ndarray, K_render: np.ndarray, size: tuple[int, int]) -> TrueLens:

@@ -1,0 +1,463 @@
+"""Reality profiles: each imperfection changes what the robot senses, exactly as specified, and nothing
+when it is zero; the ideal profile is the nominal world; profiles load, round-trip and refuse bad keys;
+sessions stay pure functions of (spec, seed, profile, commands)."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import cv2
+import mujoco
+import numpy as np
+import pytest
+
+from models.generator import paper_family
+from models.markers import aruco_dictionary
+from models.robot import Robot
+from twin.errors import ProfileError
+from twin.nominal_calibration import nominal_calibration
+from twin.reality import (
+    PRESETS,
+    ArmReality,
+    CameraReality,
+    ForceTorqueReality,
+    PhysicsReality,
+    RealityProfile,
+    ScaleRange,
+    load_profile,
+)
+from twin.rendering import RenderConfig
+from twin.session import TwinConfig, TwinSession
+
+SPEC = paper_family("test")[0]  # door-0 is free, the other four are latched
+WRIST = "xarm7/gripper/wrist_camera"
+TINY = TwinConfig(render=RenderConfig(width=96, height=72))
+
+
+def profile(**sections) -> RealityProfile:
+    return dataclasses.replace(PRESETS["ideal"], name="test", **sections)
+
+
+def session(reality=None, seed=0, config=None) -> TwinSession:
+    return TwinSession(SPEC, seed=seed, config=config, reality=reality)
+
+
+# -- the profile as a file -----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", sorted(PRESETS))
+def test_presets_load_by_name_and_round_trip_through_json(name, tmp_path):
+    preset = load_profile(name)
+    assert preset.name == name
+    path = tmp_path / f"{name}.json"
+    path.write_text(json.dumps(preset.to_dict()))
+    assert load_profile(path) == preset
+    assert RealityProfile.from_dict(json.loads(json.dumps(preset.to_dict()))) == preset
+
+
+def test_realistic_and_harsh_place_the_box_and_ideal_does_not():
+    assert PRESETS["ideal"].placement is None
+    assert PRESETS["realistic"].placement is not None and PRESETS["harsh"].placement is not None
+
+
+@pytest.mark.parametrize(
+    ("data", "names"),
+    [
+        ({"camera": {"nois_sigma": 2.0}}, ["nois_sigma", "noise_sigma"]),
+        ({"physics": {"friction_scale": {"lo": 1.0}}}, ["lo", "low", "high"]),
+        ({"forcetorque": {}}, ["forcetorque", "force_torque"]),
+    ],
+)
+def test_an_unknown_key_at_any_level_names_it_and_the_known_keys(tmp_path, data, names):
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(ProfileError) as error:
+        load_profile(path)
+    for name in names:
+        assert name in str(error.value)
+
+
+@pytest.mark.parametrize(
+    ("data", "key"),
+    [
+        ({"force_torque": {"force_noise": -0.1}}, "force_noise"),
+        ({"camera": {"noise_sigma": -1}}, "noise_sigma"),
+        ({"camera": {"dropped_frame_probability": 1.5}}, "dropped_frame_probability"),
+        ({"physics": {"jam_probability": -0.2}}, "jam_probability"),
+        ({"arm": {"encoder_noise": "loud"}}, "encoder_noise"),
+    ],
+)
+def test_a_negative_noise_or_a_probability_outside_0_1_is_a_profile_error(tmp_path, data, key):
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(ProfileError, match=key):
+        load_profile(path)
+
+
+def test_an_unknown_preset_names_the_presets():
+    with pytest.raises(ProfileError, match="harsh"):
+        load_profile("realisitc")
+
+
+# -- the robot protocol and the ideal cell ------------------------------------------------------------
+
+
+def test_the_robot_interface_is_a_robot_and_frames_carry_no_calibration():
+    with session(config=TINY) as s:
+        assert isinstance(s.robot, Robot)
+        frame = s.robot.capture("overview")
+        assert frame.rgb.shape == (72, 96, 3) and frame.time == s.time
+        assert not hasattr(frame, "K") and not hasattr(frame, "T_base_camera")
+
+
+def test_ideal_is_the_nominal_world_noiseless_exact_and_calibrated():
+    with session() as s, session(reality="ideal") as t:
+        robot = s.robot
+        assert s.reality == t.reality == PRESETS["ideal"]
+        s.advance(0.3)
+        t.advance(0.3)
+        assert np.array_equal(s.data.qpos, t.data.qpos)
+        np.testing.assert_array_equal(robot.wrench(), s.ft.load())  # no noise, bias nor drift
+        np.testing.assert_array_equal(robot.joint_positions(), s.data.qpos[s.arm_qpos])
+        tcp = s.data.site(s.scene.names.tcp_site)
+        np.testing.assert_array_equal(robot.tcp_pose_in_base()[:3, 3], tcp.xpos)
+        nominal = nominal_calibration(s)
+        for camera in robot.camera_names:
+            truth, calibrated = s.camera_truth(camera), nominal.camera(camera)
+            np.testing.assert_array_equal(truth.K, calibrated.K)
+            np.testing.assert_array_equal(truth.dist, np.zeros(5))
+            np.testing.assert_allclose(truth.pose_in_base(np.eye(4)), calibrated.pose_in_base(np.eye(4)), atol=1e-9)
+        for field in ("geom_friction", "dof_damping", "body_mass", "eq_solref", "cam_pos", "cam_fovy", "body_pos"):
+            assert np.array_equal(getattr(s.model, field), getattr(s.nominal_model, field)), field
+
+
+# -- F/T sensor -------------------------------------------------------------------------------------
+
+
+def wrench_samples(s: TwinSession, n: int) -> np.ndarray:
+    return np.array([s.robot.wrench() for _ in range(n)])
+
+
+def test_force_torque_noise_has_the_profile_sigma_and_zero_noise_repeats_exactly():
+    with session(profile(force_torque=ForceTorqueReality(force_noise=0.4, torque_noise=0.02))) as s:
+        samples = wrench_samples(s, 3000)
+        np.testing.assert_allclose(samples[:, :3].std(axis=0), 0.4, rtol=0.08)
+        np.testing.assert_allclose(samples[:, 3:].std(axis=0), 0.02, rtol=0.08)
+        np.testing.assert_allclose(samples.mean(axis=0), s.ft.load(), atol=0.05)
+    with session() as s:
+        samples = wrench_samples(s, 50)
+        assert (samples == samples[0]).all()
+
+
+def test_bias_is_there_at_reset_and_a_tare_removes_it():
+    with session(profile(force_torque=ForceTorqueReality(force_bias=2.0, torque_bias=0.05))) as s:
+        offset = s.robot.wrench() - s.ft.load()
+        assert np.linalg.norm(offset[:3]) == pytest.approx(2.0)
+        assert np.linalg.norm(offset[3:]) == pytest.approx(0.05)
+        s.robot.tare()
+        np.testing.assert_allclose(s.robot.wrench(), 0.0, atol=1e-12)
+
+
+def test_drift_accumulates_after_a_tare_at_the_profile_rate():
+    drifting = profile(force_torque=ForceTorqueReality(force_drift=60.0))  # 1 N/s: large, to see it in 0.5 s
+    with session(drifting) as s, session() as ideal:
+        for t in (s, ideal):
+            t.robot.tare()
+            t.advance(0.5)
+        drift = s.robot.wrench() - ideal.robot.wrench()  # the same physics: only the drift differs
+        assert np.linalg.norm(drift[:3]) == pytest.approx(0.5, rel=1e-6)
+        assert not drift[3:].any()
+
+
+def test_saturation_clips_the_reading_at_the_sensor_range():
+    # the gripper's 7.4 N weight against a 2 N range: the axes it loads most saturate
+    with session(profile(force_torque=ForceTorqueReality(force_range=(2.0, 2.0, 2.0), torque_range=0.1))) as s:
+        load = s.ft.load()
+        assert np.abs(load[:3]).max() > 2.0
+        limits = np.array([2.0] * 3 + [0.1] * 3)
+        np.testing.assert_array_equal(s.robot.wrench(), np.clip(load, -limits, limits))
+
+
+def test_a_delayed_sensor_reports_the_load_of_delay_ago():
+    delayed = profile(force_torque=ForceTorqueReality(rate_hz=100.0, delay=0.05))
+    with session(delayed) as s, session() as ideal:
+        gripper = s.model.body("xarm7/gripper/xarm_gripper_base_link").id
+        readings = {}
+        for t in (s, ideal):
+            t.advance(0.3)
+            t.data.xfrc_applied[gripper, :3] = [0.0, 0.0, 30.0]  # a sudden push
+            t.advance(0.03)
+            readings[t] = t.robot.wrench()
+        # 30 ms after the push the delayed sensor still reads the load before it
+        assert np.linalg.norm(readings[ideal][:3] - ideal.ft.load()[:3]) < 1e-9
+        assert np.linalg.norm(readings[s][:3] - s.ft.load()[:3]) > 5.0
+        s.advance(0.05)
+        assert np.linalg.norm(s.robot.wrench()[:3] - s.ft.load()[:3]) < 5.0
+
+
+# -- arm ----------------------------------------------------------------------------------------------
+
+
+def test_encoder_noise_has_the_profile_sigma_and_one_reading_per_instant():
+    with session(profile(arm=ArmReality(encoder_noise=0.002))) as s:
+        truth = s.data.qpos[s.arm_qpos]
+        assert np.array_equal(s.robot.joint_positions(), s.robot.joint_positions())  # same instant
+        errors = []
+        for _ in range(300):
+            errors.append(s.robot.joint_positions() - s.data.qpos[s.arm_qpos])
+            s.step(1)
+        assert np.std(errors) == pytest.approx(0.002, rel=0.1)
+        assert not np.array_equal(truth, s.robot.joint_positions())
+
+
+def test_command_latency_delays_a_joint_command():
+    late = profile(arm=ArmReality(command_latency=0.05))
+    with session(late) as s, session() as ideal:
+        for t in (s, ideal):
+            target = t.robot.joint_positions() + 0.05
+            t.robot.command_joint_positions(target)
+            t.advance(0.04)
+        assert not np.array_equal(s.data.ctrl[s.arm_actuators], target)  # not yet
+        assert np.abs(s.data.qpos[s.arm_qpos] - s.config.home_qpos).max() < 1e-3
+        assert np.abs(ideal.data.qpos[ideal.arm_qpos] - ideal.config.home_qpos).max() > 5e-3
+        s.advance(0.012)
+        np.testing.assert_array_equal(s.data.ctrl[s.arm_actuators], target)
+
+
+def test_a_command_sent_during_a_stall_waits_for_its_end():
+    stalling = profile(arm=ArmReality(stall_rate=50.0, stall_duration=0.2))
+    with session(stalling) as s:
+        delays = []
+        for _ in range(10):
+            s.advance(0.03)
+            sent = s.time
+            target = np.array(s.config.home_qpos) + 0.01 * len(delays)
+            s.robot.command_joint_positions(target)
+            while not np.array_equal(s.data.ctrl[s.arm_actuators], target):
+                s.step(1)
+            delays.append(s.time - sent)
+        assert max(delays) > 0.05  # stalled (the stalls take ~90 % of the time here)
+        assert min(delays) <= 0.2 + 1e-9  # and never longer than a stall
+
+
+def test_tcp_bias_moves_the_physical_gripper_not_the_reported_tcp():
+    with session(profile(arm=ArmReality(tcp_bias=0.01))) as s, session() as ideal:
+        reported = s.robot.tcp_pose_in_base()
+        np.testing.assert_allclose(reported, ideal.robot.tcp_pose_in_base(), atol=1e-12)
+        true_tcp = s.data.site(s.scene.names.tcp_site).xpos
+        assert np.linalg.norm(true_tcp - reported[:3, 3]) == pytest.approx(0.01, rel=1e-9)
+        # the wrist camera rides on the gripper: its true pose in the reported TCP frame moves by the bias
+        moved = s.camera_truth(WRIST).T_tcp_camera[:3, 3] - nominal_calibration(s).camera(WRIST).T_tcp_camera[:3, 3]
+        assert np.linalg.norm(moved) == pytest.approx(0.01, rel=1e-6)
+
+
+# -- cameras -----------------------------------------------------------------------------------------
+
+
+def detect(rgb: np.ndarray) -> dict[int, np.ndarray]:
+    parameters = cv2.aruco.DetectorParameters()
+    parameters.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
+    detector = cv2.aruco.ArucoDetector(aruco_dictionary(), parameters)
+    corners, ids, _ = detector.detectMarkers(cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY))
+    return {} if ids is None else {int(i): c.reshape(4, 2) for i, c in zip(ids.ravel(), corners, strict=True)}
+
+
+@pytest.fixture(scope="module")
+def ideal_corners():
+    """Marker corners in the ideal overview image [px] and their points on the lid (base frame) [m]."""
+    with session() as s:
+        found = detect(s.robot.capture("overview").rgb)
+        calibration = nominal_calibration(s).camera("overview")
+        points = {}
+        for c in SPEC.components:
+            marker = s.data.geom(s.scene.names.components[c.name].marker)
+            top = marker.xpos[2] + s.model.geom_size[marker.id][2]
+            rays = np.linalg.solve(calibration.K, np.vstack([found[c.marker].T, np.ones(4)]))
+            R, origin = calibration.T_base_camera[:3, :3], calibration.T_base_camera[:3, 3]
+            rays = R @ rays
+            points[c.marker] = (origin[:, None] + rays * (top - origin[2]) / rays[2]).T
+        return found, points, calibration.K
+
+
+def project(truth, points: np.ndarray) -> np.ndarray:
+    T_camera_base = np.linalg.inv(truth.T_base_camera)
+    rvec, _ = cv2.Rodrigues(T_camera_base[:3, :3])
+    pixels, _ = cv2.projectPoints(points, rvec, T_camera_base[:3, 3], truth.K, truth.dist)
+    return pixels.reshape(-1, 2)
+
+
+def test_intrinsic_error_and_distortion_move_marker_corners_as_cv2_projectpoints_predicts(ideal_corners):
+    found0, points, _ = ideal_corners
+    lens = CameraReality(focal_error=0.03, principal_error=10.0, k1=0.1, p=0.003)
+    with session(profile(camera=lens)) as s:
+        truth = s.camera_truth("overview")
+        assert truth.dist[0] != 0 and truth.K[0, 0] != nominal_calibration(s).camera("overview").K[0, 0]
+        found = detect(s.robot.capture("overview").rgb)
+        moved, errors = [], []
+        for marker, corners in found0.items():
+            moved.append(np.linalg.norm(found[marker] - corners, axis=1).max())
+            errors.append(np.linalg.norm(found[marker] - project(truth, points[marker]), axis=1).max())
+        assert max(moved) > 5.0  # the lens errors move corners by pixels...
+        assert max(errors) < 0.5  # ...to where the true camera model puts them (detection: ~0.3 px)
+
+
+def test_mounting_error_moves_where_a_known_point_appears(ideal_corners):
+    found0, points, _ = ideal_corners
+    with session(profile(camera=CameraReality(mount_translation=0.01, mount_rotation=1.0))) as s:
+        truth = s.camera_truth("overview")
+        offset = truth.T_base_camera[:3, 3] - nominal_calibration(s).camera("overview").T_base_camera[:3, 3]
+        assert np.linalg.norm(offset) == pytest.approx(0.01)
+        found = detect(s.robot.capture("overview").rgb)
+        for marker, corners in found0.items():
+            assert np.linalg.norm(found[marker] - corners, axis=1).min() > 3.0
+            assert np.linalg.norm(found[marker] - project(truth, points[marker]), axis=1).max() < 0.5
+
+
+def test_dropped_frames_come_at_about_their_probability():
+    with session(profile(camera=CameraReality(dropped_frame_probability=0.3)), config=TINY) as s:
+        frames = [s.robot.capture("overview") for _ in range(300)]
+        assert sum(f is None for f in frames) / len(frames) == pytest.approx(0.3, abs=0.08)
+    with session(config=TINY) as s:
+        assert all(s.robot.capture("overview") is not None for _ in range(20))
+
+
+@pytest.mark.parametrize(
+    "effect",
+    [
+        CameraReality(noise_sigma=4.0),
+        CameraReality(gain=ScaleRange(1.2, 1.2)),
+        CameraReality(defocus_sigma=1.5),
+        CameraReality(occluder_probability=1.0),
+    ],
+    ids=["noise", "gain", "defocus", "occluders"],
+)
+def test_each_frame_effect_changes_the_image_as_specified(effect):
+    config = TwinConfig(render=RenderConfig(width=160, height=120))
+    with session(config=config) as ideal, session(profile(camera=effect), config=config) as s:
+        clean = ideal.robot.capture("overview").rgb.astype(float)
+        image = s.robot.capture("overview").rgb.astype(float)
+        assert np.array_equal(clean, ideal.robot.capture("overview").rgb)  # zero effects: the same image
+        difference = image - clean
+        if effect.noise_sigma:
+            inside = (clean > 20) & (clean < 235)  # away from clipping
+            assert difference[inside].std() == pytest.approx(4.0, rel=0.1)
+        elif not effect.gain.is_identity:
+            bright = (clean > 30) & (clean < 200)
+            np.testing.assert_allclose(image[bright] / clean[bright], 1.2, atol=0.02)
+        elif effect.defocus_sigma:
+            gradient = lambda im: np.abs(np.diff(im, axis=1)).mean()  # noqa: E731
+            assert gradient(image) < 0.8 * gradient(clean)
+        else:
+            assert (np.abs(difference).max(axis=2) > 30).sum() > 100
+
+
+def test_motion_blur_smears_only_a_moving_camera():
+    config = TwinConfig(render=RenderConfig(width=160, height=120))
+    with session(profile(camera=CameraReality(exposure=0.033)), config=config) as s, session(config=config) as ideal:
+        assert np.array_equal(s.robot.capture(WRIST).rgb, ideal.robot.capture(WRIST).rgb)  # at rest: sharp
+        for t in (s, ideal):
+            t.data.qvel[t.arm_dof[0]] = 3.0  # the base joint turning at 3 rad/s: a ~7 px smear in 33 ms
+            mujoco.mj_forward(t.model, t.data)
+        frames = [t.robot.capture(WRIST).rgb.astype(float) for t in (s, ideal)]
+        sharpness = [np.abs(np.diff(f, axis=0)).mean() + np.abs(np.diff(f, axis=1)).mean() for f in frames]
+        assert sharpness[0] < 0.9 * sharpness[1]
+
+
+# -- physics ------------------------------------------------------------------------------------------
+
+
+def test_physics_scales_change_the_compiled_model():
+    twice = ScaleRange(2.0, 2.0)
+    physics = PhysicsReality(
+        friction_scale=twice,
+        joint_damping_scale=twice,
+        joint_friction_scale=twice,
+        mass_scale=twice,
+        latch_compliance_scale=twice,
+        grip_force_scale=0.5,
+    )
+    with session(profile(physics=physics)) as s:
+        m, nominal = s.model, s.nominal_model
+        for c in SPEC.components:
+            names = s.scene.names.components[c.name]
+            handle, joint, body = m.geom(names.handle).id, m.joint(names.joint), m.body(names.body).id
+            assert m.geom_friction[handle, 0] == 2 * nominal.geom_friction[handle, 0]
+            assert m.dof_damping[joint.dofadr[0]] == 2 * nominal.dof_damping[joint.dofadr[0]]
+            assert m.dof_frictionloss[joint.dofadr[0]] == 2 * nominal.dof_frictionloss[joint.dofadr[0]]
+            assert m.body_mass[body] == 2 * nominal.body_mass[body]
+            latch = m.equality(names.latch).id
+            assert m.eq_solref[latch, 0] == 2 * nominal.eq_solref[latch, 0]
+        a = s.gripper_actuator
+        np.testing.assert_array_equal(m.actuator_forcerange[a], 0.5 * nominal.actuator_forcerange[a])
+    with session(profile(physics=PhysicsReality(pad_friction=0.4))) as s:
+        handle = s.model.geom(s.scene.names.components["door-0"].handle).id
+        assert s.model.geom_friction[handle, 0] == 0.4
+
+
+def push_door(s: TwinSession, seconds: float, newtons: float = 5.0) -> None:
+    body = s.model.body(s.scene.names.components["door-0"].body).id
+    handle = s.data.site(s.scene.names.components["door-0"].handle_site).xpos
+    force = np.array([0.0, 0.0, newtons])
+    s.data.xfrc_applied[body] = np.concatenate([force, np.cross(handle - s.data.xipos[body], force)])
+    s.advance(seconds)
+    s.data.xfrc_applied[:] = 0.0
+
+
+def test_a_jam_holds_a_free_component_for_the_try_and_then_lets_it_go():
+    jamming = profile(physics=PhysicsReality(jam_probability=1.0, jam_release_after=0.5))
+    with session(jamming) as s, session() as ideal:
+        door = SPEC.index_of("door-0")
+        for t in (s, ideal):
+            push_door(t, 0.1)
+        jammed_at = s.component_positions()[door]
+        assert s.jams.jammed[door] and s.latches.engaged[door]
+        for t in (s, ideal):
+            push_door(t, 0.3)
+        assert ideal.component_positions()[door] > 0.3  # free: it swings open
+        assert abs(s.component_positions()[door] - jammed_at) < np.radians(1)  # held where it jammed
+        s.advance(0.6)  # nothing touches its handle: the try ends, the jam is released
+        assert not s.jams.jammed[door] and not s.latches.engaged[door]
+    with session(profile(physics=PhysicsReality(jam_probability=0.0))) as s:
+        assert s.jams is None
+
+
+# -- randomness ---------------------------------------------------------------------------------------
+
+
+def test_cell_errors_come_from_the_cell_seed_and_trial_randomness_from_the_session_seed():
+    realistic = load_profile("realistic")
+    with session(realistic, seed=1) as a, session(realistic, seed=2) as b:
+        other_cell = session(dataclasses.replace(realistic, cell_seed=5), seed=1)
+        with other_cell as c:
+            for camera in a.robot.camera_names:
+                assert np.array_equal(a.camera_truth(camera).K, b.camera_truth(camera).K)
+                assert not np.array_equal(a.camera_truth(camera).K, c.camera_truth(camera).K)
+            assert np.array_equal(a.cell.tcp_bias, b.cell.tcp_bias)
+            assert a.box_pose == c.box_pose != b.box_pose  # placement is per trial
+            assert np.array_equal(a.physics_draw.friction, c.physics_draw.friction)
+            assert not np.array_equal(a.physics_draw.friction, b.physics_draw.friction)
+
+
+def test_placement_puts_the_box_at_a_reachable_pose_drawn_from_the_seed():
+    with session("realistic", seed=3) as s, session("realistic", seed=3) as again:
+        assert s.box_pose == again.box_pose == s.spec.box.pose
+        assert s.box_pose != session().box_pose
+        assert s.latches.engaged.tolist() == [False, True, True, True, True]
+
+
+def test_same_seed_and_profile_give_bit_identical_images_and_readings():
+    def run() -> tuple[list, list]:
+        with session("harsh", seed=4, config=TINY) as s:
+            frames, wrenches = [], []
+            for k in range(6):
+                s.robot.command_joint_positions(np.array(s.config.home_qpos) + 0.02 * k)
+                s.robot.wait(0.05)
+                frame = s.robot.capture("overview")
+                frames.append(None if frame is None else frame.rgb)
+                wrenches.append(s.robot.wrench())
+            return frames, wrenches
+
+    (f1, w1), (f2, w2) = run(), run()
+    assert all((a is None and b is None) or np.array_equal(a, b) for a, b in zip(f1, f2, strict=True))
+    assert np.array_equal(w1, w2)
