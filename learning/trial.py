@@ -11,7 +11,6 @@ import numpy as np
 from learning.agents.base import Agent
 from models import World
 
-
 MAX_FAILURES_IN_A_ROW = 3
 """A run ends when one component fails this many tries in a row (each already retried by the world):
 a component the robot cannot try is reported, not looped on."""

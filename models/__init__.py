@@ -18,6 +18,7 @@ from models.errors import (
 from models.kinds import ALLOWED_NEIGHBOURS, KIND_NAMES, PUZZLE_KINDS, KindTemplate, get_kind, kind_code
 from models.lock_table import LockTable
 from models.observation import ComponentObservation, SceneObservation
+from models.robot import CameraImage, Robot
 from models.spec import (
     SPEC_FORMAT,
     Box,
@@ -30,9 +31,8 @@ from models.spec import (
     spec_from_dict,
     spec_from_json,
 )
-from models.validation import validate_data
-from models.robot import CameraImage, Robot
 from models.try_outcome import BLOCKED, MOVED, OUTCOMES, Outcome, TryResult
+from models.validation import validate_data
 from models.world import World
 
 __all__ = [
