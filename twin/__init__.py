@@ -26,6 +26,7 @@ from twin.errors import (  # noqa: E402
     UnknownCamera,
     VideoError,
 )
+from twin.nominal_calibration import nominal_calibration  # noqa: E402  (eager: a lazy name would be shadowed by its module)
 from twin.rendering import RenderConfig, Renderer  # noqa: E402
 from twin.video import VideoWriter  # noqa: E402
 
@@ -33,7 +34,6 @@ _LAZY = {
     "PRESETS": "twin.reality",
     "RealityProfile": "twin.reality",
     "load_profile": "twin.reality",
-    "nominal_calibration": "twin.nominal_calibration",
     "RobotInterface": "twin.robot_interface",
     "TwinConfig": "twin.session",
     "TwinSession": "twin.session",

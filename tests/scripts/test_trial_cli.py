@@ -41,7 +41,9 @@ def test_symbolic_oracle_trial_writes_contract_results(tmp_path):
     run0 = results["runs"][0]
     assert set(run0) >= {"spec", "seed", "solved", "num_actions", "wall_time_s", "actions"}
     assert run0["spec"] == "paper-test-0" and run0["seed"] == 7 and results["runs"][1]["seed"] == 8
-    assert run0["actions"][0] == {"component": "door-0", "moved": True}
+    action = run0["actions"][0]  # the contract's keys, plus the sensed outcome and its reason
+    assert {k: action[k] for k in ("component", "moved")} == {"component": "door-0", "moved": True}
+    assert action["outcome"] == "moved" and action["reason"] == ""
     config = json.loads((out / "config.json").read_text())
     assert config["agent"] == "oracle" and "versions" in config
 
