@@ -26,7 +26,6 @@ from twin.errors import (  # noqa: E402
     UnknownCamera,
     VideoError,
 )
-from twin.nominal_calibration import nominal_calibration  # noqa: E402  (eager: a lazy name would be shadowed by its module)
 from twin.rendering import RenderConfig, Renderer  # noqa: E402
 from twin.video import VideoWriter  # noqa: E402
 
@@ -69,6 +68,5 @@ __all__ = [
     "VideoError",
     "VideoWriter",
     "load_profile",
-    "nominal_calibration",
     "sweep_open",
 ]
