@@ -55,7 +55,7 @@ def run_episode(agent: Agent, world: World, spec_name: str, seed: int, max_actio
     name_of = getattr(world, "ground_truth_name", None)
     actions: list[ActionRecord] = []
     ended = ""
-    failures_in_a_row: dict[int, int] = {}
+    failures_in_a_row = 0  # of the component tried last
     while not observation.solved and len(actions) < max_actions:
         index = agent.choose(observation)
         result = world.try_toggle(index)
@@ -63,8 +63,9 @@ def run_episode(agent: Agent, world: World, spec_name: str, seed: int, max_actio
         agent.record(index, result, observation)
         name = name_of(index) if name_of else str(index)
         actions.append(ActionRecord(name, result.moved, result.outcome, result.reason))
-        failures_in_a_row = {index: failures_in_a_row.get(index, 0) + 1} if result.outcome == "failed" else {}
-        if result.give_up or failures_in_a_row.get(index, 0) >= MAX_FAILURES_IN_A_ROW:
+        repeated = len(actions) > 1 and actions[-2].component == name and actions[-2].outcome == "failed"
+        failures_in_a_row = (failures_in_a_row + 1 if repeated else 1) if result.outcome == "failed" else 0
+        if result.give_up or failures_in_a_row >= MAX_FAILURES_IN_A_ROW:
             ended = f"could not try {name}: {result.reason}"
             break
     agent.end_episode(observation.solved)

@@ -31,14 +31,12 @@ from models.spec import (
     spec_from_dict,
     spec_from_json,
 )
-from models.try_outcome import BLOCKED, MOVED, OUTCOMES, Outcome, TryResult
+from models.try_outcome import OUTCOMES, Outcome, TryResult
 from models.validation import validate_data
 from models.world import World
 
 __all__ = [
     "ALLOWED_NEIGHBOURS",
-    "BLOCKED",
-    "MOVED",
     "OUTCOMES",
     "CameraImage",
     "Outcome",

@@ -52,7 +52,4 @@ class TryResult:
         return cls("moved") if moved else cls("blocked")
 
 
-MOVED = TryResult("moved")
-BLOCKED = TryResult("blocked")
-
-__all__ = ["BLOCKED", "MOVED", "OUTCOMES", "Outcome", "TryResult"]
+__all__ = ["OUTCOMES", "Outcome", "TryResult"]

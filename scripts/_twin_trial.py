@@ -48,16 +48,16 @@ class RecordingRobot:
 
 class TrueForceWatch:
     """Evaluation only: the largest true external force on the wrist over a trial [N], sampled after
-    every robot wait (each 10 ms control tick) from the simulator's noiseless sensor, less the gripper's
-    weight — what the safety-limit target is checked against, whatever the robot sensed."""
-
-    GRIPPER_WEIGHT_N = 7.37  # DESIGN.md: the wrist sensor reads the gripper's weight at rest
+    every robot wait (each 10 ms control tick) from the sensor model's noiseless load, less the weight of
+    what hangs below the sensor — what the safety-limit target is checked against, whatever the robot
+    sensed."""
 
     def __init__(self, robot, session: TwinSession) -> None:
         self._robot, self._session = robot, session
-        names = session.scene.names
-        self._force = session.model.sensor(names.wrist_force).adr[0]
-        self._site = session.model.site(names.ft_site).id
+        m = session.model
+        self._site = m.site(session.scene.names.ft_site).id
+        hanging = m.body_subtreemass[m.site_bodyid[self._site]]  # the flange and the gripper: 7.37 N of weight
+        self._weight_in_base = hanging * m.opt.gravity
         self.peak = 0.0
 
     def __getattr__(self, name: str) -> Any:
@@ -65,10 +65,8 @@ class TrueForceWatch:
 
     def wait(self, seconds: float) -> None:
         self._robot.wait(seconds)
-        d = self._session.data
-        load_in_sensor = -d.sensordata[self._force : self._force + 3]
-        load_in_base = d.site_xmat[self._site].reshape(3, 3) @ load_in_sensor
-        external = load_in_base - (0.0, 0.0, -self.GRIPPER_WEIGHT_N)
+        load_in_base = self._session.data.site_xmat[self._site].reshape(3, 3) @ self._session.ft.load()[:3]
+        external = load_in_base - self._weight_in_base
         self.peak = max(self.peak, float(np.linalg.norm(external)))
 
 

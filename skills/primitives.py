@@ -23,18 +23,17 @@ the force limit are typed errors underneath and reported as ``failed``.
 
 from __future__ import annotations
 
+import collections
 import time
 from dataclasses import dataclass, field
-from typing import Literal
 
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
+from models.try_outcome import Outcome
 from skills.errors import ForceLimitExceeded, GraspFailure, IKFailure, SlipDetected
 from skills.joint_model import JointModel
 from skills.kinematics import ArmKinematics, top_down
-
-Outcome = Literal["moved", "blocked", "failed"]
 
 
 @dataclass(frozen=True)
@@ -126,7 +125,9 @@ class Toggler:
         self.config = config or PrimitiveConfig()
         self.ik = kinematics or ArmKinematics()
         self.rest_posture = robot.joint_positions()  # where the robot was handed over: out of view
-        self._force_window: list[np.ndarray] = []
+        self._force_window: collections.deque[np.ndarray] = collections.deque(maxlen=self.config.force_filter_samples)
+        self.force_in_base = np.zeros(3)
+        """The filtered wrist force after the last tick, in the base frame [N]."""
         self.phase = "moving"
         """What the arm is doing (for the reasons of failed tries)."""
         self.peak_force = 0.0
@@ -137,33 +138,24 @@ class Toggler:
     # -- force -------------------------------------------------------------------------------------
     def reset_force_watch(self) -> None:
         """Forget the force history (after a tare: older samples have another zero)."""
-        self._force_window = []
+        self._force_window.clear()
         self.peak_force = 0.0
 
-    def filtered_force_in_base(self) -> np.ndarray:
-        """The running median of the wrist force over the last ticks, in the base frame [N]."""
-        if not self._force_window:
-            return np.zeros(3)
-        return np.median(np.stack(self._force_window), axis=0)
-
-    def _sense(self) -> np.ndarray:
-        """Read the wrench into the filter window and enforce the safety limit; the filtered force [N]."""
-        force = self.robot.ft_rotation_in_base() @ self.robot.wrench()[:3]
-        self._force_window.append(force)
-        if len(self._force_window) > self.config.force_filter_samples:
-            self._force_window.pop(0)
-        filtered = self.filtered_force_in_base()
-        magnitude = float(np.linalg.norm(filtered))
+    def _sense(self) -> None:
+        """Read the wrench into the filter window (a running median, :attr:`force_in_base`) and enforce
+        the safety limit."""
+        self._force_window.append(self.robot.ft_rotation_in_base() @ self.robot.wrench()[:3])
+        self.force_in_base = np.median(self._force_window, axis=0)
+        magnitude = float(np.linalg.norm(self.force_in_base))
         self.peak_force = max(self.peak_force, magnitude)
         if self.guard and magnitude > self.config.force_limit:
             raise ForceLimitExceeded(
                 f"force limit: {magnitude:.0f} N > {self.config.force_limit:.0f} N while {self.phase}, motion stopped"
             )
-        return filtered
 
-    def _wait_tick(self) -> np.ndarray:
+    def _wait_tick(self) -> None:
         self.robot.wait(self.config.tick)
-        return self._sense()
+        self._sense()
 
     # -- motion ------------------------------------------------------------------------------------
     def _tick(self, target: np.ndarray) -> tuple[float, float]:
@@ -204,6 +196,7 @@ class Toggler:
         self.move_to(target, duration)
 
     def _joint_move(self, q_goal: np.ndarray, duration: float) -> None:
+        """Interpolate the joints to ``q_goal`` [rad] over ``duration`` [s] (no IK: always feasible)."""
         start = self.robot.joint_positions()
         ticks = max(1, round(duration / self.config.tick))
         for k in range(1, ticks + 1):
@@ -236,9 +229,8 @@ class Toggler:
             result = self._toggle(jm, 1.0 if opening else -1.0)
         except (IKFailure, GraspFailure, SlipDetected, ForceLimitExceeded) as err:
             result = ToggleResult("failed", reason=f"{type(err).__name__}: {err}")
-            result.peak_force = self.peak_force
             self.withdraw()
-        result.peak_force = max(result.peak_force, self.peak_force)
+        result.peak_force = self.peak_force  # over the whole try, withdrawal included
         result.sim_time = self.robot.time - start_time
         result.wall_time = time.perf_counter() - wall
         return result
@@ -254,7 +246,7 @@ class Toggler:
         self.phase = "approaching"
         self.travel_to(above, c.approach_time)
         self.robot.tare()  # fingers open, arm still: the load of the gripper alone
-        self._force_window = []  # older samples were taken with another zero
+        self._force_window.clear()  # older samples were taken with another zero
         self.phase = "descending"
         self.move_to(at_grasp, c.descend_time)
         self.phase = "grasping"
@@ -288,11 +280,11 @@ class Toggler:
             target = self._pose_along(jm, fraction, at_grasp, begin)
             self._tick(target)
             direction = sign * jm.motion_direction(fraction)
-            opposing = float(-np.dot(self.filtered_force_in_base(), direction))
+            opposing = float(-np.dot(self.force_in_base, direction))
             forces.append(opposing)
             progress = self._progress(jm, sign, begin)
             self._check_grip(progress)
-            magnitude = float(np.linalg.norm(self.filtered_force_in_base()))
+            magnitude = float(np.linalg.norm(self.force_in_base))
             if (opposing > c.blocked_force or magnitude > c.blocked_magnitude) and progress < c.blocked_progress:
                 self.move_to(at_grasp, 0.5)  # back off to where the handle was grasped
                 return ToggleResult(
@@ -375,11 +367,5 @@ class Toggler:
             self.withdraw()
 
     def _interpolate_to_rest(self) -> None:
-        start, goal = self.robot.joint_positions(), np.asarray(self.rest_posture)
-        ticks = max(1, round(self.config.rest_time / self.config.tick))
-        for k in range(1, ticks + 1):
-            s = k / ticks
-            s = s * s * (3 - 2 * s)
-            self.robot.command_joint_positions(np.clip((1 - s) * start + s * goal, *self.robot.joint_limits().T))
-            self._wait_tick()
+        self._joint_move(np.asarray(self.rest_posture), self.config.rest_time)
         self.robot.wait(self.config.settle_time)

@@ -27,7 +27,7 @@ from models.calibration import CellCalibration
 from models.robot import Robot
 from skills.errors import ForceLimitExceeded, IKFailure, MarkersNotFound
 from skills.kinematics import top_down
-from skills.perception import MarkerDetection, MarkerDetector, select_markers
+from skills.perception import MarkerDetection, MarkerDetector, lid_height, select_markers
 from skills.primitives import Toggler
 
 OVERVIEW_CAMERA = "overview"
@@ -54,8 +54,6 @@ class SurveyConfig:
     """Assumed marker height when nothing was found yet [m] (the paper boxes' lid)."""
     move_time: float = 1.2
     """Time for each move between viewpoints [s]."""
-    transit_clearance: float = 0.30
-    """Lowest TCP height above the markers while travelling to a viewpoint [m]."""
     capture_attempts: int = 3
     """Frames tried before a camera counts as giving nothing (a camera drops frames now and then)."""
     close_up_all: bool = False
@@ -94,19 +92,15 @@ class SceneSurvey:
         return self.look(OVERVIEW_CAMERA)
 
     def _wrist_from_above(self, point: np.ndarray, height: float) -> bool:
-        """Put the wrist camera ``height`` above ``point`` looking down, arriving from above (a straight
-        line from the rest posture could sweep the fingers through the handles); False if the arm
-        cannot, or if the force limit stopped it (it then withdraws)."""
+        """Put the wrist camera ``height`` above ``point`` looking down, arriving through the toggler's
+        transit waypoint high above the workspace; False if the arm cannot, or if the force limit
+        stopped it (it then withdraws)."""
         T_tcp_camera = self.calibration.camera(WRIST_CAMERA).T_tcp_camera
         for yaw in (0.0, np.pi / 2, -np.pi / 2, np.pi):
             target = top_down(np.zeros(3), yaw)
             target[:3, 3] = np.asarray(point, float) + (0.0, 0.0, height) - target[:3, :3] @ T_tcp_camera[:3, 3]
-            transit = target.copy()
-            transit[2, 3] = max(transit[2, 3], point[2] + self.config.transit_clearance)
             try:
-                self.toggler.travel_to(transit, self.config.move_time)
-                if transit[2, 3] > target[2, 3]:
-                    self.toggler.move_to(target, 0.5 * self.config.move_time)
+                self.toggler.travel_to(target, self.config.move_time)
                 return True
             except IKFailure:
                 continue
@@ -116,14 +110,18 @@ class SceneSurvey:
         return False
 
     def close_up(self, marker: int, planar_pose: np.ndarray, height: float | None = None) -> MarkerDetection | None:
-        """``marker`` measured from straight above its believed ``[x, y, yaw]``; None if not seen."""
-        z = height if height is not None else self.config.table_height
-        found = None
-        if self._wrist_from_above(np.array([planar_pose[0], planar_pose[1], z]), self.config.close_up_height):
-            seen = [d for d in self.look(WRIST_CAMERA) if d.marker_id == marker]
-            found = min(seen, key=lambda d: d.view_angle) if seen else None
+        """``marker`` measured from straight above its believed ``[x, y, yaw]`` at marker ``height`` [m],
+        the arm back at rest after; None if not seen."""
+        found = self._measure_from_above(marker, planar_pose, height)
         self.toggler.go_rest()
         return found
+
+    def _measure_from_above(self, marker: int, xy: np.ndarray, height: float | None) -> MarkerDetection | None:
+        z = height if height is not None else self.config.table_height
+        if not self._wrist_from_above(np.array([xy[0], xy[1], z]), self.config.close_up_height):
+            return None
+        seen = [d for d in self.look(WRIST_CAMERA) if d.marker_id == marker]
+        return min(seen, key=lambda d: d.view_angle) if seen else None
 
     # -- the survey --------------------------------------------------------------------------------
     def locate(self, expected: set[int]) -> dict[int, MarkerDetection]:
@@ -138,17 +136,14 @@ class SceneSurvey:
                 moved_arm = True
                 for d in self._search(found, missing):
                     found.setdefault(d.marker_id, d)
-            height = float(np.median([d.T_base_marker[2, 3] for d in found.values()])) if found else None
-            for marker in sorted(found):
-                d = found[marker]
+            height = lid_height(found) if found else None
+            for marker, d in sorted(found.items()):
                 if d.camera == OVERVIEW_CAMERA and not self.config.close_up_all:
                     continue
                 moved_arm = True
-                z = height if height is not None else self.config.table_height
-                if self._wrist_from_above(np.array([*d.T_base_marker[:2, 3], z]), self.config.close_up_height):
-                    seen = [s for s in self.look(WRIST_CAMERA) if s.marker_id == marker]
-                    if seen:
-                        found[marker] = min(seen, key=lambda s: s.view_angle)
+                closer = self._measure_from_above(marker, d.T_base_marker[:2, 3], height)
+                if closer is not None:
+                    found[marker] = closer
         finally:
             if moved_arm:
                 self.toggler.go_rest()

@@ -33,7 +33,7 @@ from models import ComponentObservation, SceneObservation, TryResult
 from models.calibration import CellCalibration
 from models.robot import Robot
 from skills.joint_model import JointModel, joint_model
-from skills.perception import MarkerDetector, kind_of, upright_pose
+from skills.perception import MarkerDetector, kind_of, lid_height, upright_pose
 from skills.primitives import Toggler, ToggleResult
 from skills.scene_survey import OVERVIEW_CAMERA, SceneSurvey, SurveyConfig
 
@@ -98,7 +98,7 @@ class TwinWorld:
         self.toggler = Toggler(self.robot)
         self.survey = SceneSurvey(self.robot, self.calibration, self.toggler, self.detector, self.config.survey)
         found = self.survey.locate(set(self.marker_map))
-        self.lid_height = float(np.median([d.T_base_marker[2, 3] for d in found.values()]))
+        self.lid_height = lid_height(found)
         order = np.random.default_rng(self.seed).permutation(sorted(self.marker_map))
         self.markers = [int(m) for m in order]
         self.closed_poses = {m: found[m].planar_pose for m in self.markers}

@@ -4,29 +4,15 @@ overview camera are found and solved, and the goal state of the spec is honoured
 from dataclasses import replace
 
 import numpy as np
+from world_fixtures import twin_world
 
 from learning import OracleAgent, run_episode
 from models import Goal, Robot
 from models.generator import generate_chain, paper_family
 from skills import MarkerDetector, joint_model, lid_height, select_markers, upright_pose
 from skills.primitives import PrimitiveConfig, Toggler
-from skills.twin_world import TwinWorld
 from twin.nominal_calibration import nominal_calibration
 from twin.session import TwinSession
-
-
-def _world(session: TwinSession, seed: int = 0) -> TwinWorld:
-    spec = session.spec
-    by_marker = {c.marker: i for i, c in enumerate(spec.components)}
-    return TwinWorld(
-        session.robot,
-        nominal_calibration(session),
-        {c.marker: c.kind for c in spec.components},
-        spec.components[spec.index_of(spec.goal.component)].marker,
-        goal_state=spec.goal.state,
-        seed=seed,
-        ground_truth=lambda m: int(session.component_states()[by_marker[m]]),
-    )
 
 
 def _joint_models(session: TwinSession, kinds: dict[int, str] | None = None) -> dict:
@@ -74,7 +60,7 @@ def test_a_box_far_from_the_overview_camera_is_found_and_solved_end_to_end():
     spec = paper_family("test")[1]
     spec = replace(spec, box=replace(spec.box, pose=(0.3083, 0.1521, 0.2397)))  # corner of the workspace
     with TwinSession(spec, seed=1) as session:
-        world = _world(session, seed=1)
+        world = twin_world(session, seed=1)
         truth = spec.poses_in_world()
         for marker, seen in zip(world.markers, world.observe().components, strict=True):
             index = next(i for i, c in enumerate(spec.components) if c.marker == marker)
@@ -89,5 +75,5 @@ def test_the_twin_world_honours_the_specs_goal_state():
     spec = generate_chain(["slide", "door"], seed=1)
     spec = replace(spec, goal=Goal(spec.goal.component, 0))  # every part starts closed: solved at once
     with TwinSession(spec, seed=0) as session:
-        observation = _world(session).observe()
+        observation = twin_world(session).observe()
         assert observation.goal_state == 0 and observation.solved

@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from world_fixtures import twin_world
 
 from learning import DualAgent, OracleAgent, run_episode
 from models import World
@@ -15,20 +16,6 @@ from twin.nominal_calibration import nominal_calibration
 from twin.session import TwinSession
 
 ROOT = Path(__file__).resolve().parents[2]
-
-
-def twin_world(session: TwinSession, seed: int = 0) -> TwinWorld:
-    spec = session.spec
-    by_marker = {c.marker: i for i, c in enumerate(spec.components)}
-    return TwinWorld(
-        session.robot,
-        nominal_calibration(session),
-        {c.marker: c.kind for c in spec.components},
-        spec.components[spec.index_of(spec.goal.component)].marker,
-        seed=seed,
-        ground_truth=lambda m: int(session.component_states()[by_marker[m]]),
-        names={c.marker: c.name for c in spec.components},
-    )
 
 
 def test_twin_world_satisfies_the_world_protocol_and_perceives_kinds_and_poses():
