@@ -8,6 +8,10 @@ Conventions: OpenCV's pinhole model and pixel convention (integer coordinates at
 distortion ``[k1, k2, p1, p2, k3]``; camera frames are OpenCV's (x right, y down, z forward).
 A fixed camera has ``T_base_camera``; a camera on the arm has ``T_tcp_camera`` (hand-eye), composed
 at capture time with the TCP pose the arm reports.
+
+A calibration belongs to one cell: :attr:`CellCalibration.cell` records the cell it was made for (in
+the twin, the reality profile, its ``cell_seed`` and the box height, which sets where the overview
+camera hangs) and :meth:`CellCalibration.check_cell` refuses to apply it to another.
 """
 
 from __future__ import annotations
@@ -121,6 +125,13 @@ class CameraCalibration:
             raise CalibrationError(f"bad camera calibration: {type(err).__name__}: {err}") from None
 
 
+CELL_KEYS = ("profile", "cell_seed", "box_height")
+"""The keys of :attr:`CellCalibration.cell` that :meth:`CellCalibration.check_cell` compares."""
+
+BOX_HEIGHT_TOLERANCE = 1e-6
+"""Box heights closer than this [m] are the same cell (both come from a spec's JSON)."""
+
+
 @dataclass(frozen=True)
 class CellCalibration:
     """The calibration of every camera of a cell, by camera name."""
@@ -128,6 +139,48 @@ class CellCalibration:
     cameras: dict[str, CameraCalibration]
     source: str = ""
     """How it was made (e.g. ``"charuco, profile realistic, cell seed 0"``), for the record."""
+    cell: dict[str, Any] = field(default_factory=dict)
+    """The cell it was made for: ``profile`` (reality profile name), ``cell_seed`` (seed of the cell's
+    fixed imperfections), ``box_height`` [m] (the overview camera hangs at box height + 0.5 m,
+    ``models.scene``), and anything else worth keeping (``spec``). Empty in files made before it existed."""
+
+    def check_cell(self, profile: str, cell_seed: int, box_height: float, spec: str = "SPEC") -> None:
+        """Refuse to apply this calibration to a cell other than the one it was made for.
+
+        Args:
+            profile: name of the reality profile of the cell it is to be used in.
+            cell_seed: that profile's ``cell_seed``.
+            box_height: height of that cell's box [m] (``spec.box.size[2]``).
+            spec: the spec file to name in the remedy.
+
+        Raises:
+            CalibrationError: the file records no cell, or another one; one sentence naming what differs
+                and the command that makes a matching file.
+        """
+        remedy = (
+            f"make a matching file with `python scripts/calibrate.py --reality {profile} --cell-seed {cell_seed} "
+            f"--spec {spec} --out FILE`"
+        )
+        missing = [key for key in CELL_KEYS if key not in self.cell]
+        if missing:
+            raise CalibrationError(
+                f"this calibration does not record the cell it was made for (no {', '.join(missing)}), so it "
+                f"cannot be checked against profile {profile!r}, cell seed {cell_seed}, box height "
+                f"{box_height:.4f} m: {remedy}"
+            )
+        made = (self.cell["profile"], self.cell["cell_seed"], self.cell["box_height"])
+        differs = []
+        if str(made[0]) != profile:
+            differs.append(f"profile {made[0]!r} instead of {profile!r}")
+        if made[1] != cell_seed:
+            differs.append(f"cell seed {made[1]} instead of {cell_seed}")
+        if not isinstance(made[2], int | float) or abs(made[2] - box_height) > BOX_HEIGHT_TOLERANCE:
+            differs.append(f"box height {made[2]} m instead of {box_height:.4f} m")
+        if differs:
+            raise CalibrationError(
+                f"this calibration was made for another cell ({'; '.join(differs)}) and would misplace what "
+                f"the cameras see: {remedy}"
+            )
 
     def camera(self, name: str) -> CameraCalibration:
         try:
@@ -141,6 +194,7 @@ class CellCalibration:
         return {
             "format": CALIBRATION_FORMAT,
             "source": self.source,
+            "cell": self.cell,
             "cameras": {name: c.to_dict() for name, c in sorted(self.cameras.items())},
         }
 
@@ -152,7 +206,11 @@ class CellCalibration:
         cameras = data.get("cameras")
         if not isinstance(cameras, dict) or not cameras:
             raise CalibrationError("a calibration file needs at least one camera under 'cameras'")
-        return cls({str(k): CameraCalibration.from_dict(v) for k, v in cameras.items()}, str(data.get("source", "")))
+        cell = data.get("cell", {})
+        if not isinstance(cell, dict):
+            raise CalibrationError(f"'cell' must map names to values (profile, cell_seed, box_height), got {cell!r}")
+        cameras = {str(k): CameraCalibration.from_dict(v) for k, v in cameras.items()}
+        return cls(cameras, str(data.get("source", "")), dict(cell))
 
     def save(self, path: str | Path) -> Path:
         return write_text_atomically(path, json.dumps(self.to_dict(), indent=1) + "\n")
@@ -170,4 +228,4 @@ class CellCalibration:
         return cls.from_dict(data)
 
 
-__all__ = ["CALIBRATION_FORMAT", "CalibrationError", "CameraCalibration", "CellCalibration"]
+__all__ = ["CALIBRATION_FORMAT", "CELL_KEYS", "CalibrationError", "CameraCalibration", "CellCalibration"]

@@ -40,6 +40,7 @@ import cv2
 import numpy as np
 
 from models.errors import ModelsError
+from models.markers import add_png_material, aruco_dictionary, png_bytes
 
 if TYPE_CHECKING:
     from dm_control import mjcf
@@ -98,7 +99,7 @@ class CharucoBoardSpec:
 
     # -- OpenCV ------------------------------------------------------------------------------------
     def aruco_dictionary(self) -> cv2.aruco.Dictionary:
-        return cv2.aruco.getPredefinedDictionary(self.dictionary)
+        return aruco_dictionary(self.dictionary)
 
     def cv_board(self) -> cv2.aruco.CharucoBoard:
         """The OpenCV board object (for ``cv2.aruco.CharucoDetector`` and ``matchImagePoints``)."""
@@ -154,11 +155,8 @@ class CharucoBoardSpec:
         return np.pad(board, margin, mode="constant", constant_values=255).astype(np.uint8)
 
     def png(self, pixels_per_square: int = 140) -> bytes:
-        """:meth:`image` encoded as PNG bytes (3-channel, which every MuJoCo version decodes)."""
-        ok, encoded = cv2.imencode(".png", cv2.cvtColor(self.image(pixels_per_square), cv2.COLOR_GRAY2BGR))
-        if not ok:  # pragma: no cover - OpenCV only fails here when out of memory
-            raise CharucoError("OpenCV could not encode the ChArUco board as PNG")
-        return encoded.tobytes()
+        """:meth:`image` encoded as PNG bytes (:func:`models.markers.png_bytes`)."""
+        return png_bytes(self.image(pixels_per_square))
 
     # -- the plate in a scene ----------------------------------------------------------------------
     @property
@@ -205,31 +203,14 @@ def add_board_body(
     """Add the board as a mocap body whose frame is the board frame, hidden inside the table at first.
 
     The plate is one box geom, visual only (``contype=conaffinity=0``, ``group=2``, massless): a rig
-    moves it anywhere, through the arm or the box, without disturbing the physics. Matte, so that the
-    key light never washes out the squares.
+    moves it anywhere, through the arm or the box, without disturbing the physics. Its material
+    (``<name>_material``, texture ``<name>_material_texture``) is matte, as a marker's
+    (:func:`models.markers.add_png_material`), so that the key light never washes out the squares.
 
     Returns:
         The ``<body>`` element.
     """
-    from dm_control import mjcf  # see models.markers: importing dm_control picks a GL backend
-
-    root = worldbody.root
-    texture = root.asset.add(
-        "texture",
-        name=f"{name}_texture",
-        type="2d",
-        file=mjcf.Asset(contents=board.png(pixels_per_square), extension=".png"),
-    )
-    material = root.asset.add(
-        "material",
-        name=f"{name}_material",
-        texture=texture,
-        texuniform=False,
-        texrepeat=[1, 1],
-        specular=0.0,
-        shininess=0.0,
-        reflectance=0.0,
-    )
+    material = add_png_material(worldbody.root, board.png(pixels_per_square), f"{name}_material")
     body = worldbody.add("body", name=name, mocap=True, pos=list(BOARD_HIDDEN_POS))
     T_board_geom = np.linalg.inv(board.T_geom_board())
     body.add(

@@ -43,10 +43,12 @@ __all__ = [
     "MarkerError",
     "add_marker_geom",
     "add_marker_material",
+    "add_png_material",
     "aruco_dictionary",
     "marker_geom_size",
     "marker_image",
     "marker_png",
+    "png_bytes",
 ]
 
 ARUCO_DICTIONARY: int = cv2.aruco.DICT_4X4_250
@@ -69,9 +71,10 @@ class MarkerError(ModelsError, ValueError):
     """A marker id outside the project's dictionary, or marker dimensions that cannot be drawn."""
 
 
-def aruco_dictionary() -> cv2.aruco.Dictionary:
-    """The OpenCV dictionary object of :data:`ARUCO_DICTIONARY` (for detectors and marker generation)."""
-    return cv2.aruco.getPredefinedDictionary(ARUCO_DICTIONARY)
+def aruco_dictionary(dictionary: int = ARUCO_DICTIONARY) -> cv2.aruco.Dictionary:
+    """The OpenCV dictionary object of ``dictionary`` (a ``cv2.aruco.DICT_*`` constant; the project's
+    :data:`ARUCO_DICTIONARY` by default), for detectors and marker generation."""
+    return cv2.aruco.getPredefinedDictionary(dictionary)
 
 
 def _check_id(marker_id: int) -> int:
@@ -113,13 +116,18 @@ def marker_image(marker_id: int, pixels_per_bit: int = 16, quiet_zone_bits: int 
     return np.pad(image, margin, mode="constant", constant_values=255).astype(np.uint8)
 
 
-def marker_png(marker_id: int, pixels_per_bit: int = 16, quiet_zone_bits: int = 1) -> bytes:
-    """:func:`marker_image` encoded as PNG bytes (3-channel, which every MuJoCo version decodes)."""
-    image = marker_image(marker_id, pixels_per_bit, quiet_zone_bits)
+def png_bytes(gray: np.ndarray) -> bytes:
+    """A grayscale ``uint8`` image encoded as PNG bytes (3-channel, which every MuJoCo version decodes)."""
+    image = np.asarray(gray, dtype=np.uint8)
     ok, encoded = cv2.imencode(".png", cv2.cvtColor(image, cv2.COLOR_GRAY2BGR))
     if not ok:  # pragma: no cover - OpenCV only fails here when out of memory
-        raise MarkerError(f"OpenCV could not encode marker {marker_id} as PNG")
+        raise MarkerError(f"OpenCV could not encode a {image.shape} image as PNG")
     return encoded.tobytes()
+
+
+def marker_png(marker_id: int, pixels_per_bit: int = 16, quiet_zone_bits: int = 1) -> bytes:
+    """:func:`marker_image` encoded as PNG bytes (:func:`png_bytes`)."""
+    return png_bytes(marker_image(marker_id, pixels_per_bit, quiet_zone_bits))
 
 
 def marker_geom_size(marker_size_m: float, quiet_zone_bits: int = 1) -> float:
@@ -166,11 +174,27 @@ def add_marker_material(
     Raises:
         MarkerError: for an id outside 0..249.
     """
+    return add_png_material(mjcf_root, marker_png(marker_id, pixels_per_bit, quiet_zone_bits), name)
+
+
+def add_png_material(mjcf_root: mjcf.RootElement, png: bytes, name: str) -> mjcf.Element:
+    """Add a PNG image as a ``2d`` texture (``<name>_texture``) and a matte material (``<name>``) that maps
+    it once onto each face of a box geom (``texuniform="false"``, ``texrepeat="1 1"``; the orientation
+    on the +z face is in the module docstring). Matte (no specular highlight, no reflection) so that the
+    lights never wash out black print.
+
+    Args:
+        mjcf_root: the model to add the assets to.
+        png: the image, PNG-encoded (:func:`png_bytes`).
+        name: name of the material; the texture is named ``<name>_texture``. Must be unique in the model.
+
+    Returns:
+        The ``<material>`` element.
+    """
     # Imported here, not at module level: importing dm_control picks an OpenGL backend from MUJOCO_GL
     # (GLFW when unset, which warns at exit without a display), and marker images alone need none.
     from dm_control import mjcf
 
-    png = marker_png(marker_id, pixels_per_bit, quiet_zone_bits)
     texture = mjcf_root.asset.add(
         "texture",
         name=f"{name}_texture",

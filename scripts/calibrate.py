@@ -11,19 +11,26 @@ the math, the skills' IK moves the arm):
 3. the board left there, the arm moving the wrist camera through varied viewpoints, recording the TCP
    pose the arm reports at each capture: the wrist camera's intrinsics and its hand-eye pose.
 
-It writes a :class:`models.calibration.CellCalibration` atomically, with the resolved settings, and
-prints one line per camera: the reprojection error and, because this is the twin and the truth is
-known, the pose and focal-length errors against the truth.
+It writes a :class:`models.calibration.CellCalibration` atomically, recording the cell it was made for
+(reality profile, ``cell_seed``, box height: ``scripts/trial.py --calibration`` refuses it for another
+cell), writes the resolved settings (arguments, rig and calibration configs, spec, box height, profile)
+beside it in ``FILE.config.json``, and prints one line per camera: the reprojection error and, because
+this is the twin and the truth is known, the pose and focal-length errors against the truth.
+
+Exit status: 0 written; 2 a mistake on the command line (bad argument, spec or profile); 1 the
+calibration failed (too few usable views, the arm could not reach, the rig found no pose), one line on
+stderr.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import time
 from pathlib import Path
 
 import numpy as np
-from _cli import fail
+from _cli import fail, versions, write_json
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -47,27 +54,26 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     return args
 
 
+def one_line(err: Exception) -> str:
+    return " ".join(line.strip() for line in str(err).splitlines())
+
+
 def load_inputs(args: argparse.Namespace):
     from models import ModelsError, load_spec
     from models.generator import paper_family
+    from twin.errors import TwinError
+    from twin.reality import load_profile
 
     try:
         spec = load_spec(args.spec) if args.spec is not None else paper_family("test", seed=0)[0]
     except (ModelsError, OSError) as err:
-        fail(f"cannot use spec {args.spec}: " + " ".join(line.strip() for line in str(err).splitlines()))
-    reality = args.reality
+        fail(f"cannot use spec {args.spec}: {one_line(err)}")
     try:
-        from twin.reality import load_profile
-    except ImportError:
-        if reality != "ideal":
-            fail(f"--reality {reality!r}: this twin has no reality profiles yet; only 'ideal'")
-        return spec, None
-    from twin.errors import TwinError
-
-    try:
-        profile = load_profile(reality)
+        profile = load_profile(args.reality)
     except TwinError as err:
-        fail("--reality: " + " ".join(line.strip() for line in str(err).splitlines()))
+        fail(f"--reality: {one_line(err)}")
+    if args.cell_seed is not None:
+        profile = dataclasses.replace(profile, cell_seed=args.cell_seed)
     return spec, profile
 
 
@@ -76,18 +82,28 @@ def main(argv: list[str] | None = None) -> int:
     spec, profile = load_inputs(args)
     start = time.perf_counter()
 
+    from models import ModelsError
     from models.calibration import CameraCalibration, CellCalibration
-    from skills.calibration import calibrate_intrinsics, fixed_camera_pose, hand_eye, pose_error
-    from skills.errors import CalibrationFailed, IKFailure
+    from skills.calibration import (
+        CalibrationConfig,
+        calibrate_intrinsics,
+        detect_board,
+        fixed_camera_pose,
+        hand_eye,
+        pose_error,
+    )
+    from skills.errors import IKFailure, SkillError
     from skills.kinematics import ArmKinematics
     from skills.primitives import Toggler
-    from twin.calibration_rig import CalibrationCell, RigError
+    from twin.calibration_rig import CalibrationCell, RigConfig, RigError
+    from twin.errors import TwinError
 
     rng = np.random.default_rng(args.seed)
+    rig_config, calibration_config = RigConfig(), CalibrationConfig()
     try:
-        cell = CalibrationCell(spec, seed=args.seed, reality=profile, cell_seed=args.cell_seed)
-    except RigError as err:
-        fail(str(err))
+        cell = CalibrationCell(spec, seed=args.seed, reality=profile, config=rig_config)
+    except (ModelsError, TwinError) as err:
+        fail(f"cannot build the cell for spec {spec.name} under profile {profile.name!r}: {one_line(err)}")
     with cell:
         robot = cell.robot
         overview, wrist = cell.overview_camera, cell.wrist_camera
@@ -97,7 +113,7 @@ def main(argv: list[str] | None = None) -> int:
             for T_base_board in cell.board_poses_in_front_of(overview, args.overview_views, rng):
                 cell.place_board(T_base_board)
                 images.append(cell.capture(overview).rgb)
-            overview_intrinsics = calibrate_intrinsics(images)
+            overview_intrinsics = calibrate_intrinsics(images, calibration_config)
 
             # 2. its pose: the board at the known place, a few still frames pooled
             T_base_board = cell.table_place()
@@ -106,11 +122,13 @@ def main(argv: list[str] | None = None) -> int:
             for _ in range(4):
                 frames.append(cell.capture(overview).rgb)
                 robot.wait(0.02)
-            overview_pose = fixed_camera_pose(frames, overview_intrinsics.K, overview_intrinsics.dist, T_base_board)
+            overview_pose = fixed_camera_pose(
+                frames, overview_intrinsics.K, overview_intrinsics.dist, T_base_board, calibration_config
+            )
 
-            # 3. the wrist camera: the board stays, the arm moves
+            # 3. the wrist camera: the board stays, the arm moves; each image's corners found once
             toggler = Toggler(robot, kinematics=ArmKinematics())
-            wrist_images, tcp_poses, unreachable = [], [], 0
+            wrist_views, tcp_poses, unreachable = [], [], 0
             for T_base_tcp in cell.wrist_viewpoints(T_base_board, args.wrist_views, rng):
                 try:
                     toggler.move_to(T_base_tcp, 1.5)
@@ -118,17 +136,26 @@ def main(argv: list[str] | None = None) -> int:
                     unreachable += 1
                     continue
                 robot.wait(0.3)  # still: no motion blur, the servos settled
-                wrist_images.append(cell.capture(wrist).rgb)
+                wrist_views.append(detect_board(cell.capture(wrist).rgb, calibration_config))
                 tcp_poses.append(robot.tcp_pose_in_base())
             toggler.go_rest()
-            wrist_intrinsics = calibrate_intrinsics(wrist_images)
-            wrist_pose = hand_eye(wrist_images, tcp_poses, wrist_intrinsics.K, wrist_intrinsics.dist)
-        except (CalibrationFailed, RigError) as err:
-            fail(f"calibration failed: {err}", code=1)
+            wrist_intrinsics = calibrate_intrinsics(wrist_views, calibration_config)
+            wrist_pose = hand_eye(wrist_views, tcp_poses, wrist_intrinsics.K, wrist_intrinsics.dist, calibration_config)
+        except (SkillError, RigError) as err:
+            fail(f"calibration failed: {one_line(err)}", code=1)
 
         truth = {name: cell.camera_truth(name) for name in (overview, wrist)}
+        made_for = {
+            "profile": cell.session.reality.name,
+            "cell_seed": int(cell.session.reality.cell_seed),
+            "box_height": cell.box_height,
+            "spec": spec.name,
+        }
 
-    source = f"charuco, profile {getattr(profile, 'name', 'ideal')}, cell seed {args.cell_seed}, seed {args.seed}"
+    source = (
+        f"charuco, profile {made_for['profile']}, cell seed {made_for['cell_seed']}, "
+        f"box height {made_for['box_height']:.4f} m, spec {spec.name}, seed {args.seed}"
+    )
     figures = {}
     cameras = {}
     for name, intrinsics, pose_kind in (
@@ -165,7 +192,17 @@ def main(argv: list[str] | None = None) -> int:
                 intrinsics.K, intrinsics.dist, intrinsics.image_size, T_tcp_camera=T_est,
                 reprojection_error_px=intrinsics.rms_px, extra=extra,
             )  # fmt: skip
-    path = CellCalibration(cameras, source=source).save(args.out)
+    path = CellCalibration(cameras, source=source, cell=made_for).save(args.out)
+    settings = {
+        "command": "calibrate",
+        **{k: str(v) if isinstance(v, Path) else v for k, v in vars(args).items()},
+        "cell": made_for,
+        "profile": profile.to_dict(),
+        "rig": dataclasses.asdict(rig_config),
+        "calibration": dataclasses.asdict(calibration_config),
+        "versions": versions(),
+    }
+    write_json(path.with_name(path.name + ".config.json"), settings)
     wall = time.perf_counter() - start
     for name, f in figures.items():
         frame = "T_base_camera" if name == overview else "T_tcp_camera"
@@ -176,7 +213,7 @@ def main(argv: list[str] | None = None) -> int:
             f"{f['truth_focal_error_pct'][1]:+.3f} %, principal point {f['truth_principal_error_px'][0]:+.2f}/"
             f"{f['truth_principal_error_px'][1]:+.2f} px"
         )
-    print(f"wrote {path} in {wall:.1f} s")
+    print(f"wrote {path} (settings in {path.name}.config.json) in {wall:.1f} s")
     return 0
 
 

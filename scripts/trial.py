@@ -11,7 +11,8 @@ simulator's truth, F/T peak, perceived position error, simulated and wall time) 
 single run). ``--reality`` picks the twin's reality profile (sensor noise, calibration error,
 friction, jams, slips, the box placed anywhere reachable; default ``ideal``), ``--calibration`` the
 cell's camera calibration made by ``scripts/calibrate.py`` (default: the nominal, datasheet
-calibration, exact only under ``ideal``).
+calibration, exact only under ``ideal``); a calibration made for another cell (another profile,
+``cell_seed`` or box height) is refused.
 
 Run ``r`` on every spec uses seed ``S + r`` for the world (component order, faults) and the agent.
 ``DIR/config.json`` records the resolved arguments and package versions, so the result can be re-run.
@@ -103,6 +104,14 @@ def main(argv: list[str] | None = None) -> int:
         specs = [load_spec(path) for path in args.specs]
     except SpecError as err:
         fail(str(err))
+    if calibration is not None:
+        # A calibration belongs to one cell: the profile's imperfections and the box height (the overview
+        # camera hangs above the lid) must be those it was made in, or every pose perceived is off.
+        for path, spec in zip(args.specs, specs, strict=True):
+            try:
+                calibration.check_cell(reality.name, reality.cell_seed, spec.box.size[2], spec=str(path))
+            except CalibrationError as err:
+                fail(f"--calibration {args.calibration} for spec {spec.name}: {err}")
 
     try:
         memory = MemoryStore.open_existing(args.memory) if args.memory else None

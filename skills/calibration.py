@@ -24,10 +24,10 @@ z forward); poses are 4x4 matrices named after their frames; lengths in metres.
 
 from __future__ import annotations
 
+import functools
 import itertools
-import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -35,7 +35,7 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from models.charuco import DEFAULT_BOARD, CharucoBoardSpec
-from skills.errors import BoardNotFound, TooFewViews
+from skills.errors import BoardNotFound, InconsistentViews, TooFewViews
 
 __all__ = [
     "BoardView",
@@ -101,9 +101,6 @@ class IntrinsicsResult:
         image_size: ``(width, height)`` [px].
         rms_px: RMS reprojection error over every corner of the views used [px].
         views_used: indices (into the images given) of the views the calibration used.
-        view_rms_px: RMS reprojection error of each view used [px].
-        view_corners: number of corners of each view used.
-        T_camera_board: board pose in each view used [m].
         views_dropped: indices of views seen but dropped as outliers.
     """
 
@@ -112,19 +109,15 @@ class IntrinsicsResult:
     image_size: tuple[int, int]
     rms_px: float
     views_used: tuple[int, ...]
-    view_rms_px: tuple[float, ...]
-    view_corners: tuple[int, ...]
-    T_camera_board: tuple[np.ndarray, ...]
     views_dropped: tuple[int, ...] = ()
 
 
 @dataclass(frozen=True)
 class FixedPoseResult:
-    """Result of :func:`fixed_camera_pose`: ``T_base_camera`` [m], RMS reprojection error [px], corners used."""
+    """Result of :func:`fixed_camera_pose`: ``T_base_camera`` [m] and the RMS reprojection error [px]."""
 
     T_base_camera: np.ndarray
     rms_px: float
-    num_corners: int
 
 
 @dataclass(frozen=True)
@@ -136,42 +129,42 @@ class HandEyeResult:
         T_base_board: 4x4 pose of the (fixed) board in the base frame found along with it [m].
         rms_px: RMS reprojection error of every corner of every view used, after refinement [px].
         views_used: indices (into the images given) of the views used.
-        closed_form_T_tcp_camera: the Park & Martin estimate the refinement started from.
-        view_rms_px: RMS reprojection error of each view used [px].
     """
 
     T_tcp_camera: np.ndarray
     T_base_board: np.ndarray
     rms_px: float
     views_used: tuple[int, ...]
-    closed_form_T_tcp_camera: np.ndarray
-    view_rms_px: tuple[float, ...] = field(default=())
 
 
 # -- small pose helpers --------------------------------------------------------------------------------
 def _pose(rvec: np.ndarray, tvec: np.ndarray) -> np.ndarray:
+    """4x4 pose from a rotation vector (OpenCV's ``rvec``, axis times angle) and a translation."""
     T = np.eye(4)
-    T[:3, :3] = cv2.Rodrigues(np.asarray(rvec, dtype=float).reshape(3))[0]
+    T[:3, :3] = Rotation.from_rotvec(np.asarray(rvec, dtype=float).reshape(3)).as_matrix()
     T[:3, 3] = np.asarray(tvec, dtype=float).reshape(3)
     return T
 
 
 def _rvec_tvec(T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    return cv2.Rodrigues(np.ascontiguousarray(T[:3, :3]))[0].reshape(3), T[:3, 3].copy()
+    """The inverse of :func:`_pose`: rotation vector and translation of a 4x4 pose."""
+    return Rotation.from_matrix(T[:3, :3]).as_rotvec(), T[:3, 3].copy()
 
 
-def _inverse(T: np.ndarray) -> np.ndarray:
-    out = np.eye(4)
-    out[:3, :3] = T[:3, :3].T
-    out[:3, 3] = -T[:3, :3].T @ T[:3, 3]
-    return out
+def _params_to_pose(p: np.ndarray) -> np.ndarray:
+    return _pose(p[:3], p[3:6])
+
+
+def _pose_to_params(T: np.ndarray) -> np.ndarray:
+    return np.concatenate(_rvec_tvec(T))
 
 
 def pose_error(T_estimate: np.ndarray, T_truth: np.ndarray) -> tuple[float, float]:
     """Distance between two poses: translation [m] and rotation angle [rad] of ``T_truth⁻¹ T_estimate``."""
-    delta = _inverse(np.asarray(T_truth, float)) @ np.asarray(T_estimate, float)
-    cos = np.clip((np.trace(delta[:3, :3]) - 1.0) / 2.0, -1.0, 1.0)
-    return float(np.linalg.norm(T_estimate[:3, 3] - T_truth[:3, 3])), float(math.acos(cos))
+    T_estimate, T_truth = np.asarray(T_estimate, float), np.asarray(T_truth, float)
+    delta = np.linalg.inv(T_truth) @ T_estimate
+    angle = Rotation.from_matrix(delta[:3, :3]).magnitude()
+    return float(np.linalg.norm(T_estimate[:3, 3] - T_truth[:3, 3])), float(angle)
 
 
 def _rms(errors: np.ndarray) -> float:
@@ -184,8 +177,14 @@ def _gray(image) -> np.ndarray:
     if pixels.ndim == 3:
         return cv2.cvtColor(pixels, cv2.COLOR_RGB2GRAY)
     if pixels.ndim != 2:
-        raise ValueError(f"an image is (H, W) or (H, W, 3), got shape {pixels.shape}")
+        raise InconsistentViews(f"an image is (H, W) or (H, W, 3), got shape {pixels.shape}")
     return pixels
+
+
+@functools.lru_cache(maxsize=4)
+def _detector(board: CharucoBoardSpec) -> cv2.aruco.CharucoDetector:
+    """One detector per board, built once: it holds the board and its dictionary."""
+    return cv2.aruco.CharucoDetector(board.cv_board())
 
 
 def detect_board(image, config: CalibrationConfig | None = None) -> BoardView | None:
@@ -193,8 +192,7 @@ def detect_board(image, config: CalibrationConfig | None = None) -> BoardView | 
     fewer than :attr:`CalibrationConfig.min_corners` are found."""
     config = config or CalibrationConfig()
     gray = _gray(image)
-    detector = cv2.aruco.CharucoDetector(config.board.cv_board())
-    corners, ids, _, _ = detector.detectBoard(gray)
+    corners, ids, _, _ = _detector(config.board).detectBoard(gray)
     if ids is None or len(ids) < config.min_corners:
         return None
     ids = ids.ravel().astype(int)
@@ -207,13 +205,16 @@ def detect_board(image, config: CalibrationConfig | None = None) -> BoardView | 
 
 
 def _board_views(images: Sequence, config: CalibrationConfig) -> list[tuple[int, BoardView]]:
+    """The views (index, corners) that show the board: images are detected, :class:`BoardView` taken as
+    they are, None (what :func:`detect_board` gives an image without the board) skipped."""
     views = [
-        (i, image if isinstance(image, BoardView) else detect_board(image, config)) for i, image in enumerate(images)
+        (i, image if image is None or isinstance(image, BoardView) else detect_board(image, config))
+        for i, image in enumerate(images)
     ]
     views = [(i, v if v is not None and len(v.ids) >= config.min_corners else None) for i, v in views]
     sizes = {v.image_size for _, v in views if v is not None}
     if len(sizes) > 1:
-        raise ValueError(f"images of one camera must share one size, got {sorted(sizes)}")
+        raise InconsistentViews(f"images of one camera must share one size, got {sorted(sizes)}")
     return [(i, v) for i, v in views if v is not None]
 
 
@@ -238,11 +239,12 @@ def calibrate_intrinsics(images: Sequence, config: CalibrationConfig | None = No
 
     Args:
         images: board views of one camera (``(H, W, 3)`` RGB, ``(H, W)`` gray, objects with ``.rgb``, or
-            :class:`BoardView` already detected).
+            what :func:`detect_board` made of them: a :class:`BoardView`, or None for no board).
         config: board and acceptance settings.
 
     Raises:
         TooFewViews: fewer than :attr:`CalibrationConfig.min_views_intrinsics` views show the board.
+        InconsistentViews: images of different sizes.
     """
     config = config or CalibrationConfig()
     views = _board_views(images, config)
@@ -258,17 +260,16 @@ def calibrate_intrinsics(images: Sequence, config: CalibrationConfig | None = No
         for (_, v), r, t in zip(selected, rvecs, tvecs, strict=True):
             projected, _ = cv2.projectPoints(v.object_points, r, t, K, dist)
             per_view.append(projected.reshape(-1, 2) - v.image_points)
-        return K, dist.ravel(), rvecs, tvecs, per_view
+        return K, dist.ravel(), per_view
 
-    K, dist, rvecs, tvecs, residuals = run(views)
+    K, dist, residuals = run(views)
     view_rms = np.array([_rms(r) for r in residuals])
     bad = view_rms > max(config.outlier_factor * float(np.median(view_rms)), 0.5)
     dropped: tuple[int, ...] = ()
     if bad.any() and (~bad).sum() >= config.min_views_intrinsics:
         dropped = tuple(i for (i, _), b in zip(views, bad, strict=True) if b)
         views = [view for view, b in zip(views, bad, strict=True) if not b]
-        K, dist, rvecs, tvecs, residuals = run(views)
-        view_rms = np.array([_rms(r) for r in residuals])
+        K, dist, residuals = run(views)
     dist5 = np.zeros(5)
     dist5[: min(5, dist.size)] = dist[:5]
     return IntrinsicsResult(
@@ -277,9 +278,6 @@ def calibrate_intrinsics(images: Sequence, config: CalibrationConfig | None = No
         image_size=size,
         rms_px=_rms(np.concatenate(residuals)),
         views_used=tuple(i for i, _ in views),
-        view_rms_px=tuple(float(r) for r in view_rms),
-        view_corners=tuple(len(v.ids) for _, v in views),
-        T_camera_board=tuple(_pose(r, t) for r, t in zip(rvecs, tvecs, strict=True)),
         views_dropped=dropped,
     )
 
@@ -330,9 +328,8 @@ def fixed_camera_pose(
     rvec, tvec = _rvec_tvec(T_camera_board)
     projected, _ = cv2.projectPoints(pooled.object_points, rvec, tvec, K, dist)
     return FixedPoseResult(
-        T_base_camera=np.asarray(T_base_board, float) @ _inverse(T_camera_board),
+        T_base_camera=np.asarray(T_base_board, float) @ np.linalg.inv(T_camera_board),
         rms_px=_rms(projected.reshape(-1, 2) - pooled.image_points),
-        num_corners=len(pooled.ids),
     )
 
 
@@ -351,11 +348,11 @@ def solve_hand_eye_closed_form(T_base_tcp: Sequence[np.ndarray], T_camera_board:
     G = [np.asarray(T, float) for T in T_base_tcp]
     C = [np.asarray(T, float) for T in T_camera_board]
     if len(G) != len(C):
-        raise ValueError(f"need one TCP pose per board pose, got {len(G)} and {len(C)}")
+        raise InconsistentViews(f"need one TCP pose per board pose, got {len(G)} and {len(C)}")
     alphas, betas, As, Bs = [], [], [], []
     for i, j in itertools.combinations(range(len(G)), 2):
-        A = _inverse(G[j]) @ G[i]
-        B = C[j] @ _inverse(C[i])
+        A = np.linalg.inv(G[j]) @ G[i]
+        B = C[j] @ np.linalg.inv(C[i])
         a = Rotation.from_matrix(A[:3, :3]).as_rotvec()
         b = Rotation.from_matrix(B[:3, :3]).as_rotvec()
         if np.linalg.norm(a) < np.radians(2.0):  # almost pure translation: no information on the rotation
@@ -382,17 +379,6 @@ def solve_hand_eye_closed_form(T_base_tcp: Sequence[np.ndarray], T_camera_board:
     return X
 
 
-def _params_to_pose(p: np.ndarray) -> np.ndarray:
-    T = np.eye(4)
-    T[:3, :3] = Rotation.from_rotvec(p[:3]).as_matrix()
-    T[:3, 3] = p[3:6]
-    return T
-
-
-def _pose_to_params(T: np.ndarray) -> np.ndarray:
-    return np.concatenate([Rotation.from_matrix(T[:3, :3]).as_rotvec(), T[:3, 3]])
-
-
 def hand_eye(
     images: Sequence,
     T_base_tcp: Sequence[np.ndarray],
@@ -403,17 +389,19 @@ def hand_eye(
     """An arm camera's ``T_tcp_camera`` from views of a board that stays put (module docstring, 3).
 
     Args:
-        images: the arm camera's images of the board, one per arm pose.
+        images: the arm camera's images of the board, one per arm pose (or what :func:`detect_board`
+            made of them, as for :func:`calibrate_intrinsics`).
         T_base_tcp: the TCP pose the arm reported at each capture (4x4, base frame) [m].
         K, dist: the camera's intrinsics [px] and distortion.
 
     Raises:
         TooFewViews: fewer than :attr:`CalibrationConfig.min_views_hand_eye` images show the board, or
             the arm poses do not turn the camera about two different axes.
+        InconsistentViews: not one TCP pose per image, or images of different sizes.
     """
     config = config or CalibrationConfig()
     if len(images) != len(T_base_tcp):
-        raise ValueError(f"need one TCP pose per image, got {len(images)} images and {len(T_base_tcp)} poses")
+        raise InconsistentViews(f"need one TCP pose per image, got {len(images)} images and {len(T_base_tcp)} poses")
     K, dist = np.asarray(K, float), np.asarray(dist, float)
     views = _board_views(images, config)
     _require_views(len(views), len(images), config.min_views_hand_eye, "hand-eye calibration", config)
@@ -426,10 +414,10 @@ def hand_eye(
     Y0[:3, :3] = Rotation.from_matrix([b[:3, :3] for b in boards]).mean().as_matrix()
     Y0[:3, 3] = np.mean([b[:3, 3] for b in boards], axis=0)
 
-    G_inv = [_inverse(g) for g in G]
+    G_inv = [np.linalg.inv(g) for g in G]
 
     def residuals(p: np.ndarray) -> np.ndarray:
-        X_inv = _inverse(_params_to_pose(p[:6]))
+        X_inv = np.linalg.inv(_params_to_pose(p[:6]))
         Y = _params_to_pose(p[6:])
         out = []
         for (_, v), g_inv in zip(views, G_inv, strict=True):
@@ -439,18 +427,9 @@ def hand_eye(
         return np.concatenate(out)
 
     solution = least_squares(residuals, np.concatenate([_pose_to_params(X0), _pose_to_params(Y0)]), method="lm")
-    X = _params_to_pose(solution.x[:6])
-    final = residuals(solution.x)
-    view_rms, start = [], 0
-    for _, v in views:
-        n = 2 * len(v.ids)
-        view_rms.append(_rms(final[start : start + n]))
-        start += n
     return HandEyeResult(
-        T_tcp_camera=X,
+        T_tcp_camera=_params_to_pose(solution.x[:6]),
         T_base_board=_params_to_pose(solution.x[6:]),
-        rms_px=_rms(final),
+        rms_px=_rms(residuals(solution.x)),
         views_used=tuple(i for i, _ in views),
-        closed_form_T_tcp_camera=X0,
-        view_rms_px=tuple(view_rms),
     )

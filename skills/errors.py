@@ -51,6 +51,11 @@ class BoardNotFound(CalibrationFailed):
     """The calibration board was not seen (or too few of its corners) in an image that needs it."""
 
 
+class InconsistentViews(CalibrationFailed, ValueError):
+    """Calibration inputs that do not go together: images of one camera in different sizes, an image that
+    is not ``(H, W)`` or ``(H, W, 3)``, not one arm pose per image."""
+
+
 class ForceLimitExceeded(SkillError):
     """The wrist force passed the safety limit during a motion: the motion was stopped."""
 

@@ -11,39 +11,40 @@ It also proposes the procedure's poses: board poses held in front of a fixed cam
 distances and tilts (:meth:`CalibrationCell.board_poses_in_front_of`), the known place where the board
 lies flat for the fixed camera's pose and the hand-eye (:meth:`CalibrationCell.table_place`), and TCP
 poses from which the wrist camera looks at it (:meth:`CalibrationCell.wrist_viewpoints`). These are
-aimed with the cell's *nominal* camera poses (the design drawing), as a person aims them by eye; the
-calibration itself never reads them. Moving the arm is the robot pipeline's job (the skills' IK), so
-the script that runs the procedure does that.
+aimed with the cell's *nominal* calibration (:func:`twin.nominal_calibration.nominal_calibration`: the
+datasheet intrinsics and the design drawing's camera poses), as a person aims them by eye, never with
+the true cameras; the calibration itself never reads them. Moving the arm is the robot pipeline's job
+(the skills' IK), so the script that runs the procedure does that.
 
-:meth:`CalibrationCell.camera_truth` gives the cameras' true parameters, for evaluating a calibration
-in the twin only.
+:meth:`CalibrationCell.camera_truth` gives the cameras' true parameters
+(:meth:`twin.session.TwinSession.camera_truth`), for evaluating a calibration in the twin only.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import inspect
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import mujoco
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from models.charuco import BOARD_BODY, BOARD_HIDDEN_POS, DEFAULT_BOARD, CharucoBoardSpec, board_pose_flat
+from models.calibration import CameraCalibration
+from models.charuco import BOARD_BODY, DEFAULT_BOARD, CharucoBoardSpec, board_pose_flat
 from models.robot import CameraImage
 from models.spec import PuzzleSpec
 from twin.errors import TwinError
+from twin.nominal_calibration import nominal_calibration
+from twin.reality import RealityProfile, load_profile
 from twin.session import TwinConfig, TwinSession
 
-__all__ = ["CalibrationCell", "CameraTruth", "RigConfig", "RigError"]
-
-# OpenCV's camera frame from MuJoCo's (see twin.rendering): same x, y and z flipped.
-_MUJOCO_TO_OPENCV = np.diag([1.0, -1.0, -1.0])
+__all__ = ["CalibrationCell", "RigConfig", "RigError"]
 
 
 class RigError(TwinError):
-    """The rig cannot do what was asked (no frame delivered, a profile the twin cannot apply...)."""
+    """The rig cannot do what was asked (no frame delivered, no board pose that fits in front of a camera)."""
 
 
 @dataclass(frozen=True)
@@ -61,7 +62,10 @@ class RigConfig:
     """A held board stays this far above the top of the box [m] (the rig's board is not solid)."""
     place_above_lid: float = 0.08
     """The known place: the board lies flat on a stand this far above the lid [m], under the fixed
-    camera (the box occupies the table there; the stand clears its handles)."""
+    camera (the box occupies the table there; the stand clears its handles). The known place is a
+    *surveyed fixture*: the fixed camera's pose is only as good as this number. Here the lid's height
+    comes exactly from the spec's box height (``spec.box.size[2]``), so the place is known exactly; a
+    real cell must measure the stand's height (and the board's position on it) instead."""
     place_yaw: float = 0.0
     """Yaw of the board at the known place [rad]."""
     wrist_distance: tuple[float, float] = (0.24, 0.34)
@@ -76,23 +80,6 @@ class RigConfig:
     """Captures tried before a camera that delivers no frame is an error."""
 
 
-@dataclass(frozen=True)
-class CameraTruth:
-    """A camera's true parameters in the twin (evaluation only).
-
-    Attributes:
-        K: 3x3 true intrinsics [px].
-        dist: ``(5,)`` true distortion ``[k1, k2, p1, p2, k3]``.
-        T_base_camera: 4x4 pose of a fixed camera in the base frame [m] (OpenCV camera frame), else None.
-        T_tcp_camera: 4x4 pose of an arm camera in the TCP frame the arm reports [m], else None.
-    """
-
-    K: np.ndarray
-    dist: np.ndarray
-    T_base_camera: np.ndarray | None
-    T_tcp_camera: np.ndarray | None
-
-
 @dataclass
 class CalibrationCell:
     """A twin cell with a ChArUco board the rig can place (see the module docstring).
@@ -100,8 +87,7 @@ class CalibrationCell:
     Args:
         spec: the puzzle box of the cell (the overview camera hangs at a height that depends on it).
         seed: the session's seed (per-trial randomness).
-        reality: a reality profile (``twin.reality.RealityProfile`` or a preset name), None for the
-            nominal twin.
+        reality: the reality profile: a profile, a preset name or a profile JSON file; None for ``ideal``.
         cell_seed: the seed of the cell's fixed imperfections (the profile's ``cell_seed``), None to keep
             the profile's.
         config: where the rig puts the board and the arm.
@@ -110,7 +96,7 @@ class CalibrationCell:
 
     spec: PuzzleSpec
     seed: int = 0
-    reality: object = None
+    reality: RealityProfile | str | Path | None = None
     cell_seed: int | None = None
     config: RigConfig = field(default_factory=RigConfig)
     twin_config: TwinConfig | None = None
@@ -119,18 +105,27 @@ class CalibrationCell:
     def __post_init__(self) -> None:
         base = self.twin_config or TwinConfig()
         twin_config = dataclasses.replace(base, scene=dataclasses.replace(base.scene, calibration_board=True))
-        self.session = _session(self.spec, self.seed, twin_config, self.reality, self.cell_seed)
+        profile = load_profile(self.reality)
+        if self.cell_seed is not None:
+            profile = dataclasses.replace(profile, cell_seed=self.cell_seed)
+        self.session = TwinSession(self.spec, seed=self.seed, config=twin_config, reality=profile)
         self.model, self.data = self.session.model, self.session.data
         self._mocap = int(self.model.body(BOARD_BODY).mocapid[0])
         names = self.session.scene.names
         self.overview_camera, self.wrist_camera = names.overview_camera, names.wrist_camera
-        self._tcp_site = self.model.site(names.tcp_site).id
+        # What the rig aims with, as a person aims by eye: the datasheet and the drawing, never the truth.
+        self.nominal = nominal_calibration(self.session)
 
     # -- the session -------------------------------------------------------------------------------
     @property
     def robot(self):
         """The robot interface: the only way images and arm poses reach the calibration."""
         return self.session.robot
+
+    @property
+    def box_height(self) -> float:
+        """Height of the box's lid above the table [m] (the spec's; the overview camera hangs 0.5 m above it)."""
+        return float(self.session.spec.box.size[2])
 
     def close(self) -> None:
         self.session.close()
@@ -150,15 +145,6 @@ class CalibrationCell:
         x, y, z, w = Rotation.from_matrix(T[:3, :3]).as_quat()
         self.data.mocap_pos[self._mocap] = T[:3, 3]
         self.data.mocap_quat[self._mocap] = (w, x, y, z)
-        self._update_poses()
-
-    def hide_board(self) -> None:
-        """Put the board away (inside the table, out of every camera's view)."""
-        self.data.mocap_pos[self._mocap] = BOARD_HIDDEN_POS
-        self.data.mocap_quat[self._mocap] = (1.0, 0.0, 0.0, 0.0)
-        self._update_poses()
-
-    def _update_poses(self) -> None:
         # The renderer reads body and camera poses; mj_kinematics alone leaves the cameras where they were.
         mujoco.mj_kinematics(self.model, self.data)
         mujoco.mj_camlight(self.model, self.data)
@@ -168,48 +154,28 @@ class CalibrationCell:
         for _ in range(self.config.capture_attempts):
             frame = self.robot.capture(camera)
             if frame is not None:
-                return CameraImage(camera=frame.camera, rgb=frame.rgb, time=frame.time)
+                return frame
             self.robot.wait(0.05)
         raise RigError(f"camera {camera!r} delivered no frame in {self.config.capture_attempts} attempts")
 
-    # -- nominal cameras (the design drawing, for aiming only) -------------------------------------
-    def _model_camera_pose(self, camera: str) -> np.ndarray:
-        cam = self.model.camera(camera).id
-        T = np.eye(4)
-        T[:3, :3] = self.data.cam_xmat[cam].reshape(3, 3) @ _MUJOCO_TO_OPENCV
-        T[:3, 3] = self.data.cam_xpos[cam]
-        return T
-
-    def _model_intrinsics(self, camera: str) -> np.ndarray:
-        width, height = self._image_size()
-        fy = 0.5 * height / math.tan(math.radians(self.model.camera(camera).fovy[0]) / 2)
-        return np.array([[fy, 0.0, (width - 1) / 2], [0.0, fy, (height - 1) / 2], [0.0, 0.0, 1.0]])
-
-    def _image_size(self) -> tuple[int, int]:
-        render = getattr(self.session.config, "render", None) or getattr(self.robot, "_render_config", None)
-        return (render.width, render.height) if render is not None else (640, 480)
-
-    def _T_base_tcp(self) -> np.ndarray:
-        T = np.eye(4)
-        T[:3, :3] = self.data.site_xmat[self._tcp_site].reshape(3, 3)
-        T[:3, 3] = self.data.site_xpos[self._tcp_site]
-        return T
-
-    def _lid_top(self) -> float:
-        return float(self.session.scene.T_world_lid[2, 3])
-
     # -- the procedure's poses ---------------------------------------------------------------------
+    def _nominal_pose(self, camera: CameraCalibration) -> np.ndarray:
+        """A camera's nominal pose now: a fixed camera's as drawn, an arm camera's composed with the TCP
+        pose the arm reports."""
+        return camera.pose_in_base(self.robot.tcp_pose_in_base() if camera.on_arm else None)
+
     def board_poses_in_front_of(self, camera: str, count: int, rng: np.random.Generator) -> list[np.ndarray]:
-        """``count`` board poses ``T_base_board`` held in front of a fixed camera: at varied distances,
-        tilted up to :attr:`RigConfig.board_max_tilt` about varied axes, turned about the normal, spread
-        over the image (mostly inside it), all above the box."""
+        """``count`` board poses ``T_base_board`` held in front of a camera (aimed with its nominal
+        calibration): at varied distances, tilted up to :attr:`RigConfig.board_max_tilt` about varied
+        axes, turned about the normal, spread over the image (mostly inside it), all above the box."""
         c = self.config
-        T_base_camera = self._model_camera_pose(camera)
-        K = self._model_intrinsics(camera)
-        width, height = self._image_size()
+        nominal = self.nominal.camera(camera)
+        T_base_camera = self._nominal_pose(nominal)
+        K = nominal.K
+        width, height = nominal.image_size
         corners = self.board.corners_in_board()
         outline = self.board.outline_in_board()
-        lowest = self._lid_top() + 0.04 + c.board_clearance  # handles stand ~3-4 cm above the lid
+        lowest = self.box_height + 0.04 + c.board_clearance  # handles stand ~3-4 cm above the lid
         poses: list[np.ndarray] = []
         for _ in range(200 * count):
             if len(poses) == count:
@@ -248,21 +214,23 @@ class CalibrationCell:
 
     def table_place(self) -> np.ndarray:
         """The known place ``T_base_board``: flat, print up, on a stand :attr:`RigConfig.place_above_lid`
-        above the lid, centred under the overview camera's nominal position."""
-        x, y = self.session.config.scene.overview_xy
-        return board_pose_flat(x, y, self._lid_top() + self.config.place_above_lid, self.config.place_yaw, self.board)
+        above the lid, centred under the overview camera's nominal position.
 
-    def nominal_T_tcp_wrist_camera(self) -> np.ndarray:
-        """The wrist camera's pose in the TCP frame on the design drawing (the nominal model) [m]."""
-        return np.linalg.inv(self._T_base_tcp()) @ self._model_camera_pose(self.wrist_camera)
+        A surveyed fixture: its height here is exactly the spec's box height plus
+        :attr:`RigConfig.place_above_lid`, so the fixed camera's pose is found against an exact place; a
+        real cell must measure where the board lies (a calibrated stand, a survey), and the fixed
+        camera's pose inherits that measurement's error."""
+        x, y = self.session.config.scene.overview_xy
+        z = self.box_height + self.config.place_above_lid
+        return board_pose_flat(x, y, z, self.config.place_yaw, self.board)
 
     def wrist_viewpoints(self, T_base_board: np.ndarray, count: int, rng: np.random.Generator) -> list[np.ndarray]:
-        """``count`` TCP poses ``T_base_tcp`` from which the wrist camera looks at the board lying at
-        ``T_base_board``: from above, at varied distances, off the normal by up to
-        :attr:`RigConfig.wrist_max_tilt`, turned about the camera axis by up to
+        """``count`` TCP poses ``T_base_tcp`` from which the wrist camera (at its nominal ``T_tcp_camera``)
+        looks at the board lying at ``T_base_board``: from above, at varied distances, off the normal by
+        up to :attr:`RigConfig.wrist_max_tilt`, turned about the camera axis by up to
         :attr:`RigConfig.wrist_max_roll` (hand-eye needs rotations about several axes)."""
         c = self.config
-        T_tcp_camera = self.nominal_T_tcp_wrist_camera()
+        T_tcp_camera = self.nominal.camera(self.wrist_camera).T_tcp_camera
         centre = T_base_board[:3, :3] @ self.board.center_in_board + T_base_board[:3, 3]
         up = -T_base_board[:3, 2]  # the board's z goes into the board
         # Nominal: the gripper straight down, its x along the base x (skills.kinematics.top_down(p, 0)).
@@ -289,38 +257,8 @@ class CalibrationCell:
         return poses
 
     # -- truth (evaluation only) -------------------------------------------------------------------
-    def camera_truth(self, camera: str) -> CameraTruth:
-        """A camera's true intrinsics, distortion and pose now. Intrinsics and lens: the session's
-        (``TwinSession.camera_truth``) when it models camera errors, else the nominal model's, which is
-        then the truth. Pose: the camera in the session's model (mounting errors included), an arm
-        camera's relative to the TCP pose the arm reports. Never for the calibration itself."""
-        truth = getattr(self.session, "camera_truth", None)
-        if truth is not None:
-            t = truth(camera)
-            K, dist = np.asarray(t.K, float), np.asarray(t.dist, float)
-        else:
-            K, dist = self._model_intrinsics(camera), np.zeros(5)
-        T_base_camera = self._model_camera_pose(camera)
-        if camera == self.wrist_camera:
-            return CameraTruth(K, dist, None, np.linalg.inv(self.robot.tcp_pose_in_base()) @ T_base_camera)
-        return CameraTruth(K, dist, T_base_camera, None)
-
-
-def _session(
-    spec: PuzzleSpec, seed: int, twin_config: TwinConfig, reality: object, cell_seed: int | None
-) -> TwinSession:
-    """The twin session, with the reality profile when the twin applies them (``TwinSession(reality=)``)."""
-    if reality is None and cell_seed is None:
-        return TwinSession(spec, seed=seed, config=twin_config)
-    try:
-        from twin.reality import load_profile  # the reality profiles live beside the session
-    except ImportError:
-        load_profile = None
-    if load_profile is None or "reality" not in inspect.signature(TwinSession).parameters:
-        if reality in (None, "ideal") or getattr(reality, "name", None) == "ideal":
-            return TwinSession(spec, seed=seed, config=twin_config)
-        raise RigError(f"this twin does not apply reality profiles yet: {getattr(reality, 'name', reality)!r}")
-    profile = load_profile(reality)
-    if cell_seed is not None:
-        profile = dataclasses.replace(profile, cell_seed=cell_seed)
-    return TwinSession(spec, seed=seed, config=twin_config, reality=profile)
+    def camera_truth(self, camera: str) -> CameraCalibration:
+        """A camera's true calibration now (:meth:`twin.session.TwinSession.camera_truth`): intrinsics and
+        lens with the profile's errors, the true mounting pose (an arm camera's relative to the TCP).
+        For evaluating a calibration in the twin; never for the calibration itself."""
+        return self.session.camera_truth(camera)

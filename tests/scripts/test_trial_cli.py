@@ -132,3 +132,31 @@ def test_memory_trial_refuses_a_missing_or_foreign_memory(tmp_path):
     foreign.write_bytes(b"this is not a database at all" * 100)
     bad = run(ROOT / "scripts/trial.py", *common, "--memory", foreign)
     assert bad.returncode == 2 and "Traceback" not in bad.stderr and "memory" in bad.stderr
+
+
+def test_twin_trial_refuses_a_calibration_made_for_another_cell(tmp_path):
+    import numpy as np
+
+    from models.calibration import CameraCalibration, CellCalibration
+
+    specs = tmp_path / "specs"
+    run(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", specs)
+    spec = specs / "paper-test-0.json"
+    box_height = json.loads(spec.read_text())["box"]["size"][2]
+    K = np.array([[600.0, 0, 319.5], [0, 600.0, 239.5], [0, 0, 1]])
+    camera = CameraCalibration(K, np.zeros(5), (640, 480), T_base_camera=np.eye(4))
+    common = ["--specs", spec, "--sim", "twin", "--agent", "dual", "--runs", 1, "--seed", 0, "--max-actions", 5]
+    for cell, reality, what in (
+        ({"profile": "realistic", "cell_seed": 0, "box_height": box_height}, "ideal", "profile 'realistic'"),
+        ({"profile": "realistic", "cell_seed": 7, "box_height": box_height}, "realistic", "cell seed 7 instead of 0"),
+        ({"profile": "ideal", "cell_seed": 0, "box_height": box_height + 0.05}, "ideal", "box height"),
+    ):
+        calibration = CellCalibration({"overview": camera}, cell=cell).save(tmp_path / "cal.json")
+        out = tmp_path / "out"
+        result = run(
+            ROOT / "scripts/trial.py", *common, "--out", out, "--reality", reality, "--calibration", calibration
+        )
+        assert result.returncode == 2, result.stderr
+        assert what in result.stderr and "scripts/calibrate.py --reality" in result.stderr
+        assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1
+        assert not (out / "results.json").exists()

@@ -1,6 +1,7 @@
-"""Calibration recovers a known camera: intrinsics and distortion from synthetic board views, a fixed
-camera's pose from a board at a known place, an arm camera's hand-eye pose from exact arm poses; too
-few views and corrupted calibration files are clear errors."""
+"""Calibration recovers a known camera: intrinsics and distortion from synthetic board views (a view
+with misplaced corners dropped), a fixed camera's pose from a board at a known place, an arm camera's
+hand-eye pose from exact arm poses; too few views, inputs that do not go together, corrupted calibration
+files and a calibration made for another cell are clear errors."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from models.calibration import CalibrationError, CameraCalibration, CellCalibration
+from models.calibration import CALIBRATION_FORMAT, CalibrationError, CameraCalibration, CellCalibration
 from models.charuco import DEFAULT_BOARD
 from skills.calibration import (
     BoardView,
@@ -20,7 +21,7 @@ from skills.calibration import (
     pose_error,
     solve_hand_eye_closed_form,
 )
-from skills.errors import BoardNotFound, TooFewViews
+from skills.errors import BoardNotFound, CalibrationFailed, InconsistentViews, TooFewViews
 
 SIZE = (640, 480)
 # A D435-like camera with a visible lens distortion (REALITY_NOTES.md §3, pessimistic k1).
@@ -90,6 +91,21 @@ def test_intrinsics_recover_a_known_camera_from_exact_projections():
     assert abs(result.dist[0] - DIST_TRUE[0]) < 0.02
     assert result.rms_px < 0.2
     assert len(result.views_used) == 15
+
+
+def test_a_view_with_misplaced_corners_is_dropped_and_the_camera_still_recovered():
+    rng = np.random.default_rng(10)
+    views = [project_view(random_board_pose_in_camera(rng), noise_px=0.1, rng=rng) for _ in range(12)]
+    bad = views[4]
+    # A few pixels of error on every corner of one view (a misdetection, motion blur).
+    views[4] = BoardView(
+        bad.ids, bad.image_points + rng.normal(0.0, 3.0, bad.image_points.shape), bad.object_points, SIZE
+    )
+    result = calibrate_intrinsics(views)
+    assert result.views_dropped == (4,)
+    assert 4 not in result.views_used and len(result.views_used) == 11
+    assert np.allclose(np.diag(result.K)[:2], np.diag(K_TRUE)[:2], rtol=0.005)
+    assert result.rms_px < 0.2
 
 
 def test_intrinsics_recover_a_known_camera_from_synthetic_images():
@@ -182,6 +198,18 @@ def test_hand_eye_recovers_a_known_camera_from_board_views():
     assert result.rms_px < 0.35
 
 
+def test_inputs_that_do_not_go_together_are_a_calibration_error():
+    _, _, G, C = hand_eye_scene(np.random.default_rng(8), 6)
+    views = [project_view(c) for c in C]
+    with pytest.raises(InconsistentViews, match="one TCP pose per image"):
+        hand_eye(views, G[:-1], K_TRUE, DIST_TRUE)
+    other_size = BoardView(views[0].ids, views[0].image_points, views[0].object_points, (1280, 720))
+    with pytest.raises(InconsistentViews, match="share one size"):
+        calibrate_intrinsics([*views, other_size])
+    with pytest.raises(CalibrationFailed, match=r"\(H, W\)"):
+        detect_board(np.zeros((4, 4, 4, 4), np.uint8))
+
+
 def test_hand_eye_without_rotation_is_a_clear_error():
     T_tcp_camera, T_base_board, G, _ = hand_eye_scene(np.random.default_rng(7), 1)
     shifted = []
@@ -194,11 +222,48 @@ def test_hand_eye_without_rotation_is_a_clear_error():
         hand_eye(views, shifted, K_TRUE, DIST_TRUE)
 
 
+CELL = {"profile": "realistic", "cell_seed": 3, "box_height": 0.12, "spec": "paper-test-0"}
+
+
 def test_a_calibration_file_round_trips(tmp_path):
     camera = CameraCalibration(K_TRUE, DIST_TRUE, SIZE, T_base_camera=np.eye(4), reprojection_error_px=0.1)
-    path = CellCalibration({"overview": camera}, source="test").save(tmp_path / "cal.json")
-    loaded = CellCalibration.load(path).camera("overview")
+    T_tcp_camera = pose([0.01, -0.02, np.pi / 2], [0.0, 0.075, -0.13])
+    wrist = CameraCalibration(K_TRUE, DIST_TRUE, SIZE, T_tcp_camera=T_tcp_camera, extra={"views": 14})
+    cell = CellCalibration({"overview": camera, "wrist": wrist}, source="test", cell=CELL)
+    path = cell.save(tmp_path / "cal.json")
+    loaded_cell = CellCalibration.load(path)
+    loaded = loaded_cell.camera("overview")
     assert np.array_equal(loaded.K, K_TRUE) and np.array_equal(loaded.dist, DIST_TRUE)
+    assert loaded_cell.to_dict() == cell.to_dict()
+    loaded_wrist = loaded_cell.camera("wrist")
+    assert loaded_wrist.on_arm and loaded_wrist.to_dict() == wrist.to_dict()
+    assert np.array_equal(loaded_wrist.T_tcp_camera, T_tcp_camera)
+    assert loaded_cell.cell == CELL
+
+
+def test_a_calibration_applies_only_to_the_cell_it_was_made_for(tmp_path):
+    camera = CameraCalibration(K_TRUE, DIST_TRUE, SIZE, T_base_camera=np.eye(4))
+    calibration = CellCalibration({"overview": camera}, cell=CELL)
+    calibration.check_cell("realistic", 3, 0.12)  # the same cell: no complaint
+    for wrong, what in (
+        (("harsh", 3, 0.12), "profile 'realistic' instead of 'harsh'"),
+        (("realistic", 0, 0.12), "cell seed 3 instead of 0"),
+        (("realistic", 3, 0.15), "box height 0.12 m instead of 0.1500 m"),
+    ):
+        with pytest.raises(CalibrationError, match="another cell") as err:
+            calibration.check_cell(*wrong, spec="box.json")
+        message = str(err.value)
+        assert what in message and len(message.splitlines()) == 1
+        assert f"scripts/calibrate.py --reality {wrong[0]} --cell-seed {wrong[1]} --spec box.json" in message
+    # A file from before cells were recorded still loads, but cannot be checked against a cell.
+    data = calibration.to_dict()
+    del data["cell"]
+    old = CellCalibration.from_dict(data)
+    assert old.cell == {} and old.camera("overview").K.tolist() == K_TRUE.tolist()
+    with pytest.raises(CalibrationError, match="does not record the cell"):
+        old.check_cell("realistic", 3, 0.12)
+    with pytest.raises(CalibrationError, match="'cell' must map"):
+        CellCalibration.from_dict({"format": CALIBRATION_FORMAT, "cell": [1], "cameras": data["cameras"]})
 
 
 @pytest.mark.parametrize(
