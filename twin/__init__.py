@@ -15,7 +15,6 @@ from typing import Any
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # before mujoco/dm_control load: headless EGL by default
 
-from models.robot import CameraImage  # noqa: E402  (the Robot protocol's frame; kept here for old callers)
 from twin.component_states import ComponentStates, HysteresisConfig  # noqa: E402
 from twin.errors import (  # noqa: E402
     CommandError,
@@ -48,7 +47,6 @@ def __getattr__(name: str) -> Any:
 
 
 __all__ = [
-    "CameraImage",
     "CommandError",
     "ComponentStates",
     "HysteresisConfig",

@@ -71,16 +71,6 @@ def draw_cell(profile: RealityProfile, camera_names: tuple[str, ...]) -> CellImp
     return CellImperfections(cameras, random_vector(rng, profile.arm.tcp_bias))
 
 
-def _quat_of_rotvec(rotvec: np.ndarray) -> np.ndarray:
-    quat = np.zeros(4)
-    angle = float(np.linalg.norm(rotvec))
-    if angle == 0:
-        quat[0] = 1.0
-        return quat
-    mujoco.mju_axisAngle2Quat(quat, rotvec / angle, angle)
-    return quat
-
-
 def apply_cell(model: mujoco.MjModel, cell: CellImperfections, gripper_body: int) -> bool:
     """Build the cell's mounting errors and TCP bias into ``model``; True if anything changed."""
     changed = False
@@ -90,8 +80,9 @@ def apply_cell(model: mujoco.MjModel, cell: CellImperfections, gripper_body: int
             model.cam_pos[cam] += errors.mount_translation
             changed = True
         if errors.mount_rotation.any():
-            quat = np.zeros(4)
-            mujoco.mju_mulQuat(quat, model.cam_quat[cam], _quat_of_rotvec(errors.mount_rotation))
+            # the rotation vector is in the camera's own frame: q <- q ⊗ exp(rotvec / 2)
+            quat = model.cam_quat[cam].copy()
+            mujoco.mju_quatIntegrate(quat, errors.mount_rotation, 1.0)
             model.cam_quat[cam] = quat
             changed = True
     if cell.tcp_bias.any():

@@ -4,54 +4,65 @@ The overview camera's ``K`` from its field of view and the image size, zero dist
 ``T_base_camera``; the wrist camera's ``K`` and designed ``T_tcp_camera`` (its pose in the TCP frame,
 OpenCV camera frame). It comes from the session's *nominal* model, so it ignores the reality profile:
 under ``ideal`` it is exactly the truth (:meth:`TwinSession.camera_truth`); under another profile it
-is the starting point a calibration procedure improves on.
+is the starting point a calibration procedure improves on. Both are made by :func:`camera_calibration`.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 import numpy as np
 
 from models.calibration import CameraCalibration, CellCalibration
-from twin.rendering import pinhole_intrinsics
-from twin.sensors.cameras import MUJOCO_TO_OPENCV
+from twin.rendering import camera_pose_in_world, pinhole_intrinsics
 
 if TYPE_CHECKING:
     from twin.session import TwinSession
 
 
-def _pose(pos: np.ndarray, xmat: np.ndarray) -> np.ndarray:
-    T = np.eye(4)
-    T[:3, :3] = xmat.reshape(3, 3)
-    T[:3, 3] = pos
-    return T
+def camera_calibration(
+    model: mujoco.MjModel,
+    qpos: np.ndarray,
+    cam: int,
+    K: np.ndarray,
+    dist: np.ndarray,
+    size: tuple[int, int],
+    T_base_tcp: np.ndarray,
+    extra: dict[str, Any],
+) -> CameraCalibration:
+    """Calibration of camera ``cam`` of ``model`` in the configuration ``qpos`` (all of the model's), with
+    intrinsics ``K`` [px] and distortion ``dist`` for images of ``size`` ``(W, H)`` [px]: a camera fixed in
+    the world gets its ``T_base_camera``, one carried by the arm its ``T_tcp_camera`` relative to
+    ``T_base_tcp`` (the TCP as the arm's kinematics report it) [m]."""
+    data = mujoco.MjData(model)
+    data.qpos[:] = qpos
+    mujoco.mj_kinematics(model, data)
+    mujoco.mj_camlight(model, data)  # camera poses are not part of mj_kinematics
+    T_base_camera = camera_pose_in_world(data, cam)
+    K, dist = np.array(K, dtype=float), np.array(dist, dtype=float)
+    if model.cam_bodyid[cam] == 0:
+        return CameraCalibration(K, dist, size, T_base_camera=T_base_camera, extra=extra)
+    T_tcp_camera = np.linalg.solve(T_base_tcp, T_base_camera)
+    return CameraCalibration(K, dist, size, T_tcp_camera=T_tcp_camera, extra=extra)
 
 
 def nominal_calibration(session: TwinSession) -> CellCalibration:
     """The nominal (datasheet / CAD) calibration of ``session``'s cell (see the module docstring)."""
     model = session.nominal_model
     names = session.scene.names
-    data = mujoco.MjData(model)
-    data.qpos[session.arm_qpos] = session.config.home_qpos
-    mujoco.mj_kinematics(model, data)
-    mujoco.mj_camlight(model, data)  # camera poses are not part of mj_kinematics
-    width, height = session.config.render.width, session.config.render.height
-    tcp = model.site(names.tcp_site).id
-    T_base_tcp = _pose(data.site_xpos[tcp], data.site_xmat[tcp])
+    qpos = model.qpos0.copy()
+    qpos[session.arm_qpos] = session.config.home_qpos
+    size = (session.config.render.width, session.config.render.height)
+    T_base_tcp = session.encoders.nominal_tcp_pose(np.asarray(session.config.home_qpos, dtype=float))
     cameras = {}
     for name in (names.overview_camera, names.wrist_camera):
         cam = model.camera(name).id
-        K = pinhole_intrinsics(model, cam, width, height)
-        T_base_camera = _pose(data.cam_xpos[cam], data.cam_xmat[cam].reshape(3, 3) @ MUJOCO_TO_OPENCV)
-        extra = {"source": "nominal model"}
-        if model.cam_bodyid[cam] == 0:
-            cameras[name] = CameraCalibration(K, np.zeros(5), (width, height), T_base_camera=T_base_camera, extra=extra)
-        else:
-            T_tcp_camera = np.linalg.solve(T_base_tcp, T_base_camera)
-            cameras[name] = CameraCalibration(K, np.zeros(5), (width, height), T_tcp_camera=T_tcp_camera, extra=extra)
+        K = pinhole_intrinsics(model, cam, *size)
+        cameras[name] = camera_calibration(
+            model, qpos, cam, K, np.zeros(5), size, T_base_tcp, extra={"source": "nominal model"}
+        )
     return CellCalibration(cameras, source="nominal (datasheet / CAD model)")
 
 
-__all__ = ["nominal_calibration"]
+__all__ = ["camera_calibration", "nominal_calibration"]

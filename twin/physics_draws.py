@@ -33,7 +33,8 @@ def draw_physics(config: PhysicsReality, n: int, rng: np.random.Generator) -> Ph
     )
 
 
-def _subtree(model: mujoco.MjModel, root: int) -> np.ndarray:
+def subtree_bodies(model: mujoco.MjModel, root: int) -> np.ndarray:
+    """Ids of body ``root`` and of every body below it in ``model``'s tree."""
     inside = np.zeros(model.nbody, dtype=bool)
     inside[root] = True
     for b in range(root + 1, model.nbody):  # MuJoCo numbers a parent before its children
@@ -71,7 +72,7 @@ def apply_physics(
         changed = True
     if np.any(draw.mass != 1):
         for body, s in zip(component_bodies, draw.mass, strict=True):
-            for b in _subtree(model, body):
+            for b in subtree_bodies(model, body):
                 model.body_mass[b] *= s
                 model.body_inertia[b] *= s
         changed = True

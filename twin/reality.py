@@ -87,9 +87,8 @@ class ScaleRange:
         return self.low == 1.0 and self.high == 1.0
 
     def draw(self, rng: np.random.Generator, size: int | None = None) -> np.ndarray | float:
-        """Factors drawn from this range (exactly 1 and no draw when the range is the identity)."""
-        if self.is_identity:
-            return 1.0 if size is None else np.ones(size)
+        """Factors drawn from this range. Always draws (one uniform per factor, exactly 1 for the identity),
+        so what is drawn after it does not depend on whether this range is the identity."""
         if self.log:
             return np.exp(rng.uniform(math.log(self.low), math.log(self.high), size))
         return rng.uniform(self.low, self.high, size)
@@ -148,10 +147,6 @@ class CameraReality:
         _check(self.occluder_count >= 1, "occluder_count", f"must be >= 1, got {self.occluder_count!r}")
         low, high = self.occluder_size
         _check(0 < low <= high, "occluder_size", f"needs 0 < low <= high [px], got {self.occluder_size!r}")
-
-    @property
-    def has_fixed_errors(self) -> bool:
-        return any((self.focal_error, self.principal_error, self.k1, self.k2, self.p))
 
 
 @dataclass(frozen=True)
@@ -274,7 +269,8 @@ class RealityProfile:
     """Where the box is placed, drawn per trial among reachable poses; None: the spec's own pose."""
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON-ready dict; :func:`profile_from_dict` reads it back to an equal profile."""
+        """Plain JSON-ready dict; :meth:`from_dict` (and :func:`load_profile`, from a file) reads it back to an
+        equal profile."""
         return _to_plain(self)
 
     @classmethod

@@ -46,8 +46,10 @@ from twin.errors import RenderingError, UnknownCamera
 
 __all__ = [
     "GL_BACKENDS",
+    "MUJOCO_TO_OPENCV",
     "RenderConfig",
     "Renderer",
+    "camera_pose_in_world",
     "gl_backend",
     "pinhole_intrinsics",
 ]
@@ -58,8 +60,8 @@ GL_BACKENDS: tuple[str, ...] = ("egl", "osmesa", "glfw")
 # MUJOCO_GL values that MuJoCo itself accepts to mean "its default": here the default is headless EGL.
 _DEFAULT_VALUES = ("", "enable", "enabled", "on", "true", "1")
 _DISABLED_VALUES = ("disable", "disabled", "off", "false", "0")
-# OpenCV's camera frame from MuJoCo's: same x, y and z flipped (MuJoCo looks along -z with y up).
-_MUJOCO_TO_OPENCV = np.diag([1.0, -1.0, -1.0])
+MUJOCO_TO_OPENCV = np.diag([1.0, -1.0, -1.0])
+"""OpenCV's camera frame from MuJoCo's: same x, y and z flipped (MuJoCo looks along -z with y up)."""
 
 
 @dataclass(frozen=True)
@@ -184,6 +186,16 @@ def pinhole_intrinsics(model: mujoco.MjModel, cam: int, width: int, height: int)
         fx = fy
         cx, cy = (width - 1) / 2, (height - 1) / 2
     return np.array([[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]])
+
+
+def camera_pose_in_world(data: mujoco.MjData, cam: int) -> np.ndarray:
+    """``T_world_camera`` of camera ``cam`` in state ``data``, OpenCV camera frame (see
+    :meth:`Renderer.camera_pose_in_world`; ``data`` needs its camera poses computed: ``mj_forward``, or
+    ``mj_kinematics`` then ``mj_camlight``)."""
+    transform = np.eye(4)
+    transform[:3, :3] = data.cam_xmat[cam].reshape(3, 3) @ MUJOCO_TO_OPENCV
+    transform[:3, 3] = data.cam_xpos[cam]
+    return transform
 
 
 class Renderer:
@@ -335,11 +347,7 @@ class Renderer:
         Raises:
             UnknownCamera: if the model has no camera of that name.
         """
-        cam = self.camera_id(camera)
-        transform = np.eye(4)
-        transform[:3, :3] = data.cam_xmat[cam].reshape(3, 3) @ _MUJOCO_TO_OPENCV
-        transform[:3, 3] = data.cam_xpos[cam]
-        return transform
+        return camera_pose_in_world(data, self.camera_id(camera))
 
     def close(self) -> None:
         """Free the OpenGL resources. Idempotent; the renderer cannot render afterwards."""

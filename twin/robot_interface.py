@@ -39,7 +39,6 @@ class RobotInterface:
         names = session.scene.names
         m = session.model
         self.camera_names: tuple[str, ...] = session.cameras.names
-        self._ft = m.site(names.ft_site).id
         self._ctrl_range = m.actuator_ctrlrange[session.arm_actuators].copy()
         driver = m.joint(names.gripper_actuator.replace("fingers", "right_driver_joint"))
         self._gripper_qpos, self._gripper_range = driver.qposadr[0], driver.range.copy()
@@ -72,8 +71,9 @@ class RobotInterface:
         return self._session.encoders.tcp_pose()
 
     def ft_rotation_in_base(self) -> np.ndarray:
-        """3x3 orientation of the F/T sensor frame in the base frame."""
-        return self._session.data.site_xmat[self._ft].reshape(3, 3).copy()
+        """3x3 orientation of the F/T sensor frame in the base frame, as the arm's nominal kinematics
+        compute it from the encoders (the same reading as :meth:`tcp_pose_in_base`)."""
+        return self._session.encoders.ft_rotation()
 
     # -- the wrist F/T sensor ----------------------------------------------------------------------
     def wrench(self) -> np.ndarray:
@@ -121,8 +121,5 @@ class RobotInterface:
         (lens distortion and all), or None when the camera dropped the frame."""
         return self._session.cameras.capture(camera, self.time)
 
-    def close(self) -> None:
-        """Nothing to free: the session owns the cameras (kept for callers that close the robot)."""
 
-
-__all__ = ["GRIPPER_CTRL_MAX", "CameraImage", "RobotInterface"]
+__all__ = ["GRIPPER_CTRL_MAX", "RobotInterface"]

@@ -2,10 +2,11 @@
 during an occasional stall (:class:`~twin.reality.ArmReality`).
 
 Joint commands wait in a queue keyed by the physics step at which they take effect (the latency
-rounded to whole steps); the session steps up to each one and writes it to the servos. Stalls are a
-Poisson process (``stall_rate``) of windows ``stall_duration`` long: a command sent during one takes
-effect when it ends. Gripper commands take effect at once (the gripper has its own controller). With
-no latency and no stalls a command is written immediately, as to an ideal servo.
+rounded up to whole steps: never shorter than the profile's, and 5 ms at 2 ms steps is 6 ms, where
+Python's half-to-even ``round`` would make it 4 ms); the session steps up to each one and writes it to
+the servos. Stalls are a Poisson process (``stall_rate``) of windows ``stall_duration`` long: a command
+sent during one takes effect when it ends. Gripper commands take effect at once (the gripper has its
+own controller). With no latency and no stalls a command is written immediately, as to an ideal servo.
 """
 
 from __future__ import annotations
@@ -20,6 +21,12 @@ import numpy as np
 from twin.reality import ArmReality
 
 
+def _whole_steps(seconds: float, timestep: float) -> int:
+    """``seconds`` rounded up to whole physics steps; a quotient a rounding error above a whole number
+    (``0.05 / 0.002``) stays that number."""
+    return math.ceil(seconds / timestep - 1e-9)
+
+
 class Servos:
     """Joint and gripper commands of a session (see the module docstring)."""
 
@@ -30,8 +37,8 @@ class Servos:
         self._arm = arm_actuators
         self._gripper = gripper_actuator
         self._dt = timestep
-        self.latency_steps = round(config.command_latency / timestep)
-        self._stall_steps = math.ceil(config.stall_duration / timestep) if config.stall_rate > 0 else 0
+        self.latency_steps = _whole_steps(config.command_latency, timestep)
+        self._stall_steps = _whole_steps(config.stall_duration, timestep) if config.stall_rate > 0 else 0
         self._stall_rate = config.stall_rate
 
     @property

@@ -39,11 +39,12 @@ from twin.component_states import ComponentStates, HysteresisConfig
 from twin.errors import SimulationDiverged
 from twin.jams import Jams
 from twin.latches import Latches
-from twin.physics_draws import apply_physics, draw_physics
+from twin.nominal_calibration import camera_calibration
+from twin.physics_draws import apply_physics, draw_physics, subtree_bodies
 from twin.reality import RealityProfile, load_profile
 from twin.rendering import RenderConfig, pinhole_intrinsics
 from twin.robot_interface import RobotInterface
-from twin.sensors.cameras import Cameras, TrueLens, render_fovy, true_lens
+from twin.sensors.cameras import Cameras, true_lens
 from twin.sensors.encoders import JointEncoders
 from twin.sensors.force_torque import ForceTorqueSensor
 from twin.servos import Servos
@@ -106,8 +107,8 @@ class TwinSession:
         self.reality = load_profile(reality)
         if self.config.latch_period < 1:
             raise ValueError(f"latch_period must be >= 1, got {self.config.latch_period}")
-        streams = np.random.SeedSequence(seed).spawn(len(_STREAMS) + 2)
-        self._streams = dict(zip(_STREAMS, streams, strict=False))
+        root = np.random.SeedSequence(seed)
+        self._streams = dict(zip(_STREAMS, root.spawn(len(_STREAMS)), strict=True))
         if self.reality.placement is not None:
             rng = np.random.default_rng(self._streams["placement"])
             spec = placed(spec, sample_reachable_pose(spec, rng, self.reality.placement, self.config.scene))
@@ -129,7 +130,8 @@ class TwinSession:
         self.states = ComponentStates(self.travel, self.config.hysteresis)
         self.latches = Latches(m, spec, [c.latch for c in component_names], self.component_qpos)
         camera_names = (names.overview_camera, names.wrist_camera)
-        self._camera_streams = dict(zip(camera_names, streams[len(_STREAMS) :], strict=True))
+        # the next children of the same root: spawn keys follow on from the streams above
+        self._camera_streams = dict(zip(camera_names, root.spawn(len(camera_names)), strict=True))
 
         # the cell (cell_seed) and this trial's physics (seed), built into the model
         flange = m.body(names.flange).id
@@ -152,7 +154,12 @@ class TwinSession:
             self.latches.eq_ids,
             self.gripper_actuator,
         )
-        lenses = {name: self._true_lens(name) for name in camera_names}
+        size = (self.config.render.width, self.config.render.height)
+        lenses = {}
+        for name in camera_names:  # may widen a camera's render field of view: the true camera sees more
+            cam, errors = m.camera(name).id, self.cell.cameras[name]
+            K_true = errors.true_K(pinhole_intrinsics(self.nominal_model, cam, *size))
+            lenses[name] = true_lens(m, cam, K_true, errors.dist, size)
         if changed:
             mujoco.mj_setConst(m, self.data)  # masses, inertias and poses changed: recompute what depends on them
 
@@ -166,6 +173,7 @@ class TwinSession:
             self.data,
             self.arm_qpos,
             m.site(names.tcp_site).id,
+            m.site(names.ft_site).id,
             self.nominal_model,
             r.arm.encoder_noise,
             exact=not self.cell.tcp_bias.any(),
@@ -174,34 +182,13 @@ class TwinSession:
         self.servos = Servos(self.data, self.arm_actuators, self.gripper_actuator, r.arm, self.timestep)
         self.jams: Jams | None = None
         if r.physics.jam_probability > 0:
-            gripper_bodies = np.flatnonzero(self._subtree_mask(gripper_body))
+            gripper_bodies = subtree_bodies(m, gripper_body)
             self.jams = Jams(
                 m, handle_geoms, gripper_bodies, self.travel, r.physics.jam_probability, r.physics.jam_release_after
             )
         self._plain = self.ft.sample_steps == 0 and self.servos.immediate
         self._robot: RobotInterface | None = None
         self.reset()
-
-    def _subtree_mask(self, root: int) -> np.ndarray:
-        inside = np.zeros(self.model.nbody, dtype=bool)
-        inside[root] = True
-        for b in range(root + 1, self.model.nbody):  # MuJoCo numbers a parent before its children
-            inside[b] = inside[self.model.body_parentid[b]]
-        return inside
-
-    def _true_lens(self, camera: str) -> TrueLens:
-        """The camera's true lens; widens the model's render field of view when the true camera sees more."""
-        width, height = self.config.render.width, self.config.render.height
-        cam = self.model.camera(camera).id
-        K_nominal = pinhole_intrinsics(self.nominal_model, cam, width, height)
-        errors = self.cell.cameras[camera]
-        K_true = errors.true_K(K_nominal)
-        if np.array_equal(K_true, K_nominal) and not errors.dist.any():
-            return TrueLens(K_true, errors.dist, None, None)
-        fovy = render_fovy(K_nominal, K_true, errors.dist, (width, height))
-        if fovy is not None:
-            self.model.cam_fovy[cam] = fovy
-        return true_lens(K_true, errors.dist, pinhole_intrinsics(self.model, cam, width, height), (width, height))
 
     # -- life cycle --------------------------------------------------------------------------------
     def reset(self) -> None:
@@ -312,7 +299,7 @@ class TwinSession:
             physics=physics,
             latch_targets=self.latches.targets(),
             component_states=self.states.states.copy(),
-            sensors={name: copy.deepcopy(model.get_state()) for name, model in self._sensor_models().items()},
+            sensors={name: model.get_state() for name, model in self._sensor_models().items()},  # copies
         )
 
     def set_state(self, state: TwinState) -> None:
@@ -321,7 +308,7 @@ class TwinSession:
         self.latches.restore(self.data, state.latch_targets)
         self.states.states = state.component_states.copy()
         for name, model in self._sensor_models().items():
-            model.set_state(copy.deepcopy(state.sensors[name]))
+            model.set_state(state.sensors[name])  # copies: the snapshot can be restored again
         mujoco.mj_forward(self.model, self.data)
 
     # -- ground truth (evaluation only) ------------------------------------------------------------
@@ -338,18 +325,11 @@ class TwinSession:
         distortion, its true mounting pose (a wrist camera's relative to the TCP the arm reports).
         Evaluation only: for testing calibration procedures, never for skills."""
         lens = self.cameras.lens(camera)
-        scratch = mujoco.MjData(self.model)
-        scratch.qpos[:] = self.data.qpos
-        mujoco.mj_kinematics(self.model, scratch)
-        mujoco.mj_camlight(self.model, scratch)  # camera poses are not part of mj_kinematics
-        T_world_camera = self.cameras.pose_in_world(camera, scratch)
         size = (self.config.render.width, self.config.render.height)
-        extra = {"profile": self.reality.name, "cell_seed": self.reality.cell_seed}
-        if self.model.cam_bodyid[self.model.camera(camera).id] == 0:
-            return CameraCalibration(lens.K.copy(), lens.dist.copy(), size, T_base_camera=T_world_camera, extra=extra)
         T_base_tcp = self.encoders.nominal_tcp_pose(self.data.qpos[self.arm_qpos])
-        T_tcp_camera = np.linalg.solve(T_base_tcp, T_world_camera)
-        return CameraCalibration(lens.K.copy(), lens.dist.copy(), size, T_tcp_camera=T_tcp_camera, extra=extra)
+        extra = {"profile": self.reality.name, "cell_seed": self.reality.cell_seed}
+        cam = self.model.camera(camera).id
+        return camera_calibration(self.model, self.data.qpos, cam, lens.K, lens.dist, size, T_base_tcp, extra)
 
     # -- the robot ---------------------------------------------------------------------------------
     @property

@@ -155,6 +155,10 @@ def test_state_round_trip_reproduces_the_future_exactly(reality):
         session.advance(0.3)
         second = (session.data.qpos.copy(), robot.wrench())
         assert np.array_equal(first[0], second[0]) and np.array_equal(first[1], second[1])
+        session.set_state(saved)  # running on did not change the snapshot: it restores again
+        session.advance(0.3)
+        third = (session.data.qpos.copy(), robot.wrench())
+        assert np.array_equal(first[0], third[0]) and np.array_equal(first[1], third[1])
 
 
 def test_divergence_raises_naming_the_warning_and_never_resets():

@@ -4,15 +4,16 @@ imperfections (:class:`~twin.reality.CameraReality`).
 The renderer draws an ideal pinhole image. A true camera with intrinsics ``K_true`` and lens
 distortion ``dist_true`` (OpenCV's model) sees, at its pixel ``p``, the ray ``undistort(p)``; so each
 frame is the pinhole render sampled at ``K_render · undistort(p)`` (:func:`cv2.undistortPoints` over
-the pixel grid, computed once per camera, then :func:`cv2.remap`). When the true camera sees wider than
-the nominal one, the session renders it with a wider field of view (:func:`render_fovy`) so no true
-pixel falls outside the render. Then, per frame: occluders, defocus and motion blur, gain, noise.
+the pixel grid, computed once per cell and camera, then :func:`cv2.remap`). When the true camera sees wider
+than the nominal one, it is rendered with a wider field of view (:func:`true_lens`) so no true pixel falls
+outside the render. Then, per frame: occluders, defocus and motion blur, gain, noise.
 A dropped frame is None. The mounting error lives in the session's model (``cam_pos``/``cam_quat``).
 """
 
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 from typing import Any
 
@@ -23,10 +24,7 @@ import numpy as np
 from models.robot import CameraImage
 from twin.errors import UnknownCamera
 from twin.reality import CameraReality
-from twin.rendering import RenderConfig, Renderer
-
-# OpenCV's camera frame from MuJoCo's: same x, y and z flipped (MuJoCo looks along -z with y up).
-MUJOCO_TO_OPENCV = np.diag([1.0, -1.0, -1.0])
+from twin.rendering import MUJOCO_TO_OPENCV, RenderConfig, Renderer, pinhole_intrinsics
 
 
 @dataclass(frozen=True)
@@ -53,23 +51,45 @@ def undistorted_rays(K: np.ndarray, dist: np.ndarray, size: tuple[int, int]) -> 
     return rays.reshape(height, width, 2)
 
 
-def render_fovy(K_nominal: np.ndarray, K_true: np.ndarray, dist: np.ndarray, size: tuple[int, int]) -> float | None:
-    """Vertical field of view [deg] to render at so the true camera's every pixel lies inside the render
-    (a centred pinhole, as MuJoCo renders a ``fovy`` camera); None when the nominal one already does."""
+# The rays of a true camera depend only on the cell (its K_true, dist and the image size), yet every
+# trial builds a new session: keep the few most recent (~5 MB each at 640x480), read-only.
+_RAYS_CACHE_SIZE = 8
+_rays_cache: dict[tuple[bytes, bytes, tuple[int, int]], np.ndarray] = {}
+_rays_lock = threading.Lock()
+
+
+def _cached_rays(K: np.ndarray, dist: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    key = (np.asarray(K, dtype=np.float64).tobytes(), np.asarray(dist, dtype=np.float64).tobytes(), tuple(size))
+    with _rays_lock:
+        rays = _rays_cache.get(key)
+    if rays is None:
+        rays = undistorted_rays(K, dist, size)
+        rays.flags.writeable = False
+        with _rays_lock:
+            _rays_cache[key] = rays
+            while len(_rays_cache) > _RAYS_CACHE_SIZE:
+                del _rays_cache[next(iter(_rays_cache))]  # the oldest
+    return rays
+
+
+def true_lens(model: mujoco.MjModel, cam: int, K_true: np.ndarray, dist: np.ndarray, size: tuple[int, int]) -> TrueLens:
+    """The true lens ``(K_true, dist)`` of camera ``cam``, rendered as a pinhole by ``model``.
+
+    When the true camera is the model's pinhole, no resampling (maps None) and ``model`` is untouched.
+    Otherwise, when the true camera sees wider than the model's camera, the model's ``cam_fovy`` is widened
+    (a centred pinhole, as MuJoCo renders a ``fovy`` camera, with a half-percent margin) so that every true
+    pixel lies inside the render; the maps then sample that render.
+    """
     width, height = size
-    rays = undistorted_rays(K_true, dist, size)
-    # a centred render of focal f keeps x·f + (W-1)/2 inside [0, W-1]: f <= (W-1)/2 / max|x|
-    limit = min((width - 1) / 2 / np.abs(rays[..., 0]).max(), (height - 1) / 2 / np.abs(rays[..., 1]).max())
-    if K_nominal[1, 1] <= limit:
-        return None
-    return math.degrees(2 * math.atan(0.5 * height / (0.995 * limit)))  # a half-percent margin
-
-
-def true_lens(K_true: np.ndarray, dist: np.ndarray, K_render: np.ndarray, size: tuple[int, int]) -> TrueLens:
-    """The resampling maps of a true camera ``(K_true, dist)`` from a pinhole render of ``K_render``."""
+    K_render = pinhole_intrinsics(model, cam, width, height)
     if np.array_equal(K_true, K_render) and not np.any(dist):
         return TrueLens(K_true, dist, None, None)
-    rays = undistorted_rays(K_true, dist, size)
+    rays = _cached_rays(K_true, dist, size)
+    # a centred render of focal f keeps x·f + (W-1)/2 inside [0, W-1]: f <= (W-1)/2 / max|x|
+    limit = min((width - 1) / 2 / np.abs(rays[..., 0]).max(), (height - 1) / 2 / np.abs(rays[..., 1]).max())
+    if K_render[1, 1] > limit:
+        model.cam_fovy[cam] = math.degrees(2 * math.atan(0.5 * height / (0.995 * limit)))
+        K_render = pinhole_intrinsics(model, cam, width, height)
     map_x = (rays[..., 0] * K_render[0, 0] + K_render[0, 2]).astype(np.float32)
     map_y = (rays[..., 1] * K_render[1, 1] + K_render[1, 2]).astype(np.float32)
     return TrueLens(K_true, dist, map_x, map_y)
@@ -106,6 +126,10 @@ class Cameras:
         self.config = config
         self.render_config = render
         self._renderer: Renderer | None = None
+        c = config
+        self._frame_effects = bool(
+            c.noise_sigma or not c.gain.is_identity or c.exposure or c.defocus_sigma or c.occluder_probability
+        )
 
     def lens(self, camera: str) -> TrueLens:
         self._check(camera)
@@ -119,16 +143,6 @@ class Cameras:
         """A new trial: each camera's per-frame randomness from its own generator."""
         self._rngs = rngs
 
-    def pose_in_world(self, camera: str, data: mujoco.MjData | None = None) -> np.ndarray:
-        """True ``T_world_camera`` (OpenCV frame) in ``data`` (default: the session's) [m]."""
-        self._check(camera)
-        data = self._data if data is None else data
-        cam = self._ids[camera]
-        T = np.eye(4)
-        T[:3, :3] = data.cam_xmat[cam].reshape(3, 3) @ MUJOCO_TO_OPENCV
-        T[:3, 3] = data.cam_xpos[cam]
-        return T
-
     def capture(self, camera: str, time: float) -> CameraImage | None:
         """A frame of a named camera as the true camera delivers it, or None when it drops the frame."""
         self._check(camera)
@@ -141,13 +155,9 @@ class Cameras:
         lens = self._lenses[camera]
         if lens.map_x is not None:
             rgb = cv2.remap(rgb, lens.map_x, lens.map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
-        if self._frame_effects():
+        if self._frame_effects:
             rgb = self._effects(rgb, camera, lens, rng)
         return CameraImage(camera=camera, rgb=rgb, time=time)
-
-    def _frame_effects(self) -> bool:
-        c = self.config
-        return bool(c.noise_sigma or not c.gain.is_identity or c.exposure or c.defocus_sigma or c.occluder_probability)
 
     def _effects(self, rgb: np.ndarray, camera: str, lens: TrueLens, rng: np.random.Generator) -> np.ndarray:
         c = self.config

@@ -1,10 +1,10 @@
 """The arm's joint encoders and what the arm's own kinematics report from them.
 
 A reading is the true joint position plus Gaussian noise drawn once per reading time (a driver
-reports one state per control cycle, so two reads in the same instant agree). The TCP pose is computed
-from that reading by the *nominal* kinematics: with a TCP bias in the cell (the physical gripper offset
-from where the model puts it, :attr:`~twin.reality.ArmReality.tcp_bias`) the reported TCP is not the
-true one, as on a real arm.
+reports one state per control cycle, so two reads in the same instant agree). The TCP pose and the F/T
+sensor's orientation are computed from that reading by the *nominal* kinematics: with a TCP bias in the
+cell (the physical gripper offset from where the model puts it, :attr:`~twin.reality.ArmReality.tcp_bias`)
+the reported TCP is not the true one, as on a real arm.
 """
 
 from __future__ import annotations
@@ -30,19 +30,22 @@ class JointEncoders:
         data: mujoco.MjData,
         arm_qpos: np.ndarray,
         tcp_site: int,
+        ft_site: int,
         nominal_model: mujoco.MjModel,
         noise: float,
         exact: bool,
     ) -> None:
         """``exact``: the cell's kinematics are the nominal ones (no TCP bias) and the encoders noiseless;
-        the TCP pose is then read from the simulation itself."""
+        the TCP pose and F/T orientation are then read from the simulation itself."""
         self._data = data
         self._arm_qpos = arm_qpos
         self._tcp = tcp_site
+        self._ft = ft_site
         self._noise = noise
         self._exact = exact and noise == 0
         self._nominal_model = nominal_model
-        self._nominal_data = mujoco.MjData(nominal_model)
+        self._nominal: mujoco.MjData | None = None  # allocated on first use (never, in exact mode)
+        self._nominal_q: np.ndarray | None = None  # the joint positions it holds the kinematics of
 
     def reset(self, rng: np.random.Generator) -> None:
         self._rng = rng
@@ -62,16 +65,30 @@ class JointEncoders:
 
     def tcp_pose(self) -> np.ndarray:
         """4x4 TCP pose in the base frame as the nominal kinematics compute it from :meth:`positions` [m]."""
-        if self._exact:
-            return _pose(self._data.site_xpos[self._tcp], self._data.site_xmat[self._tcp])
-        return self.nominal_tcp_pose(self.positions())
+        d = self._data if self._exact else self._kinematics(self.positions())
+        return _pose(d.site_xpos[self._tcp], d.site_xmat[self._tcp])
+
+    def ft_rotation(self) -> np.ndarray:
+        """3x3 orientation of the F/T sensor frame in the base frame, by the nominal kinematics from
+        :meth:`positions` (as :meth:`tcp_pose`, so the two agree)."""
+        d = self._data if self._exact else self._kinematics(self.positions())
+        return d.site_xmat[self._ft].reshape(3, 3).copy()
 
     def nominal_tcp_pose(self, q: np.ndarray) -> np.ndarray:
         """The nominal kinematics' TCP pose for joint positions ``q`` [rad] -> [m]."""
-        d = self._nominal_data
-        d.qpos[self._arm_qpos] = q
-        mujoco.mj_kinematics(self._nominal_model, d)
+        d = self._kinematics(np.asarray(q, dtype=float))
         return _pose(d.site_xpos[self._tcp], d.site_xmat[self._tcp])
+
+    def _kinematics(self, q: np.ndarray) -> mujoco.MjData:
+        """The nominal model's data with its kinematics at arm joint positions ``q`` (computed once per ``q``:
+        a control tick asks for the TCP and the F/T orientation of the same reading)."""
+        if self._nominal is None:
+            self._nominal = mujoco.MjData(self._nominal_model)
+        if self._nominal_q is None or not np.array_equal(q, self._nominal_q):
+            self._nominal.qpos[self._arm_qpos] = q
+            mujoco.mj_kinematics(self._nominal_model, self._nominal)
+            self._nominal_q = q.copy()
+        return self._nominal
 
     def get_state(self) -> dict[str, Any]:
         return {"rng": self._rng.bit_generator.state, "time": self._time, "error": self._error.copy()}

@@ -43,6 +43,7 @@ class ForceTorqueSensor:
         self._limits = limits if np.isfinite(limits).any() else None
         resolution = np.array([config.force_resolution] * 3 + [config.torque_resolution] * 3)
         self._resolution = resolution if resolution.any() else None
+        self._step = np.where(resolution > 0, resolution, 1.0)  # quantisation step (1: an unquantised axis)
 
     def reset(self, rng: np.random.Generator) -> None:
         """A new trial: bias and drift direction drawn from ``rng``, no tare, the load sampled now."""
@@ -84,8 +85,7 @@ class ForceTorqueSensor:
         if self._limits is not None:
             value = np.clip(value, -self._limits, self._limits)  # the sensor's raw range, before any tare
         if self._resolution is not None:
-            step = np.where(self._resolution > 0, self._resolution, 1.0)
-            value = np.where(self._resolution > 0, np.round(value / step) * step, value)
+            value = np.where(self._resolution > 0, np.round(value / self._step) * self._step, value)
         return value
 
     def read(self, time: float) -> np.ndarray:
