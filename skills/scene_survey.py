@@ -56,6 +56,10 @@ class SurveyConfig:
     """Time for each move between viewpoints [s]."""
     capture_attempts: int = 3
     """Frames tried before a camera counts as giving nothing (a camera drops frames now and then)."""
+    lid_tolerance: float = 0.01
+    """An overview marker posed farther than this from the lid's plane (the median marker height) is
+    measured again close up [m]: sub-millimetre in height when the pose is right, centimetres when a
+    corner is hidden."""
     close_up_all: bool = False
     """Measure every marker close up, even those the overview posed within bounds."""
 
@@ -127,7 +131,7 @@ class SceneSurvey:
     def locate(self, expected: set[int]) -> dict[int, MarkerDetection]:
         """One detection per expected marker id (see the module docstring), the arm back at rest."""
         found = self._unique(self.overview(), expected)
-        if not self.config.close_up_all and set(found) == expected:
+        if not self.config.close_up_all and set(found) == expected and not self._off_the_lid(found):
             return found
         moved_arm = False
         try:
@@ -136,14 +140,12 @@ class SceneSurvey:
                 moved_arm = True
                 for d in self._search(found, missing):
                     found.setdefault(d.marker_id, d)
-            height = lid_height(found) if found else None
-            for marker, d in sorted(found.items()):
-                if d.camera == OVERVIEW_CAMERA and not self.config.close_up_all:
-                    continue
-                moved_arm = True
-                closer = self._measure_from_above(marker, d.T_base_marker[:2, 3], height)
-                if closer is not None:
-                    found[marker] = closer
+            # close up: what the search found from afar, then (with the lid height those give) every
+            # overview pose off the lid's plane — a marker partly hidden by its own handle post in an
+            # oblique view reprojects well but is posed centimetres deep along the line of sight
+            from_afar = [m for m, d in found.items() if d.camera != OVERVIEW_CAMERA or self.config.close_up_all]
+            moved_arm |= self._refine(found, from_afar)
+            moved_arm |= self._refine(found, self._off_the_lid(found))
         finally:
             if moved_arm:
                 self.toggler.go_rest()
@@ -151,6 +153,27 @@ class SceneSurvey:
         if missing:
             raise MarkersNotFound(missing, (), (OVERVIEW_CAMERA, WRIST_CAMERA))
         return found
+
+    def _refine(self, found: dict[int, MarkerDetection], markers: list[int]) -> bool:
+        """Replace ``markers`` in ``found`` by close-up measurements where seen; True if the arm moved."""
+        height = lid_height(found) if found else None
+        for marker in sorted(markers):
+            closer = self._measure_from_above(marker, found[marker].T_base_marker[:2, 3], height)
+            if closer is not None:
+                found[marker] = closer
+        return bool(markers)
+
+    def _off_the_lid(self, found: dict[int, MarkerDetection]) -> list[int]:
+        """Overview markers posed off the plane of the others by more than ``lid_tolerance`` (all
+        markers of a closed box lie on its lid)."""
+        if len(found) < 2:
+            return []
+        height = lid_height(found)
+        return [
+            m
+            for m, d in found.items()
+            if d.camera == OVERVIEW_CAMERA and abs(d.T_base_marker[2, 3] - height) > self.config.lid_tolerance
+        ]
 
     def _search(self, found: dict[int, MarkerDetection], missing: set[int]) -> list[MarkerDetection]:
         c = self.config
