@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from models.generator import paper_family
-from models.markers import aruco_dictionary
 from models.robot import Robot
+from skills import MarkerDetector
 from twin.errors import ProfileError
 from twin.jams import Jams
 from twin.nominal_calibration import nominal_calibration
@@ -296,11 +296,8 @@ def test_tcp_bias_moves_the_physical_gripper_not_the_reported_tcp():
 
 
 def detect(rgb: np.ndarray) -> dict[int, np.ndarray]:
-    parameters = cv2.aruco.DetectorParameters()
-    parameters.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
-    detector = cv2.aruco.ArucoDetector(aruco_dictionary(), parameters)
-    corners, ids, _ = detector.detectMarkers(cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY))
-    return {} if ids is None else {int(i): c.reshape(4, 2) for i, c in zip(ids.ravel(), corners, strict=True)}
+    """Marker corners by id, as the pipeline's detector finds them [px]."""
+    return {marker_id: corners for corners, marker_id in MarkerDetector().detect_pixels(rgb)}
 
 
 @pytest.fixture(scope="module")
