@@ -29,7 +29,6 @@ import dataclasses
 import time
 from pathlib import Path
 
-import numpy as np
 from _cli import fail, versions, write_json
 
 
@@ -82,124 +81,18 @@ def main(argv: list[str] | None = None) -> int:
     spec, profile = load_inputs(args)
     start = time.perf_counter()
 
-    from models import ModelsError
-    from models.calibration import CameraCalibration, CellCalibration
-    from skills.calibration import (
-        CalibrationConfig,
-        calibrate_intrinsics,
-        detect_board,
-        fixed_camera_pose,
-        hand_eye,
-        pose_error,
-    )
-    from skills.errors import IKFailure, SkillError
-    from skills.kinematics import ArmKinematics
-    from skills.primitives import Toggler
-    from twin.calibration_rig import CalibrationCell, RigConfig, RigError
-    from twin.errors import TwinError
+    from _calibration_run import CellCalibrationError, calibrate_cell
 
-    rng = np.random.default_rng(args.seed)
-    rig_config, calibration_config = RigConfig(), CalibrationConfig()
     try:
-        cell = CalibrationCell(spec, seed=args.seed, reality=profile, config=rig_config)
-    except (ModelsError, TwinError) as err:
-        fail(f"cannot build the cell for spec {spec.name} under profile {profile.name!r}: {one_line(err)}")
-    with cell:
-        robot = cell.robot
-        overview, wrist = cell.overview_camera, cell.wrist_camera
-        try:
-            # 1. intrinsics of the overview camera: the board held in front of it
-            images = []
-            for T_base_board in cell.board_poses_in_front_of(overview, args.overview_views, rng):
-                cell.place_board(T_base_board)
-                images.append(cell.capture(overview).rgb)
-            overview_intrinsics = calibrate_intrinsics(images, calibration_config)
-
-            # 2. its pose: the board at the known place, a few still frames pooled
-            T_base_board = cell.table_place()
-            cell.place_board(T_base_board)
-            frames = []
-            for _ in range(4):
-                frames.append(cell.capture(overview).rgb)
-                robot.wait(0.02)
-            overview_pose = fixed_camera_pose(
-                frames, overview_intrinsics.K, overview_intrinsics.dist, T_base_board, calibration_config
-            )
-
-            # 3. the wrist camera: the board stays, the arm moves; each image's corners found once
-            toggler = Toggler(robot, kinematics=ArmKinematics())
-            wrist_views, tcp_poses, unreachable = [], [], 0
-            for T_base_tcp in cell.wrist_viewpoints(T_base_board, args.wrist_views, rng):
-                try:
-                    toggler.move_to(T_base_tcp, 1.5)
-                except IKFailure:
-                    unreachable += 1
-                    continue
-                robot.wait(0.3)  # still: no motion blur, the servos settled
-                wrist_views.append(detect_board(cell.capture(wrist).rgb, calibration_config))
-                tcp_poses.append(robot.tcp_pose_in_base())
-            toggler.go_rest()
-            wrist_intrinsics = calibrate_intrinsics(wrist_views, calibration_config)
-            wrist_pose = hand_eye(wrist_views, tcp_poses, wrist_intrinsics.K, wrist_intrinsics.dist, calibration_config)
-        except (SkillError, RigError) as err:
-            fail(f"calibration failed: {one_line(err)}", code=1)
-
-        truth = {name: cell.camera_truth(name) for name in (overview, wrist)}
-        made_for = {
-            "profile": cell.session.reality.name,
-            "cell_seed": int(cell.session.reality.cell_seed),
-            "box_height": cell.box_height,
-            "spec": spec.name,
-        }
-
-    source = (
-        f"charuco, profile {made_for['profile']}, cell seed {made_for['cell_seed']}, "
-        f"box height {made_for['box_height']:.4f} m, spec {spec.name}, seed {args.seed}"
-    )
-    figures = {}
-    cameras = {}
-    for name, intrinsics, pose_kind in (
-        (overview, overview_intrinsics, "fixed"),
-        (wrist, wrist_intrinsics, "arm"),
-    ):
-        t = truth[name]
-        if pose_kind == "fixed":
-            T_est, T_true, pose_rms = overview_pose.T_base_camera, t.T_base_camera, overview_pose.rms_px
-        else:
-            T_est, T_true, pose_rms = wrist_pose.T_tcp_camera, t.T_tcp_camera, wrist_pose.rms_px
-        position, angle = pose_error(T_est, T_true)
-        focal = (np.diag(intrinsics.K)[:2] / np.diag(t.K)[:2] - 1.0) * 100.0
-        principal = intrinsics.K[:2, 2] - t.K[:2, 2]
-        figures[name] = {
-            "reprojection_px": intrinsics.rms_px,
-            "pose_reprojection_px": pose_rms,
-            "views": len(intrinsics.views_used),
-            "views_dropped": len(intrinsics.views_dropped),
-            "truth_position_error_mm": position * 1000,
-            "truth_angle_error_deg": float(np.degrees(angle)),
-            "truth_focal_error_pct": focal.tolist(),
-            "truth_principal_error_px": principal.tolist(),
-        }
-        extra = {k: v for k, v in figures[name].items() if not k.startswith("truth")}
-        if pose_kind == "fixed":
-            cameras[name] = CameraCalibration(
-                intrinsics.K, intrinsics.dist, intrinsics.image_size, T_base_camera=T_est,
-                reprojection_error_px=intrinsics.rms_px, extra=extra,
-            )  # fmt: skip
-        else:
-            extra["unreachable_viewpoints"] = unreachable
-            cameras[name] = CameraCalibration(
-                intrinsics.K, intrinsics.dist, intrinsics.image_size, T_tcp_camera=T_est,
-                reprojection_error_px=intrinsics.rms_px, extra=extra,
-            )  # fmt: skip
-    path = CellCalibration(cameras, source=source, cell=made_for).save(args.out)
+        run = calibrate_cell(spec, profile, args.seed, args.overview_views, args.wrist_views)
+    except CellCalibrationError as err:
+        fail(str(err), code=err.exit_code)
+    overview, figures = run.overview, run.figures
+    path = run.calibration.save(args.out)
     settings = {
         "command": "calibrate",
         **{k: str(v) if isinstance(v, Path) else v for k, v in vars(args).items()},
-        "cell": made_for,
-        "profile": profile.to_dict(),
-        "rig": dataclasses.asdict(rig_config),
-        "calibration": dataclasses.asdict(calibration_config),
+        **run.settings,
         "versions": versions(),
     }
     write_json(path.with_name(path.name + ".config.json"), settings)

@@ -1,7 +1,9 @@
-"""Run the paper's symbolic protocols for every agent and compare with the paper's numbers.
+"""Run the paper's symbolic protocols for every agent and compare with the paper's numbers; or sweep
+the reality gap in the twin.
 
     python scripts/experiment.py {variants,episodes,noise,all} --agents memory,dqn,model-based,mt-dqn,mt-model-based \\
         --out DIR [--quick] [--runs R] [--seeds S] [--workers W]
+    python scripts/experiment.py reality --out DIR [--quick] [--runs R] [--memory MEM.sqlite]
 
 Writes ``DIR/<protocol>.json`` (every point, mean and std over training seeds and each seed's value,
 the settings), ``DIR/<protocol>.png`` (success and mean actions, like the paper's Fig. 3 panels) and
@@ -13,6 +15,15 @@ The deep agents (``dqn``, ``model-based``, ``mt-dqn``, ``mt-model-based``; torch
 per agent, training seed and training-variant count, ``--workers`` at a time (default: one per
 core). Every finished job is saved in ``DIR/jobs/`` at once: run the same command again after an
 interruption and it resumes, reusing every finished job.
+
+``reality`` (``scripts/_reality_sweep.py``) runs the memory agent end to end in the twin on the paper
+test boxes at ``--runs`` random reachable placements each (default 4), with each factor of the reality
+gap alone at levels 0 (ideal), 1 (realistic) and 2 (harsh), all factors together, and the F/T force noise
+alone over σ; each profile's cell is calibrated from ChArUco images first. It writes
+``DIR/reality.{json,md,png}`` (success, mean actions, outcome agreement and failure reasons against each
+factor's level; the F/T noise at which outcome agreement drops below 99 %) and keeps every calibration and
+trial in ``DIR/calibrations/`` and ``DIR/trials/``: the same command resumes. ``--memory`` is the memory
+agent's store (default: trained into ``DIR/memory.sqlite`` on the paper training boxes).
 """
 
 from __future__ import annotations
@@ -32,14 +43,15 @@ from learning.experiments.deep_protocols import DEEP_AGENTS, DeepSchedule, jobs_
 from learning.experiments.report import episodes_to_solve_table
 
 PLANNED = ("disassembly",)
+REALITY = "reality"
 ALL = "all"
 AGENTS = (*SYMBOLIC_AGENTS, *DEEP_AGENTS)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("protocol", choices=(*PROTOCOLS, ALL, *PLANNED))
-    parser.add_argument("--agents", required=True, help=f"comma-separated, from {list(AGENTS)}")
+    parser.add_argument("protocol", choices=(*PROTOCOLS, ALL, REALITY, *PLANNED))
+    parser.add_argument("--agents", default=None, help=f"comma-separated, from {list(AGENTS)} (reality: memory)")
     parser.add_argument("--out", required=True, help="output directory (also the resume cache of deep jobs)")
     parser.add_argument("--quick", action="store_true", help="CI size: few runs, one training seed, short schedules")
     parser.add_argument("--runs", type=int, default=None, help="runs per unseen variant (default 50)")
@@ -50,8 +62,15 @@ def main(argv: list[str] | None = None) -> int:
         help="where the deep agents' graph network sees poses: relative (edges, default) or absolute (nodes, "
         "as the authors' release: an ablation)",
     )  # fmt: skip
+    parser.add_argument("--memory", default=None, help="reality: the memory agent's store (default: trained in DIR)")
     args = parser.parse_args(argv)
 
+    if args.protocol == REALITY:
+        return _reality(args)
+    if args.memory is not None:
+        fail("--memory is for the reality protocol (the symbolic protocols train their own)")
+    if args.agents is None:
+        fail(f"protocol {args.protocol!r} needs --agents (comma-separated, from {list(AGENTS)})")
     if args.protocol in PLANNED:
         fail(f"protocol {args.protocol!r} is not available yet; available: {sorted(PROTOCOLS)} and {ALL!r}")
     agents = [a.strip() for a in args.agents.split(",") if a.strip()]
@@ -108,6 +127,32 @@ def main(argv: list[str] | None = None) -> int:
         (out / "all.md").write_text("\n".join(lines))
         print("\n".join(lines))
     print(f"{args.protocol}: {total:.0f} s -> {out}/")
+    return 0
+
+
+def _reality(args: argparse.Namespace) -> int:
+    from _reality_sweep import SweepConfig, run_sweep
+
+    if args.agents not in (None, "memory"):
+        fail(f"the reality protocol runs the memory agent only, got --agents {args.agents}")
+    if args.seeds is not None or args.workers is not None:
+        fail("--seeds and --workers are for the symbolic protocols")
+    config = SweepConfig().quick() if args.quick else SweepConfig()
+    if args.runs is not None:
+        if args.runs < 1:
+            fail(f"--runs must be >= 1, got {args.runs}")
+        config = replace(config, placements=args.runs)
+    memory = None
+    if args.memory is not None:
+        memory = Path(args.memory)
+        if not memory.is_file():
+            fail(f"--memory {memory}: no such file (train one with scripts/train.py, or leave it out)")
+    out = Path(args.out)
+    write_json(out / "reality.config.json", {"command": "experiment", **vars(args), "sweep": asdict(config),
+                                             "versions": versions()})  # fmt: skip
+    summary = run_sweep(out, config, memory)
+    print((out / "reality.md").read_text())
+    print(f"reality: {summary['wall_time_s']:.0f} s -> {out}/")
     return 0
 
 

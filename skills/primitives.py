@@ -77,6 +77,15 @@ class PrimitiveConfig:
     blocked_magnitude: float = 35.0
     """Force magnitude (any direction) that, with little progress, also means a latch [N]: a latched wheel
     or a part pulled along a slightly wrong direction loads the grasp sideways more than along the path."""
+    door_overtravel: float = 0.15
+    """How far past the far end of a door's travel the grasp point is driven (fraction of the travel): a
+    handle pivoting between the pads lags the fingers by up to ~15 mm along an 85 deg door arc, which left
+    doors at ~74 deg, leaning over their neighbours' handles; the joint's end stop takes the rest. Past the
+    travel, a filtered force above ``overtravel_force`` stops the over-travel where the handle is."""
+    overtravel_force: float = 40.0
+    """Filtered force magnitude that ends a door's over-travel [N]: a lagging handle pulled into its end stop
+    loads the grasp with 20-30 N; a handle that follows the fingers closely is pushed towards the safety
+    limit (47 N at 80 deg, then 60 N, with the box 0.34 m from the base)."""
     moved_fraction: float = 0.75
     """Progress that counts as reaching the other state (the twin's hysteresis threshold)."""
     empty_grasp_closure: float = 0.95
@@ -130,6 +139,8 @@ class Toggler:
         """The filtered wrist force after the last tick, in the base frame [N]."""
         self.phase = "moving"
         """What the arm is doing (for the reasons of failed tries)."""
+        self.progress = 0.0
+        """Measured progress of the current toggle's actuation so far (kept when a stop ends it)."""
         self.peak_force = 0.0
         """Largest filtered force magnitude since the last :meth:`reset_force_watch` [N]."""
         self.guard = True
@@ -225,10 +236,11 @@ class Toggler:
         wall = time.perf_counter()
         start_time = self.robot.time
         self.reset_force_watch()
+        self.progress = 0.0
         try:
             result = self._toggle(jm, 1.0 if opening else -1.0)
         except (IKFailure, GraspFailure, SlipDetected, ForceLimitExceeded) as err:
-            result = ToggleResult("failed", reason=f"{type(err).__name__}: {err}")
+            result = ToggleResult("failed", reason=f"{type(err).__name__}: {err}", progress=self.progress)
             self.withdraw()
         result.peak_force = self.peak_force  # over the whole try, withdrawal included
         result.sim_time = self.robot.time - start_time
@@ -273,26 +285,29 @@ class Toggler:
             * np.linalg.norm((jm.grasp_point - jm.origin) - np.dot(jm.grasp_point - jm.origin, jm.axis) * jm.axis)
         )
         lead = c.lead / path_length  # as a fraction of the travel
+        end = 1.0 + (c.door_overtravel if jm.kind == "door" and sign > 0 else 0.0)
         self.ik.set_joints(self.robot.joint_positions())
         for k in range(1, ticks + 1):
-            s = min(k / ticks, max(progress, 0.0) + lead)
+            s = min(end * (k / ticks), max(progress, 0.0) + lead)
             fraction = begin + sign * s
             target = self._pose_along(jm, fraction, at_grasp, begin)
             self._tick(target)
             direction = sign * jm.motion_direction(fraction)
             opposing = float(-np.dot(self.force_in_base, direction))
             forces.append(opposing)
-            progress = self._progress(jm, sign, begin)
+            progress = self.progress = self._progress(jm, sign, begin)
             self._check_grip(progress)
             magnitude = float(np.linalg.norm(self.force_in_base))
+            if s > 1.0 and magnitude > c.overtravel_force:  # past the travel and pushing hard: stop here
+                end = max(1.0, min(progress, s))
             if (opposing > c.blocked_force or magnitude > c.blocked_magnitude) and progress < c.blocked_progress:
                 self.move_to(at_grasp, 0.5)  # back off to where the handle was grasped
                 return ToggleResult(
                     "blocked", "latched: force rose without progress", progress, max(forces), forces=forces
                 )
         for _ in range(round(2 * c.settle_time / c.tick)):  # let the part catch up with the end target
-            progress = self._progress(jm, sign, begin)
-            self._tick(self._pose_along(jm, begin + sign * min(1.0, max(progress, 0.0) + lead), at_grasp, begin))
+            progress = self.progress = self._progress(jm, sign, begin)
+            self._tick(self._pose_along(jm, begin + sign * min(end, max(progress, 0.0) + lead), at_grasp, begin))
         progress = self._progress(jm, sign, begin)
         self._check_grip(progress)
         peak = max(forces)

@@ -12,7 +12,9 @@ missed, saw at a grazing angle or could not pose within the reprojection bound.
 held through the F/T sensor: evidence of a lock) or ``failed`` with its reason (the grasp closed on
 nothing, slipped, IK, the force limit: no evidence). A failed try is retried within ``max_retries``,
 each time after measuring the component's marker again close up (a grasp that missed is most often a
-pose that was off); a component that still fails is reported with ``give_up``, never looped on.
+pose that was off); a component that still fails is reported with ``give_up``, never looped on. A try
+stopped after the grasp carried the handle past ``moved_fraction`` of its travel is checked against the
+overview first: a part that did move is not tried again.
 "moved" is checked against the marker re-observed by the overview camera when the overview trusted
 that marker at the start (a marker that left its closed pose — or vanished, as a door's does when it
 stands open — moved; one still at its closed pose after a "moved" means the handle slipped).
@@ -132,6 +134,10 @@ class TwinWorld:
                 sim_time + result.sim_time,
                 wall_time + result.wall_time,
             )
+            if result.outcome == "failed" and result.progress >= self.toggler.config.moved_fraction:
+                # stopped (force limit, slip) after carrying the handle most of the way: look before retrying
+                if self._sensed_outcome(ToggleResult("moved"), marker, opening).moved:
+                    result.outcome, result.reason = "moved", ""
             if result.outcome != "failed":
                 break
             reasons.append(result.reason)

@@ -80,3 +80,39 @@ def test_quick_all_runs_every_deep_agent_and_resumes_from_its_saved_jobs(tmp_pat
     )  # fmt: skip
     assert trial.returncode == 0, trial.stderr
     assert json.loads((tmp_path / "trial/results.json").read_text())["runs"][0]["num_actions"] >= 5
+
+
+def test_quick_reality_sweep_calibrates_each_cell_runs_placed_boxes_and_resumes(tmp_path):
+    result = experiment("reality", "--out", tmp_path, "--quick")
+    assert result.returncode == 0, result.stderr
+    data = json.loads((tmp_path / "reality.json").read_text())
+    assert {(p["series"], p["level"]) for p in data["points"]} == {("force-torque", 0.0), ("force-torque", 1.0)}
+    for point in data["points"]:
+        assert point["trials"] == 3 and 0.0 <= point["success_rate"] <= 1.0
+        assert point["calibration_reprojection_px"] < 0.5
+        assert len(point["unsolved_reasons"]) == round(3 * (1 - point["success_rate"]))
+    assert (tmp_path / "reality.png").read_bytes().startswith(b"\x89PNG")
+    assert "| force-torque | 1 | 3 |" in (tmp_path / "reality.md").read_text()
+    trials = sorted((tmp_path / "trials").rglob("*.json"))
+    assert len(trials) == 6 and len(list((tmp_path / "calibrations").glob("*.json"))) == 4
+    poses = {(t.name, tuple(json.loads(t.read_text())["box_pose"])) for t in trials}
+    assert len(poses) == 3  # each level meets the same placements (common random numbers)...
+    assert all(0.30 <= x <= 0.60 and abs(y) <= 0.30 for _, (x, y, _) in poses)  # ... drawn in the workspace
+    stamps = [t.stat().st_mtime_ns for t in trials]
+    again = experiment("reality", "--out", tmp_path, "--quick")  # resumes: every trial reused
+    assert again.returncode == 0, again.stderr
+    assert [t.stat().st_mtime_ns for t in trials] == stamps
+    assert json.loads((tmp_path / "reality.json").read_text())["points"] == data["points"]
+
+
+def test_reality_sweep_command_line_mistakes_are_one_line(tmp_path):
+    for args, words in (
+        (("--agents", "dqn"), "memory agent only"),
+        (("--memory", tmp_path / "none.sqlite"), "no such file"),
+        (("--runs", "0"), "--runs"),
+        (("--seeds", "2"), "symbolic protocols"),
+    ):
+        bad = experiment("reality", "--out", tmp_path / "out", *args)
+        assert bad.returncode == 2 and words in bad.stderr and "Traceback" not in bad.stderr, bad.stderr
+    symbolic = experiment("variants", "--out", tmp_path / "out")
+    assert symbolic.returncode == 2 and "needs --agents" in symbolic.stderr
