@@ -90,6 +90,10 @@ class PrimitiveConfig:
     """Progress that counts as reaching the other state (the twin's hysteresis threshold)."""
     empty_grasp_closure: float = 0.95
     """Gripper closure at or above which nothing is between the fingers."""
+    slip_closure_rise: float = 0.02
+    """Rise of the gripper closure over the grasp's that means the handle left the fingers [-]: a held
+    handle lets it creep up to 0.014 over a toggle; a lost one 0.02 within ~0.2 s (the fingers close
+    slowly at a reduced grip force, so :attr:`empty_grasp_closure` came seconds late)."""
     force_filter_samples: int = 5
     """Ticks in the running median of the wrench (5 x 10 ms: a 50 ms window, short beside the 0.13 s
     it took the fastest latched attempt to build up force, long enough that no single sample decides)."""
@@ -141,6 +145,7 @@ class Toggler:
         """What the arm is doing (for the reasons of failed tries)."""
         self.progress = 0.0
         """Measured progress of the current toggle's actuation so far (kept when a stop ends it)."""
+        self._grasp_closure = 1.0
         self.peak_force = 0.0
         """Largest filtered force magnitude since the last :meth:`reset_force_watch` [N]."""
         self.guard = True
@@ -263,7 +268,8 @@ class Toggler:
         self.move_to(at_grasp, c.descend_time)
         self.phase = "grasping"
         self._gripper(1.0, c.close_time)
-        if self.robot.gripper_opening() >= c.empty_grasp_closure:
+        self._grasp_closure = self.robot.gripper_opening()
+        if self._grasp_closure >= c.empty_grasp_closure:
             raise GraspFailure(f"the gripper closed on nothing at {np.round(at_grasp[:3, 3], 3).tolist()}")
 
         self.phase = "actuating"
@@ -286,6 +292,7 @@ class Toggler:
         )
         lead = c.lead / path_length  # as a fraction of the travel
         end = 1.0 + (c.door_overtravel if jm.kind == "door" and sign > 0 else 0.0)
+        progress_at_peak = 0.0
         self.ik.set_joints(self.robot.joint_positions())
         for k in range(1, ticks + 1):
             s = min(end * (k / ticks), max(progress, 0.0) + lead)
@@ -296,7 +303,16 @@ class Toggler:
             opposing = float(-np.dot(self.force_in_base, direction))
             forces.append(opposing)
             progress = self.progress = self._progress(jm, sign, begin)
-            self._check_grip(progress)
+            if opposing >= max(forces):
+                progress_at_peak = progress
+            try:
+                self._check_grip(progress)
+            except SlipDetected:
+                if progress_at_peak < c.blocked_progress and max(forces) >= c.push_force:
+                    # the part held while pulled until the pads slid off its handle: a latch, not a slip
+                    return ToggleResult("blocked", "latched: held until the grasp slipped", progress, max(forces),
+                                        forces=forces)  # fmt: skip
+                raise
             magnitude = float(np.linalg.norm(self.force_in_base))
             if s > 1.0 and magnitude > c.overtravel_force:  # past the travel and pushing hard: stop here
                 end = max(1.0, min(progress, s))
@@ -321,7 +337,8 @@ class Toggler:
         )
 
     def _check_grip(self, progress: float) -> None:
-        if self.robot.gripper_opening() >= self.config.empty_grasp_closure:
+        closure = self.robot.gripper_opening()
+        if closure >= self.config.empty_grasp_closure or closure > self._grasp_closure + self.config.slip_closure_rise:
             raise SlipDetected(f"the handle slipped out of the grasp after {progress:.0%} of the travel")
 
     def _pose_along(self, jm: JointModel, fraction: float, at_grasp: np.ndarray, begin: float) -> np.ndarray:
