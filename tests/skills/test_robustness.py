@@ -19,6 +19,7 @@ from skills import MarkerDetector, joint_model, lid_height, select_markers, upri
 from skills.primitives import PrimitiveConfig, Toggler
 from skills.twin_world import TwinWorld
 from twin.nominal_calibration import nominal_calibration
+from twin.reality import PhysicsReality, RealityProfile
 from twin.session import TwinSession
 
 
@@ -136,3 +137,18 @@ def test_an_opened_door_stands_at_its_full_travel_clear_of_its_neighbours_handle
                 door = session.component_qpos[names.index("door-3")]
                 assert np.degrees(session.data.qpos[door]) > 83.0
         assert session.component_states().tolist() == [1, 1, 1, 1, 1]
+
+
+def test_a_latched_door_whose_handle_slides_out_of_a_weak_grip_is_never_read_as_moved():
+    """With a weak grip (10 N, pad μ 0.25: harsh) a latched door's handle slides up out of the pads with
+    hardly any force: the fingers travelled the arc, the door did not (this read "moved"). The slip is seen
+    from the gripper closing on the lost handle; the try is failed (no evidence) or, when the pull was
+    felt first, blocked."""
+    weak_grip = RealityProfile(name="weak-grip", physics=PhysicsReality(pad_friction=0.25, grip_force_scale=1 / 3))
+    spec = placed(paper_family("test", seed=0)[1], (0.331, 0.222, 2.574))  # where it was seen, realistic seed 1006
+    with TwinSession(spec, seed=0, reality=weak_grip) as session:
+        world = twin_world(session)
+        door = spec.components[spec.index_of("door-3")]  # locked closed while slide-2 is closed
+        result = world.try_toggle(world.markers.index(door.marker))
+        assert result.outcome in ("failed", "blocked") and "slipped" in result.reason, result
+        assert world.log[-1].true_moved is False and world.states.tolist() == [0] * 5
