@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from _cli import one_line
 
 from models import ModelsError
 from models.calibration import CameraCalibration, CellCalibration
@@ -47,10 +48,6 @@ class CellCalibrationRun:
     settings: dict[str, Any]
     overview: str
     wrist: str
-
-
-def one_line(err: Exception) -> str:
-    return " ".join(line.strip() for line in str(err).splitlines())
 
 
 def calibrate_cell(

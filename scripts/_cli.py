@@ -29,6 +29,11 @@ def write_json(path: Path, data: Any) -> Path:
     return write_text_atomically(path, dumps_compact(data) if isinstance(data, dict) else json.dumps(data, indent=2))
 
 
+def one_line(err: Exception) -> str:
+    """An error's message on one line (for ``fail`` and logs)."""
+    return " ".join(line.strip() for line in str(err).splitlines())
+
+
 def fail(message: str, code: int = 2) -> None:
     """Print ``error: message`` on stderr and exit (no traceback for a user's mistake)."""
     print(f"error: {message}", file=sys.stderr)

@@ -29,7 +29,7 @@ import dataclasses
 import time
 from pathlib import Path
 
-from _cli import fail, versions, write_json
+from _cli import fail, one_line, versions, write_json
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -51,10 +51,6 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     if args.out.exists() and args.out.is_dir():
         fail(f"--out {args.out} is a directory; give a file name")
     return args
-
-
-def one_line(err: Exception) -> str:
-    return " ".join(line.strip() for line in str(err).splitlines())
 
 
 def load_inputs(args: argparse.Namespace):

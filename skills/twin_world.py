@@ -136,7 +136,7 @@ class TwinWorld:
             )
             if result.outcome == "failed" and result.progress >= self.toggler.config.moved_fraction:
                 # stopped (force limit, slip) after carrying the handle most of the way: look before retrying
-                if self._sensed_outcome(ToggleResult("moved"), marker, opening).moved:
+                if self._overview_verdict(marker, opening).moved:
                     result.outcome, result.reason = "moved", ""
             if result.outcome != "failed":
                 break
@@ -170,6 +170,11 @@ class TwinWorld:
     def _sensed_outcome(self, result: ToggleResult, marker: int, opening: bool) -> TryResult:
         if result.outcome != "moved":
             return TryResult(result.outcome, result.reason)
+        return self._overview_verdict(marker, opening)
+
+    def _overview_verdict(self, marker: int, opening: bool) -> TryResult:
+        """Whether the overview agrees that ``marker``'s part moved (``moved``) or shows it where it was
+        (``failed``: slipped); ``moved`` when the overview has no trusted view of it."""
         if marker not in self.seen_by_overview:
             return TryResult("moved")  # no view to check against: the primitive's progress decides
         seen = [d.planar_pose for d in self.survey.overview() if d.marker_id == marker]
