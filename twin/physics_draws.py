@@ -54,17 +54,14 @@ def apply_physics(
 ) -> bool:
     """Scale the model's fields by ``draw``; True if anything changed (then call ``mj_setConst``)."""
     changed = False
-    if config.pad_friction is not None or np.any(draw.friction != 1):
-        # the handle geoms have priority 2: their friction is the handle/pad contact's (DESIGN.md)
+    if config.pad_friction is not None or np.any(draw.friction != 1) or config.grip_force_scale != 1.0:
+        # the handle geoms have priority 2: their friction is the handle/pad contact's (DESIGN.md). A weaker
+        # grip is applied as the pad friction it leaves: what holds a handle is the friction capacity
+        # 2 mu N, and scaling mu by the grip's factor scales it as scaling N would. (Scaling the gripper
+        # servo itself does not model a weaker grip: the robosuite linkage's passive resistance then
+        # stalls the fingers short of a 12 mm post — at 1/3 they stopped 5 mm off it and crept on.)
         base = model.geom_friction[handle_geoms, 0] if config.pad_friction is None else config.pad_friction
-        model.geom_friction[handle_geoms, 0] = base * draw.friction
-        changed = True
-    if config.grip_force_scale != 1.0:
-        # scale the servo's stiffness, damping and force limit alike: the same target, a weaker grip
-        s = config.grip_force_scale
-        model.actuator_gainprm[gripper_actuator, 0] *= s
-        model.actuator_biasprm[gripper_actuator, 1:3] *= s
-        model.actuator_forcerange[gripper_actuator] *= s
+        model.geom_friction[handle_geoms, 0] = base * draw.friction * config.grip_force_scale
         changed = True
     if np.any(draw.joint_damping != 1) or np.any(draw.joint_friction != 1):
         model.dof_damping[component_dofs] *= draw.joint_damping

@@ -223,7 +223,9 @@ class PhysicsReality:
     """Sliding friction μ of the handle/pad contact before :attr:`friction_scale` [-]; None: the
     model's (1.0, chosen to hold the handles, DESIGN.md)."""
     grip_force_scale: float = 1.0
-    """Gripper force relative to the model's full-force grip, taken as the datasheet's 30 N [-]."""
+    """Gripper force relative to the model's full-force grip, taken as the datasheet's 30 N [-]. Applied
+    as the handle/pad friction it leaves (the holding capacity 2 mu N scales with it), the fingers closing
+    as the nominal servo closes them."""
     joint_damping_scale: ScaleRange = IDENTITY
     """Multiplier of each component joint's viscous damping [-]."""
     joint_friction_scale: ScaleRange = IDENTITY

@@ -436,14 +436,16 @@ def test_physics_scales_change_the_compiled_model():
         for c in SPEC.components:
             names = s.scene.names.components[c.name]
             handle, joint, body = m.geom(names.handle).id, m.joint(names.joint), m.body(names.body).id
-            assert m.geom_friction[handle, 0] == 2 * nominal.geom_friction[handle, 0]
+            # friction x2 and half the grip: the pad friction that holds a handle is unchanged (2 x 0.5)
+            assert m.geom_friction[handle, 0] == pytest.approx(nominal.geom_friction[handle, 0])
             assert m.dof_damping[joint.dofadr[0]] == 2 * nominal.dof_damping[joint.dofadr[0]]
             assert m.dof_frictionloss[joint.dofadr[0]] == 2 * nominal.dof_frictionloss[joint.dofadr[0]]
             assert m.body_mass[body] == 2 * nominal.body_mass[body]
             latch = m.equality(names.latch).id
             assert m.eq_solref[latch, 0] == 2 * nominal.eq_solref[latch, 0]
-        a = s.gripper_actuator
-        np.testing.assert_array_equal(m.actuator_forcerange[a], 0.5 * nominal.actuator_forcerange[a])
+        a = s.gripper_actuator  # the fingers still close as the nominal servo closes them
+        np.testing.assert_array_equal(m.actuator_forcerange[a], nominal.actuator_forcerange[a])
+        np.testing.assert_array_equal(m.actuator_gainprm[a], nominal.actuator_gainprm[a])
     with session(profile(physics=PhysicsReality(pad_friction=0.4))) as s:
         handle = s.model.geom(s.scene.names.components["door-0"].handle).id
         assert s.model.geom_friction[handle, 0] == 0.4
