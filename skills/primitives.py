@@ -90,10 +90,13 @@ class PrimitiveConfig:
     """Progress that counts as reaching the other state (the twin's hysteresis threshold)."""
     empty_grasp_closure: float = 0.95
     """Gripper closure at or above which nothing is between the fingers."""
-    slip_closure_rise: float = 0.02
-    """Rise of the gripper closure over the grasp's that means the handle left the fingers [-]: a held
-    handle lets it creep up to 0.014 over a toggle; a lost one 0.02 within ~0.2 s (the fingers close
-    slowly at a reduced grip force, so :attr:`empty_grasp_closure` came seconds late)."""
+    slip_closure_rise: float = 0.012
+    """Rise of the gripper closure within :attr:`slip_window` that means the handle left the fingers [-]:
+    a lost handle lets the fingers close 0.02 within ~0.2 s (slowly at a reduced grip force, so
+    :attr:`empty_grasp_closure` came seconds late), while a held one creeps steadily, 0.003 per 0.25 s at
+    the harsh 10 N grip, up to 0.02 over a whole toggle (a rise over the grasp's closure misread that)."""
+    slip_window: float = 0.25
+    """Time over which the closure's rise is measured [s]."""
     force_filter_samples: int = 5
     """Ticks in the running median of the wrench (5 x 10 ms: a 50 ms window, short beside the 0.13 s
     it took the fastest latched attempt to build up force, long enough that no single sample decides)."""
@@ -146,6 +149,7 @@ class Toggler:
         self.progress = 0.0
         """Measured progress of the current toggle's actuation so far (kept when a stop ends it)."""
         self._grasp_closure = 1.0
+        self._closures: collections.deque[float] = collections.deque()
         self.peak_force = 0.0
         """Largest filtered force magnitude since the last :meth:`reset_force_watch` [N]."""
         self.guard = True
@@ -269,6 +273,7 @@ class Toggler:
         self.phase = "grasping"
         self._gripper(1.0, c.close_time)
         self._grasp_closure = self.robot.gripper_opening()
+        self._closures = collections.deque([self._grasp_closure], maxlen=max(2, round(c.slip_window / c.tick) + 1))
         if self._grasp_closure >= c.empty_grasp_closure:
             raise GraspFailure(f"the gripper closed on nothing at {np.round(at_grasp[:3, 3], 3).tolist()}")
 
@@ -324,8 +329,8 @@ class Toggler:
         for _ in range(round(2 * c.settle_time / c.tick)):  # let the part catch up with the end target
             progress = self.progress = self._progress(jm, sign, begin)
             self._tick(self._pose_along(jm, begin + sign * min(end, max(progress, 0.0) + lead), at_grasp, begin))
+            self._check_grip(progress)
         progress = self._progress(jm, sign, begin)
-        self._check_grip(progress)
         peak = max(forces)
         if progress >= c.moved_fraction:
             return ToggleResult("moved", "", progress, peak, forces=forces)
@@ -338,7 +343,8 @@ class Toggler:
 
     def _check_grip(self, progress: float) -> None:
         closure = self.robot.gripper_opening()
-        if closure >= self.config.empty_grasp_closure or closure > self._grasp_closure + self.config.slip_closure_rise:
+        self._closures.append(closure)
+        if closure >= self.config.empty_grasp_closure or closure > min(self._closures) + self.config.slip_closure_rise:
             raise SlipDetected(f"the handle slipped out of the grasp after {progress:.0%} of the travel")
 
     def _pose_along(self, jm: JointModel, fraction: float, at_grasp: np.ndarray, begin: float) -> np.ndarray:
