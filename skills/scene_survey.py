@@ -78,6 +78,8 @@ class SceneSurvey:
         self.robot, self.calibration, self.toggler = robot, calibration, toggler
         self.detector = detector or MarkerDetector()
         self.config = config or SurveyConfig()
+        self.last_close_up_reached = False
+        """Whether the last close-up look got the wrist camera above its marker."""
 
     # -- single looks ------------------------------------------------------------------------------
     def look(self, camera: str) -> list[MarkerDetection]:
@@ -115,14 +117,16 @@ class SceneSurvey:
 
     def close_up(self, marker: int, planar_pose: np.ndarray, height: float | None = None) -> MarkerDetection | None:
         """``marker`` measured from straight above its believed ``[x, y, yaw]`` at marker ``height`` [m],
-        the arm back at rest after; None if not seen."""
+        the arm back at rest after; None if not seen (:attr:`last_close_up_reached` tells whether the
+        camera got there)."""
         found = self._measure_from_above(marker, planar_pose, height)
         self.toggler.go_rest()
         return found
 
     def _measure_from_above(self, marker: int, xy: np.ndarray, height: float | None) -> MarkerDetection | None:
         z = height if height is not None else self.config.table_height
-        if not self._wrist_from_above(np.array([xy[0], xy[1], z]), self.config.close_up_height):
+        self.last_close_up_reached = self._wrist_from_above(np.array([xy[0], xy[1], z]), self.config.close_up_height)
+        if not self.last_close_up_reached:
             return None
         seen = [d for d in self.look(WRIST_CAMERA) if d.marker_id == marker]
         return min(seen, key=lambda d: d.view_angle) if seen else None

@@ -15,9 +15,10 @@ each time after measuring the component's marker again close up (a grasp that mi
 pose that was off); a component that still fails is reported with ``give_up``, never looped on. A try
 stopped after the grasp carried the handle past ``moved_fraction`` of its travel is checked against the
 overview first: a part that did move is not tried again.
-"moved" is checked against the marker re-observed by the overview camera when the overview trusted
-that marker at the start (a marker that left its closed pose — or vanished, as a door's does when it
-stands open — moved; one still at its closed pose after a "moved" means the handle slipped).
+"moved" is checked against the marker re-observed — by the overview camera when the overview trusted
+that marker at the start, else close up from the wrist camera — (a marker that left its closed pose, or
+vanished, as a door's does when it stands open, moved; one still at its closed pose after a "moved"
+means the handle slipped out of the pads: with a weak grip a latched door's did, with hardly any force).
 
 :attr:`TwinWorld.log` records each try as sensed and — only when an evaluator passes
 ``ground_truth`` — the simulator's truth beside it, for scoring.
@@ -176,13 +177,30 @@ class TwinWorld:
         """Whether the overview agrees that ``marker``'s part moved (``moved``) or shows it where it was
         (``failed``: slipped); ``moved`` when the overview has no trusted view of it."""
         if marker not in self.seen_by_overview:
-            return TryResult("moved")  # no view to check against: the primitive's progress decides
+            return self._close_up_verdict(marker, opening)
         seen = [d.planar_pose for d in self.survey.overview() if d.marker_id == marker]
         if not seen:
             # a door standing open shows its marker edge-on: it left its closed pose; anything else
             # hidden (the arm?) leaves the primitive's verdict standing
             return TryResult("moved")
-        delta = seen[0] - self.closed_poses[marker]
+        return self._verdict(seen[0], marker, opening)
+
+    def _close_up_verdict(self, marker: int, opening: bool) -> TryResult:
+        """As :meth:`_overview_verdict` for a marker the overview does not see well, from the wrist camera
+        straight above the marker's closed pose: a weakly held handle can slide out of the pads while the
+        fingers travel the whole path with hardly any force (a latched door at a 10 N grip), and only a
+        look tells that from a move. Not seen there: an opened part left its closed pose (a door's marker
+        stands edge-on), a closed one did not come back; the arm out of reach leaves the primitive's
+        verdict standing."""
+        seen = self.survey.close_up(marker, self.closed_poses[marker], self.lid_height)
+        if seen is None:
+            if opening or not self.survey.last_close_up_reached:
+                return TryResult("moved")
+            return TryResult("failed", "the handle moved but the part is not back at its closed pose: slipped")
+        return self._verdict(seen.planar_pose, marker, opening)
+
+    def _verdict(self, pose: np.ndarray, marker: int, opening: bool) -> TryResult:
+        delta = pose - self.closed_poses[marker]
         turn = abs((delta[2] + math.pi) % (2 * math.pi) - math.pi)
         away = bool(np.linalg.norm(delta[:2]) > MOVED_DISTANCE or turn > MOVED_ANGLE)
         if away == opening:
