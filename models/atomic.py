@@ -1,19 +1,40 @@
-"""Atomic file writes: a crash or an interrupted run never leaves a half-written file behind."""
+"""Atomic file writes: a crash or an interrupted run never leaves a half-written file behind.
+
+The data goes to a temporary file with a unique name in the target's directory (so two writers of one
+path never share a temporary, and the rename stays on one file system), is flushed to disk (``fsync``)
+and then renamed over the target in one step (``os.replace``). A failed write removes its temporary.
+"""
 
 from __future__ import annotations
 
+import contextlib
+import os
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
+_UMASK = os.umask(0o022)
+os.umask(_UMASK)  # read once: a file written atomically gets the permissions a plain open() would give it
+
 
 def write_atomically(path: str | Path, write: Callable[[Path], object]) -> Path:
-    """Call ``write(tmp)`` on a temporary file beside ``path`` (parents created), then rename it to
-    ``path`` in one step."""
+    """Call ``write(tmp)`` on a fresh temporary file beside ``path`` (parents created), flush it to disk,
+    then rename it to ``path`` in one step; on any error the temporary is removed and the error raised."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    write(tmp)
-    tmp.replace(path)
+    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    tmp = Path(name)
+    try:
+        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes it 0600
+        write(tmp)
+        with open(tmp, "rb+") as f:
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
+        raise
     return path
 
 
