@@ -16,14 +16,21 @@ calibration, exact only under ``ideal``); a calibration made for another cell (a
 
 Run ``r`` on every spec uses seed ``S + r`` for the world (component order, faults) and the agent.
 ``DIR/config.json`` records the resolved arguments and package versions, so the result can be re-run.
+Each run's record is written to ``DIR/runs/`` the moment it ends and ``results.json`` is rewritten
+from the records (``runs_done`` of ``runs_planned``): a crash, a kill or Ctrl-C (SIGINT or SIGTERM: stop
+after the current run; twice: at once) keeps every finished run, and ``--resume`` continues them. A
+directory that holds results is refused unless ``--resume`` (same arguments) or ``--force`` (start over).
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
-from _cli import fail, versions, write_json
+from _cli import fail
+from _interrupt import StopRequests
+from _run_store import RunStore
 from tqdm import tqdm
 
 from learning import AGENT_NAMES, LearningError, SymbolicWorld, make_agent, run_episode, summarise
@@ -61,6 +68,33 @@ def twin_figures(runs: list) -> dict:
     }
 
 
+def _run(args, spec, seed, memory, reality, calibration, out: Path, n_jobs: int) -> dict:
+    """One run's record (a dict: the contract's run entry)."""
+    try:
+        if args.sim == "twin":
+            from _twin_trial import run_twin_trial  # MuJoCo and rendering only when asked
+
+            name = "rollout.mp4" if n_jobs == 1 else f"rollout-{spec.name}-s{seed}.mp4"
+            video = out / name if args.video else None
+            return run_twin_trial(
+                spec, seed, args.agent, memory, args.max_actions, video, args.checkpoint, reality, calibration
+            )
+        agent = make_agent(args.agent, spec, memory, args.checkpoint)
+        return run_episode(agent, SymbolicWorld(spec, seed), spec.name, seed,
+                           args.max_actions).to_dict()  # fmt: skip
+    except (LearningError, ModelsError, SkillError, TwinError) as err:
+        fail(f"{spec.name} seed {seed}: {err}")
+        raise  # unreachable: fail exits
+
+
+def _results(runs: list[dict], args, planned: int) -> dict:
+    results = summarise(runs, args.max_actions)
+    if args.sim == "twin":
+        results.update(twin_figures(runs))
+    results["runs_done"], results["runs_planned"] = len(runs), planned
+    return results
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--specs", nargs="+", required=True, help="puzzle spec files")
@@ -77,11 +111,15 @@ def main(argv: list[str] | None = None) -> int:
         "--reality", default="ideal", help="twin reality profile: ideal, realistic, harsh or a JSON file"
     )
     parser.add_argument("--calibration", default=None, help="camera calibration from scripts/calibrate.py (twin)")
+    parser.add_argument("--resume", action="store_true", help="continue the runs already in --out (same arguments)")
+    parser.add_argument("--force", action="store_true", help="delete the results already in --out first")
     args = parser.parse_args(argv)
     # The memory is read, never written, during trials: evaluation does not change what was learned.
 
     if args.runs < 1 or args.max_actions < 1:
         fail("--runs and --max-actions must be >= 1")
+    if args.seed < 0:
+        fail(f"--seed must be >= 0, got {args.seed}")
     if args.agent not in AGENT_NAMES:
         fail(f"unknown agent {args.agent!r}. Available agents: {sorted(AGENT_NAMES)}")
     if (args.agent == "memory") != (args.memory is not None):
@@ -119,30 +157,32 @@ def main(argv: list[str] | None = None) -> int:
         fail(str(err))
 
     out = Path(args.out)
-    write_json(out / "config.json", {"command": "trial", **vars(args), "versions": versions()})
-    runs = []
-    jobs = [(spec, args.seed + r) for spec in specs for r in range(args.runs)]
-    for spec, seed in tqdm(jobs, desc=f"{args.agent} {args.sim} trials", unit="run", disable=None):
+    experiment = {"command": "trial", **{k: v for k, v in vars(args).items() if k not in ("out", "resume", "force")}}
+    store = RunStore(out, experiment, resume=args.resume, force=args.force)
+    jobs = [(i, spec, args.seed + r) for i, spec in enumerate(specs) for r in range(args.runs)]
+    runs: list[dict] = []
+    with StopRequests("run") as stop:
         try:
-            if args.sim == "twin":
-                from _twin_trial import run_twin_trial  # MuJoCo and rendering only when asked
-
-                name = "rollout.mp4" if len(jobs) == 1 else f"rollout-{spec.name}-s{seed}.mp4"
-                video = out / name if args.video else None
-                runs.append(
-                    run_twin_trial(
-                        spec, seed, args.agent, memory, args.max_actions, video, args.checkpoint, reality, calibration
-                    )
-                )
-            else:
-                agent = make_agent(args.agent, spec, memory, args.checkpoint)
-                runs.append(run_episode(agent, SymbolicWorld(spec, seed), spec.name, seed, args.max_actions))
-        except (LearningError, ModelsError, SkillError, TwinError) as err:
-            fail(f"{spec.name} seed {seed}: {err}")
-    results = summarise(runs, args.max_actions)
-    if args.sim == "twin":
-        results.update(twin_figures(runs))
-    write_json(out / "results.json", results)
+            for i, spec, seed in tqdm(jobs, desc=f"{args.agent} {args.sim} trials", unit="run", disable=None):
+                if stop.requested:
+                    break
+                key = f"{i:03d}-{spec.name}-seed{seed}"
+                record = store.get(key)
+                if record is None:
+                    record = _run(args, spec, seed, memory, reality, calibration, out, len(jobs))
+                    store.put(key, record)
+                runs.append(record)
+                store.write_results(_results(runs, args, len(jobs)))
+        except KeyboardInterrupt:
+            stop.requested = True
+    results = _results(runs, args, len(jobs))
+    store.write_results(results)
+    if len(runs) < len(jobs):
+        print(
+            f"stopped: {len(runs)} of {len(jobs)} run(s) kept in {out}; continue with the same command and --resume",
+            file=sys.stderr,
+        )
+        return 130
     print(
         f"{args.agent} on {len(specs)} spec(s) x {args.runs} run(s): success {results['success_rate']:.1%}, "
         f"mean actions {results['mean_actions']:.2f} -> {out / 'results.json'}"

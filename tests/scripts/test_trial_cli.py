@@ -160,3 +160,93 @@ def test_twin_trial_refuses_a_calibration_made_for_another_cell(tmp_path):
         assert what in result.stderr and "scripts/calibrate.py --reality" in result.stderr
         assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1
         assert not (out / "results.json").exists()
+
+
+# -- nothing lost: records written as runs end, resume, interrupts ---------------------------------------
+
+
+def _without_times(value):
+    """A results object with its wall-clock fields removed (the only part a rerun may change)."""
+    if isinstance(value, dict):
+        return {k: _without_times(v) for k, v in value.items() if "wall" not in k}
+    if isinstance(value, list):
+        return [_without_times(v) for v in value]
+    return value
+
+
+def _symbolic_trial(specs, out, runs, *extra):
+    return [
+        sys.executable, ROOT / "scripts/trial.py", "--specs", *sorted(specs.glob("*.json")), "--sim", "symbolic",
+        "--agent", "dual", "--runs", runs, "--seed", 3, "--max-actions", 30, "--out", out, *extra,
+    ]  # fmt: skip
+
+
+def _wait_for_records(out: Path, at_least: int, proc: subprocess.Popen) -> None:
+    import time
+
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and proc.poll() is None:
+        if (out / "runs").is_dir() and len(list((out / "runs").glob("*.json"))) >= at_least:
+            return
+        time.sleep(0.02)
+    raise AssertionError(f"the trial ended or stalled before writing {at_least} records")
+
+
+def test_a_killed_trial_resumes_with_no_run_lost_or_duplicated(tmp_path):
+    import signal
+
+    specs = tmp_path / "specs"
+    assert run(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", specs).returncode == 0
+    whole = tmp_path / "whole"
+    assert subprocess.run(list(map(str, _symbolic_trial(specs, whole, 60))), capture_output=True).returncode == 0
+    for k, at in enumerate((1, 47, 133)):  # SIGKILL at three moments: nothing is flushed on the way out
+        out = tmp_path / f"killed{k}"
+        proc = subprocess.Popen(list(map(str, _symbolic_trial(specs, out, 60))), stderr=subprocess.DEVNULL)
+        _wait_for_records(out, at, proc)
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+        kept = len(list((out / "runs").glob("*.json")))
+        assert kept >= at and not list(out.rglob("*.tmp")), "a kill leaves only whole records"
+        refused = subprocess.run(list(map(str, _symbolic_trial(specs, out, 60))), capture_output=True, text=True)
+        assert refused.returncode == 2 and "--resume" in refused.stderr and "Traceback" not in refused.stderr
+        resumed = subprocess.run(list(map(str, _symbolic_trial(specs, out, 60, "--resume"))), capture_output=True)
+        assert resumed.returncode == 0
+        got, want = (json.loads((d / "results.json").read_text()) for d in (out, whole))
+        assert len(got["runs"]) == 180 and got["runs_done"] == got["runs_planned"] == 180
+        assert _without_times(got) == _without_times(want)
+
+
+def test_sigterm_stops_after_the_current_run_and_says_how_to_resume(tmp_path):
+    import signal
+
+    specs = tmp_path / "specs"
+    assert run(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", specs).returncode == 0
+    out = tmp_path / "out"
+    proc = subprocess.Popen(list(map(str, _symbolic_trial(specs, out, 200))), stderr=subprocess.PIPE, text=True)
+    _wait_for_records(out, 5, proc)
+    proc.send_signal(signal.SIGTERM)
+    _, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "--resume" in stderr and "Traceback" not in stderr
+    results = json.loads((out / "results.json").read_text())
+    kept = sorted((out / "runs").glob("*.json"))
+    assert 5 <= results["runs_done"] == len(results["runs"]) == len(kept) < results["runs_planned"] == 600
+
+
+def test_an_output_directory_of_another_configuration_is_refused_unless_forced(tmp_path):
+    specs = tmp_path / "specs"
+    assert run(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", specs).returncode == 0
+    out = tmp_path / "out"
+    assert subprocess.run(list(map(str, _symbolic_trial(specs, out, 2))), capture_output=True).returncode == 0
+    other = subprocess.run(list(map(str, _symbolic_trial(specs, out, 3, "--resume"))), capture_output=True, text=True)
+    assert other.returncode == 2 and "differs in runs" in other.stderr
+    forced = subprocess.run(list(map(str, _symbolic_trial(specs, out, 3, "--force"))), capture_output=True, text=True)
+    assert forced.returncode == 0
+    assert json.loads((out / "config.json").read_text())["runs"] == 3
+    assert len(list((out / "runs").glob("*.json"))) == 9
+    a_file = tmp_path / "a-file"
+    a_file.write_text("")
+    on_file = subprocess.run(list(map(str, _symbolic_trial(specs, a_file, 1))), capture_output=True, text=True)
+    assert on_file.returncode == 2 and "is a file" in on_file.stderr and "Traceback" not in on_file.stderr
+    negative = subprocess.run(list(map(str, _symbolic_trial(specs, tmp_path / "n", 1, "--seed", -1))),
+                              capture_output=True, text=True)  # fmt: skip
+    assert negative.returncode == 2 and "error: --seed must be >= 0, got -1" in negative.stderr

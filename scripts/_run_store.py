@@ -1,0 +1,82 @@
+"""A results directory written as it is produced, and resumable.
+
+Layout of ``DIR``: ``config.json`` (the experiment's resolved arguments, written first), ``runs/KEY.json``
+(one record per finished run, each written atomically the moment the run ends) and ``results.json``
+(the summary, rewritten from the records after every run, with ``runs_done`` of ``runs_planned``).
+A crash, a kill or Ctrl-C keeps every finished run; ``--resume`` continues a directory of the same
+configuration, skipping what is there; ``--force`` empties one that holds anything else. Without either,
+a directory holding results is refused, so no directory ever describes one experiment and holds
+another's numbers.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+from typing import Any
+
+from _cli import fail, versions, write_json
+
+RECORDS = "runs"
+
+
+class RunStore:
+    """See the module docstring. ``experiment`` is what defines the results (the resolved arguments without
+    the output flags); ``resume``/``force`` are the command line's."""
+
+    def __init__(self, out: Path, experiment: dict[str, Any], resume: bool = False, force: bool = False) -> None:
+        if resume and force:
+            fail("--resume continues a directory, --force empties it: give one")
+        if out.exists() and not out.is_dir():
+            fail(f"--out {out} is a file, not a directory")
+        self.out, self.experiment = out, experiment
+        self.records_dir = out / RECORDS
+        config_path = out / "config.json"
+        holds = [p for p in (config_path, out / "results.json") if p.exists()] + self._record_paths()
+        if holds and not force:
+            old = self._read_config(config_path)
+            if not resume:
+                fail(
+                    f"--out {out} already holds results ({len(self._record_paths())} run(s)): add --resume to "
+                    "continue them (same configuration) or --force to delete them and start over"
+                )
+            if old != experiment:
+                changed = sorted(k for k in set(old) | set(experiment) if old.get(k) != experiment.get(k))
+                fail(f"--resume: {out} holds another configuration (differs in {', '.join(changed)}); use --force")
+        if force:
+            shutil.rmtree(self.records_dir, ignore_errors=True)
+            (out / "results.json").unlink(missing_ok=True)
+        try:
+            write_json(config_path, {**experiment, "versions": versions()})
+        except OSError as err:
+            fail(f"--out {out}: cannot write there ({err.strerror})")
+
+    def _record_paths(self) -> list[Path]:
+        return sorted(self.records_dir.glob("*.json")) if self.records_dir.is_dir() else []
+
+    @staticmethod
+    def _read_config(path: Path) -> dict[str, Any]:
+        try:
+            config = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, json.JSONDecodeError):
+            return {}
+        config.pop("versions", None)
+        return config
+
+    def get(self, key: str) -> dict[str, Any] | None:
+        """The record of run ``key`` if it finished earlier, else None."""
+        path = self.records_dir / f"{key}.json"
+        if not path.exists():
+            return None
+        try:
+            return json.loads(path.read_text(encoding="utf-8"))
+        except json.JSONDecodeError:
+            return None  # cannot happen with atomic writes; rerun the run rather than trust it
+
+    def put(self, key: str, record: dict[str, Any]) -> None:
+        """Keep the record of a finished run (atomically: a kill leaves it whole or absent)."""
+        write_json(self.records_dir / f"{key}.json", record)
+
+    def write_results(self, results: dict[str, Any]) -> Path:
+        return write_json(self.out / "results.json", results)
