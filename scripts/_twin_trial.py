@@ -59,6 +59,10 @@ class TrueForceWatch:
         hanging = m.body_subtreemass[m.site_bodyid[self._site]]  # the flange and the gripper: 7.37 N of weight
         self._weight_in_base = hanging * m.opt.gravity
         self.peak = 0.0
+        self.peak_during = ""
+        """What the arm was doing at the peak (from :attr:`doing`)."""
+        self.doing: Any = lambda: "surveying"
+        """Callable naming what the arm is doing, for :attr:`peak_during`."""
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._robot, name)
@@ -67,7 +71,9 @@ class TrueForceWatch:
         self._robot.wait(seconds)
         load_in_base = self._session.data.site_xmat[self._site].reshape(3, 3) @ self._session.ft.load()[:3]
         external = load_in_base - self._weight_in_base
-        self.peak = max(self.peak, float(np.linalg.norm(external)))
+        magnitude = float(np.linalg.norm(external))
+        if magnitude > self.peak:
+            self.peak, self.peak_during = magnitude, self.doing()
 
 
 def annotate(frame: np.ndarray, detector: MarkerDetector) -> np.ndarray:
@@ -121,6 +127,7 @@ def run_twin_trial(
                 ground_truth=lambda m: int(session.component_states()[by_marker[m]]),
                 names={c.marker: c.name for c in spec.components},
             )
+            watch.doing = lambda: f"{world.toggler.phase}, action {len(world.log) + 1}"
             for c in spec.components:  # perceived closed pose against the simulator's (evaluation only)
                 truth = session.data.site(session.scene.names.components[c.name].frame_site).xpos
                 pose_errors[c.name] = float(np.linalg.norm(world.closed_poses[c.marker][:2] - truth[:2]))
@@ -142,6 +149,7 @@ def run_twin_trial(
     entry["box_pose"] = list(session.box_pose)
     entry["reality"] = session.reality.name
     entry["peak_true_wrist_force_n"] = watch.peak
+    entry["peak_true_wrist_force_during"] = watch.peak_during
     entry["timeline"] = [
         {**asdict(a), "component": spec.components[by_marker[a.marker]].name,
          "pose_error_m": pose_errors.get(spec.components[by_marker[a.marker]].name)}

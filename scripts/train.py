@@ -6,17 +6,23 @@
 ``DEEP`` is one of dqn, model-based, mt-dqn, mt-model-based.
 
 Episode ``e`` runs on ``specs[e % len(specs)]`` with world seed ``S + e``. The memory is written to
-SQLite after every episode (one transaction each), so an interrupted run keeps every finished
-episode; training an existing memory continues it. ``MEM.sqlite.train.json`` records the resolved
-arguments, versions and every episode's outcome.
+SQLite after every episode (one transaction each, the episode's training-log row with it), so an
+interrupted run keeps every finished episode and the log always matches the memory; training an
+existing memory continues it, and several trainers may share one file. ``MEM.sqlite.train.json`` is an
+export of the file's training log (every run's resolved arguments and versions, every episode's
+outcome), rewritten after every episode. Ctrl-C or SIGTERM stops after the current episode.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import sqlite3
+import sys
 from pathlib import Path
 
 from _cli import fail, versions, write_json
+from _interrupt import StopRequests
 from tqdm import tqdm
 
 from learning import DEEP_AGENT_NAMES, MemoryAgent, SymbolicWorld, run_episode
@@ -37,6 +43,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.episodes < 1 or args.max_actions < 1:
         fail("--episodes and --max-actions must be >= 1")
+    if args.seed < 0:
+        fail(f"--seed must be >= 0, got {args.seed}")
     try:
         specs = [load_spec(path) for path in args.specs]
     except SpecError as err:
@@ -47,23 +55,42 @@ def main(argv: list[str] | None = None) -> int:
         return _train_deep(args, specs)
     if args.memory is None:
         fail("the memory agent needs --memory MEM.sqlite")
+    memory_path = Path(args.memory)
+    if memory_path.is_dir():
+        fail(f"--memory {memory_path} is a directory, not a memory file")
+    writable = memory_path if memory_path.exists() else memory_path.parent
+    if writable.exists() and not os.access(writable, os.W_OK):
+        fail(f"--memory {memory_path}: cannot write {'it' if memory_path.exists() else 'there'} (read-only)")
     try:
         store = MemoryStore(args.memory)
+        run_id = store.begin_training_run({"command": "train", **vars(args), "versions": versions()})
     except LearningError as err:
         fail(str(err))
+    except sqlite3.OperationalError as err:  # e.g. a read-only directory for SQLite's journal
+        fail(f"--memory {memory_path}: cannot write ({err})")
 
     log_path = Path(args.memory + ".train.json")
-    log = {"command": "train", **vars(args), "versions": versions(), "episodes_before": store.num_episodes, "runs": []}
-    for e in tqdm(range(args.episodes), desc="training", unit="episode", disable=None):
-        spec = specs[e % len(specs)]
-        agent = MemoryAgent(store, learn=True)
-        agent.episode_label = spec.name
-        result = run_episode(agent, SymbolicWorld(spec, args.seed + e), spec.name, args.seed + e, args.max_actions)
-        log["runs"].append({k: v for k, v in result.to_dict().items() if k != "actions"})
-        write_json(log_path, log)
+    solved = done = 0
+    with StopRequests("episode") as stop:
+        try:
+            for e in tqdm(range(args.episodes), desc="training", unit="episode", disable=None):
+                if stop.requested:
+                    break
+                spec = specs[e % len(specs)]
+                agent = MemoryAgent(store, learn=True)
+                agent.episode_label, agent.episode_seed, agent.training_run = spec.name, args.seed + e, run_id
+                result = run_episode(agent, SymbolicWorld(spec, args.seed + e), spec.name, args.seed + e,
+                                     args.max_actions)  # fmt: skip
+                solved, done = solved + result.solved, done + 1
+                write_json(log_path, {"memory": args.memory, "runs": store.training_log()})
+        except KeyboardInterrupt:
+            pass
     store.close()
-    solved = sum(r["solved"] for r in log["runs"])
-    print(f"trained {args.episodes} episode(s), {solved} solved; memory holds {store.num_episodes} -> {args.memory}")
+    print(f"trained {done} episode(s), {solved} solved; memory holds {store.num_episodes} -> {args.memory}")
+    if done < args.episodes:
+        print(f"stopped after {done} of {args.episodes} episode(s): every finished one is in the memory",
+              file=sys.stderr)  # fmt: skip
+        return 130
     return 0
 
 

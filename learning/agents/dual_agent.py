@@ -84,6 +84,11 @@ class MemoryAgent(DualAgent):
             self.config = replace(self.config, entropy_scale=self.memory_config.training_entropy_scale)
         self.learn = learn
         self.episode_label = ""
+        """Spec name stored with the episode (the training log)."""
+        self.episode_seed: int | None = None
+        """World seed stored with the episode (the training log)."""
+        self.training_run: int | None = None
+        """Training-run id from ``MemoryStore.begin_training_run`` the episode belongs to."""
         self._observation: SceneObservation | None = None
 
     def initial_prior(self, observation: SceneObservation) -> np.ndarray:
@@ -106,4 +111,6 @@ class MemoryAgent(DualAgent):
             spec=self.episode_label,
             solved=solved,
             num_actions=len(self.decisions),
+            seed=self.episode_seed,
+            training_run=self.training_run,
         )

@@ -7,6 +7,13 @@ being independent (per state) to the bucket of its kind. Everything lives in mem
 nearest-neighbour look-ups and, when a path is given, in an SQLite file: one transaction per
 episode, so a crash loses at most the episode in progress.
 
+The training log lives in the same file: each training run (:meth:`MemoryStore.begin_training_run`,
+with its configuration) and each episode's outcome (spec, seed, solved, actions) are rows written in
+the episode's transaction, so the log and the memory never disagree, several trainers can share one
+file (SQLite serialises their transactions) and the history accumulates. :meth:`training_log` reads
+it back; ``MEM.sqlite.train.json`` is an export of it. Schema 1 files (no log) are read as they are
+and upgraded in place when trained further.
+
 A file that is not a puzzlebox memory (not SQLite, another application's database, a newer schema)
 or that is damaged (truncated, failed integrity check, malformed rows) raises
 :class:`~learning.errors.MemoryFileError`; it is never read as an empty memory.
@@ -15,6 +22,7 @@ or that is damaged (truncated, failed integrity check, malformed rows) raises
 from __future__ import annotations
 
 import json
+import math
 import sqlite3
 import time
 from collections import defaultdict
@@ -28,9 +36,18 @@ from learning.errors import MemoryFileError
 MEMORY_FORMAT = "puzzlebox-memory"
 PAIR_VALUE_SIZE = 6
 """Per stored pair: 4 probabilities [s_j, s_i] and the confidence of j's two blocks."""
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+READABLE_SCHEMAS = ("1", "2")
 
-_SCHEMA = """
+_LOG_SCHEMA = """
+CREATE TABLE training_runs (id INTEGER PRIMARY KEY, started REAL NOT NULL, config TEXT NOT NULL);
+ALTER TABLE episodes ADD COLUMN seed INTEGER;
+ALTER TABLE episodes ADD COLUMN training_run INTEGER REFERENCES training_runs(id);
+"""
+"""What schema 2 adds to schema 1: the training log."""
+
+_SCHEMA = (
+    """
 CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
 CREATE TABLE episodes (
     id INTEGER PRIMARY KEY, spec TEXT NOT NULL, solved INTEGER NOT NULL,
@@ -41,6 +58,11 @@ CREATE TABLE pair_entries (
 CREATE TABLE independence_entries (
     episode INTEGER NOT NULL REFERENCES episodes(id), kind TEXT NOT NULL, value BLOB NOT NULL);
 """
+    + _LOG_SCHEMA
+)
+
+BUSY_TIMEOUT = 120.0
+"""How long a writer waits for another trainer's transaction on the same file [s]."""
 
 
 @dataclass(frozen=True)
@@ -73,6 +95,7 @@ class MemoryStore:
         self._independence: dict[str, list[np.ndarray]] = defaultdict(list)
         self._cache: dict[tuple[str, ...], Bucket] = {}
         self.num_episodes = 0
+        self._schema = str(SCHEMA_VERSION)
         self._conn: sqlite3.Connection | None = None
         if self.path is not None:
             self._open_file(self.path)
@@ -93,7 +116,7 @@ class MemoryStore:
             path.parent.mkdir(parents=True, exist_ok=True)
         conn = None
         try:
-            conn = sqlite3.connect(path)
+            conn = sqlite3.connect(path, timeout=BUSY_TIMEOUT)
             if exists:
                 self._check(conn, path)
                 self._load(conn, path)
@@ -126,18 +149,19 @@ class MemoryStore:
         meta = dict(conn.execute("SELECT key, value FROM meta").fetchall())
         if meta.get("format") != MEMORY_FORMAT:
             raise MemoryFileError(f"{path} is not a puzzlebox memory (format {meta.get('format')!r})")
-        if meta.get("schema_version") != str(SCHEMA_VERSION):
+        if meta.get("schema_version") not in READABLE_SCHEMAS:
             raise MemoryFileError(
-                f"{path} has memory schema {meta.get('schema_version')}; this version reads {SCHEMA_VERSION}"
+                f"{path} has memory schema {meta.get('schema_version')}; this version reads {list(READABLE_SCHEMAS)}"
             )
+        self._schema = meta["schema_version"]
         try:
             self.position_scale = float(meta["position_scale"])
         except (KeyError, ValueError):
             raise MemoryFileError(
                 f"{path} has no valid position_scale in its meta table ({meta.get('position_scale')!r})"
             ) from None
-        if not self.position_scale > 0.0:
-            raise MemoryFileError(f"{path} has a non-positive position_scale {self.position_scale}")
+        if not (math.isfinite(self.position_scale) and self.position_scale > 0.0):
+            raise MemoryFileError(f"{path} has a position_scale that is not a finite length > 0: {self.position_scale}")
 
     def _load(self, conn: sqlite3.Connection, path: Path) -> None:
         self.num_episodes = conn.execute("SELECT COUNT(*) FROM episodes").fetchone()[0]
@@ -149,17 +173,80 @@ class MemoryStore:
                 raise MemoryFileError(
                     f"{path} has a malformed pair entry ({key_arr.size} key, {value_arr.size} values)"
                 )
+            _check_probabilities(value_arr, f"{path} has a pair entry ({kind_i} -> {kind_j})")
             self._pairs[(kind_i, kind_j)].append((key_arr, value_arr))
         for kind, value in conn.execute("SELECT kind, value FROM independence_entries ORDER BY rowid"):
             value_arr = _decode(value, path)
             if value_arr.size != 2:
                 raise MemoryFileError(f"{path} has a malformed independence entry")
+            _check_probabilities(value_arr, f"{path} has an independence entry ({kind})")
             self._independence[kind].append(value_arr)
 
     def close(self) -> None:
         if self._conn is not None:
             self._conn.close()
             self._conn = None
+
+    # -- the training log ----------------------------------------------------------------------------
+    def _upgrade(self) -> None:
+        """Add the training log to a schema 1 file (once, whichever trainer gets there first)."""
+        if self._conn is None or self._schema == str(SCHEMA_VERSION):
+            return
+        conn = self._conn
+        conn.execute("BEGIN IMMEDIATE")  # hold the write lock: another trainer may be upgrading too
+        try:
+            if conn.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()[0] == "1":
+                for statement in filter(str.strip, _LOG_SCHEMA.split(";")):
+                    conn.execute(statement)
+                conn.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", (str(SCHEMA_VERSION),))
+            conn.commit()
+        except BaseException:
+            conn.rollback()
+            raise
+        self._schema = str(SCHEMA_VERSION)
+
+    def begin_training_run(self, config: dict[str, object]) -> int | None:
+        """Log the start of a training run with its ``config`` (JSON-able); its id for :meth:`add_episode`,
+        or None for a memory kept in RAM only."""
+        if self._conn is None:
+            return None
+        self._upgrade()
+        with self._conn:
+            cursor = self._conn.execute(
+                "INSERT INTO training_runs (started, config) VALUES (?, ?)",
+                (time.time(), json.dumps(config, sort_keys=True)),
+            )
+        return cursor.lastrowid
+
+    def training_log(self) -> list[dict[str, object]]:
+        """The file's training runs, oldest first, each with its ``config`` and ``episodes`` (spec, seed,
+        solved, num_actions, created [s since the epoch]) — read from the file, so it includes what other
+        trainers of the same file stored. Episodes stored before the log existed (schema 1) or without
+        a run come under a run with ``id`` None. Empty for a memory kept in RAM only."""
+        if self._conn is None:
+            return []
+        runs: dict[int | None, dict[str, object]] = {}
+        if self._schema != "1":
+            for run_id, started, config in self._conn.execute(
+                "SELECT id, started, config FROM training_runs ORDER BY id"
+            ):
+                runs[run_id] = {"id": run_id, "started": started, "config": json.loads(config), "episodes": []}
+            rows = self._conn.execute(
+                "SELECT training_run, spec, seed, solved, num_actions, created FROM episodes ORDER BY id"
+            ).fetchall()
+        else:
+            rows = [
+                (None, spec, None, solved, num_actions, created)
+                for spec, solved, num_actions, created in self._conn.execute(
+                    "SELECT spec, solved, num_actions, created FROM episodes ORDER BY id"
+                )
+            ]
+        for run_id, spec, seed, solved, num_actions, created in rows:
+            run = runs.setdefault(run_id, {"id": run_id, "started": created, "config": {}, "episodes": []})
+            run["episodes"].append(  # type: ignore[union-attr]
+                {"spec": spec, "seed": seed, "solved": bool(solved), "num_actions": num_actions, "created": created}
+            )
+        return sorted(runs.values(), key=lambda r: (r["id"] is not None, r["id"] or 0))
 
     # -- writing -----------------------------------------------------------------------------------
     def add_episode(
@@ -171,6 +258,8 @@ class MemoryStore:
         spec: str = "",
         solved: bool = True,
         num_actions: int = 0,
+        seed: int | None = None,
+        training_run: int | None = None,
     ) -> None:
         """Store one episode's learned graph.
 
@@ -179,6 +268,8 @@ class MemoryStore:
             keys: ``(N, N, K)`` relative-pose keys (``[i, j]``: j seen from i).
             pair_values: ``(N, N, 6)`` — ``[i, j]`` the block of "i holds j" (see the class docstring).
             independence: ``(N, 2)`` probability that each component is independent, per state.
+            spec, solved, num_actions, seed: the episode's outcome, for the training log.
+            training_run: id from :meth:`begin_training_run` (None: an episode outside a logged run).
         """
         n = len(kinds)
         pairs = [
@@ -189,10 +280,12 @@ class MemoryStore:
         ]
         singles = [(kinds[j], independence[j].astype(np.float64)) for j in range(n)]
         if self._conn is not None:
-            with self._conn:  # one transaction: the episode is stored whole or not at all
+            self._upgrade()
+            with self._conn:  # one transaction: the episode (log row included) is stored whole or not at all
                 cursor = self._conn.execute(
-                    "INSERT INTO episodes (spec, solved, num_actions, created) VALUES (?, ?, ?, ?)",
-                    (spec, int(solved), num_actions, time.time()),
+                    "INSERT INTO episodes (spec, solved, num_actions, created, seed, training_run) "
+                    "VALUES (?, ?, ?, ?, ?, ?)",
+                    (spec, int(solved), num_actions, time.time(), seed, training_run),
                 )
                 episode = cursor.lastrowid
                 self._conn.executemany(
@@ -244,6 +337,12 @@ class MemoryStore:
 
     def __repr__(self) -> str:
         return f"MemoryStore({json.dumps(self.summary())})"
+
+
+def _check_probabilities(values: np.ndarray, where: str) -> None:
+    """Every stored value (probabilities and confidences) lies in [0, 1]."""
+    if np.any(values < 0.0) or np.any(values > 1.0):
+        raise MemoryFileError(f"{where} outside [0, 1]: {np.round(values, 4).tolist()}")
 
 
 def _decode(blob: object, path: Path) -> np.ndarray:

@@ -79,7 +79,8 @@ def test_train_then_memory_trial_beats_dual_on_unseen_boxes(tmp_path):
         memory,
     )
     assert trained.returncode == 0, trained.stderr
-    assert json.loads((tmp_path / "memory.sqlite.train.json").read_text())["runs"][8]["spec"] == "paper-train-8"
+    (logged,) = json.loads((tmp_path / "memory.sqlite.train.json").read_text())["runs"]
+    assert logged["config"]["episodes"] == 9 and logged["episodes"][8]["spec"] == "paper-train-8"
     tests = sorted(specs.glob("paper-test-*.json"))
     means = {}
     for agent, extra in (("memory", ["--memory", memory]), ("dual", [])):
