@@ -51,6 +51,10 @@ class PrimitiveConfig:
     approach_time: float = 1.5
     descend_time: float = 1.0
     close_time: float = 0.6
+    close_speed: float = 0.6
+    """Rate at which the gripper's commanded closure ramps up while closing on a handle [1/s]: the
+    servo alone snaps the fingers shut at ~2/s, and pads meeting a post at that speed put a 30 ms,
+    60 N impact on the wrist."""
     actuate_time: float = 2.5
     release_time: float = 0.4
     retreat_time: float = 0.8
@@ -231,6 +235,18 @@ class Toggler:
         for _ in range(ticks):
             self._tick(self.ik.tcp_pose())
 
+    def _close_slowly(self) -> None:
+        """Ramp the gripper command from its pre-grasp closure to fully closed at ``close_speed``, then
+        hold for ``close_time`` while the grip builds."""
+        c = self.config
+        ramp = max(1, round((1.0 - c.pregrasp_closure) / c.close_speed / c.tick))
+        hold = self.ik.tcp_pose()
+        for k in range(1, ramp + 1):
+            self.robot.command_gripper(c.pregrasp_closure + (1.0 - c.pregrasp_closure) * k / ramp)
+            self._tick(hold)
+        for _ in range(round(c.close_time / c.tick)):
+            self._tick(hold)
+
     # -- the toggle --------------------------------------------------------------------------------
     def grasp_yaw(self, jm: JointModel) -> float:
         """Yaw of the gripper. Slides and wheels: the fingers close along the handle's (horizontal)
@@ -271,7 +287,7 @@ class Toggler:
         self.phase = "descending"
         self.move_to(at_grasp, c.descend_time)
         self.phase = "grasping"
-        self._gripper(1.0, c.close_time)
+        self._close_slowly()
         self._grasp_closure = self.robot.gripper_opening()
         self._closures = collections.deque([self._grasp_closure], maxlen=max(2, round(c.slip_window / c.tick) + 1))
         if self._grasp_closure >= c.empty_grasp_closure:
