@@ -152,3 +152,29 @@ def test_a_latched_door_whose_handle_slides_out_of_a_weak_grip_is_never_read_as_
         result = world.try_toggle(world.markers.index(door.marker))
         assert result.outcome in ("failed", "blocked") and "slipped" in result.reason, result
         assert world.log[-1].true_moved is False and world.states.tolist() == [0] * 5
+
+
+def test_closing_on_a_handle_puts_no_impact_on_the_wrist():
+    """The pads meet a wheel's post a few millimetres off their centre here; snapped shut by the servo
+    they hit it with a 30 ms, 62 N true wrist force (past the 60 N safety limit, too short for the
+    filtered guard to see). Closed at a ramped command, the impact stays under 35 N."""
+    spec = paper_family("test", seed=0)[1]
+    with TwinSession(spec, seed=0) as session:
+        world = twin_world(session)
+        m, d = session.model, session.data
+        site = m.site(session.scene.names.ft_site).id
+        weight = m.body_subtreemass[m.site_bodyid[site]] * m.opt.gravity
+        peak = {"grasping": 0.0}
+        wait = session.robot.wait
+
+        def watched_wait(seconds: float) -> None:
+            wait(seconds)
+            if world.toggler.phase == "grasping":
+                true_force = d.site_xmat[site].reshape(3, 3) @ session.ft.load()[:3] - weight
+                peak["grasping"] = max(peak["grasping"], float(np.linalg.norm(true_force)))
+
+        session.robot.wait = watched_wait
+        for name in ("slide-0", "wheel-1"):
+            result = world.try_toggle(world.markers.index(spec.components[spec.index_of(name)].marker))
+            assert result.outcome == "moved", (name, result)
+        assert 5.0 < peak["grasping"] < 35.0, peak
