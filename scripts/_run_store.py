@@ -6,13 +6,15 @@ Layout of ``DIR``: ``config.json`` (the experiment's resolved arguments, written
 A crash, a kill or Ctrl-C keeps every finished run; ``--resume`` continues a directory of the same
 configuration, skipping what is there; ``--force`` empties one that holds anything else. Without either,
 a directory holding results is refused, so no directory ever describes one experiment and holds
-another's numbers.
+another's numbers. Half-written files a SIGKILL left (hidden temporaries of records and videos) are
+removed when the directory is taken up again.
 """
 
 from __future__ import annotations
 
 import json
 import shutil
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -47,6 +49,11 @@ class RunStore:
         if force:
             shutil.rmtree(self.records_dir, ignore_errors=True)
             (out / "results.json").unlink(missing_ok=True)
+        stale = [*out.glob(".*.tmp"), *out.glob(".rollout*.mp4"), *self.records_dir.glob(".*.tmp")]
+        for path in stale:  # half-written files of a killed run (a normal end or an error removes its own)
+            path.unlink(missing_ok=True)
+        if stale:
+            print(f"removed {len(stale)} unfinished file(s) a killed run left in {out}", file=sys.stderr)
         try:
             write_json(config_path, {**experiment, "versions": versions()})
         except OSError as err:

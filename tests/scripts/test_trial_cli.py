@@ -207,7 +207,8 @@ def test_a_killed_trial_resumes_with_no_run_lost_or_duplicated(tmp_path):
         proc.send_signal(signal.SIGKILL)
         proc.wait()
         kept = len(list((out / "runs").glob("*.json")))
-        assert kept >= at and not list(out.rglob("*.tmp")), "a kill leaves only whole records"
+        assert kept >= at, "every record written before the kill is kept"
+        (out / "runs" / ".000-x.json.abc.tmp").write_text("{")  # what a kill in mid-write leaves
         refused = subprocess.run(list(map(str, _symbolic_trial(specs, out, 60))), capture_output=True, text=True)
         assert refused.returncode == 2 and "--resume" in refused.stderr and "Traceback" not in refused.stderr
         resumed = subprocess.run(list(map(str, _symbolic_trial(specs, out, 60, "--resume"))), capture_output=True)
@@ -215,6 +216,7 @@ def test_a_killed_trial_resumes_with_no_run_lost_or_duplicated(tmp_path):
         got, want = (json.loads((d / "results.json").read_text()) for d in (out, whole))
         assert len(got["runs"]) == 180 and got["runs_done"] == got["runs_planned"] == 180
         assert _without_times(got) == _without_times(want)
+        assert not list(out.rglob("*.tmp")), "the resumed run removed the killed run's half-written file"
 
 
 def test_sigterm_stops_after_the_current_run_and_says_how_to_resume(tmp_path):
