@@ -192,13 +192,29 @@ def spec_from_dict(data: Any, source: str | None = None) -> PuzzleSpec:
     return build_from_valid_data(data)
 
 
+class _DuplicateKey(ValueError):
+    pass
+
+
+def _refuse_duplicate_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """``json.loads`` keeps the last of two equal keys silently; a spec with one is ambiguous."""
+    out: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in out:
+            raise _DuplicateKey(key)
+        out[key] = value
+    return out
+
+
 def spec_from_json(text: str, source: str | None = None) -> PuzzleSpec:
     """Parse and validate JSON text."""
     try:
-        data = json.loads(text)
+        data = json.loads(text, object_pairs_hook=_refuse_duplicate_keys)
     except json.JSONDecodeError as err:
         problem = SpecProblem("file", f"not valid JSON: {err.msg} at line {err.lineno} column {err.colno}")
         raise SpecError([problem], source) from None
+    except _DuplicateKey as err:
+        raise SpecError([SpecProblem("file", f"duplicate key {err.args[0]!r} in one JSON object")], source) from None
     return spec_from_dict(data, source)
 
 

@@ -13,6 +13,7 @@ from models.errors import ReachabilityUndecided, SpecProblem
 from models.geometry import polygon_gap
 from models.kinds import KIND_NAMES, PUZZLE_KINDS, get_kind
 from models.lock_table import LockTable
+from models.markers import MAX_MARKER_ID
 from models.spec import SPEC_FORMAT, build_from_valid_data
 
 MAX_COMPONENTS = 62
@@ -105,6 +106,13 @@ def validate_data(data: Any) -> list[SpecProblem]:
             if not isinstance(marker, int) or isinstance(marker, bool) or marker < 0:
                 problem(f"{where}.marker", f"must be a non-negative integer ArUco id, got {marker!r}")
                 ok = False
+            elif marker > MAX_MARKER_ID:
+                problem(
+                    f"{where}.marker",
+                    f"ArUco id {marker} is outside the project's dictionary (DICT_4X4_250: ids 0..{MAX_MARKER_ID}); "
+                    "the twin cannot render it nor the camera read it",
+                )
+                ok = False
             elif marker in markers:
                 problem(f"{where}.marker", f"ArUco id {marker} already used by component {markers[marker]!r}")
                 ok = False
@@ -118,6 +126,7 @@ def validate_data(data: Any) -> list[SpecProblem]:
     if not isinstance(locks, list):
         problem("locks", "missing or not a list (use [] for a puzzle without locks)")
         locks = []
+    seen_locks: dict[tuple[Any, ...], int] = {}
     for k, rule in enumerate(locks):
         where = f"locks[{k}]"
         if not isinstance(rule, dict):
@@ -140,6 +149,11 @@ def validate_data(data: Any) -> list[SpecProblem]:
             problem(where, f"component {rule['locker']!r} locks itself")
             ok = False
         if ok:
+            key = (rule["locker"], rule["locker_state"], rule["locked"], rule["locked_state"])
+            if key in seen_locks:
+                problem(where, f"duplicates locks[{seen_locks[key]}] ({key[0]} in {key[1]} holds {key[2]} in {key[3]})")
+                continue
+            seen_locks[key] = k
             valid_locks.append(rule)
 
     goal = data.get("goal")

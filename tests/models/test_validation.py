@@ -134,6 +134,29 @@ def test_duplicate_marker_ids_are_rejected(spec_dict):
     only_problem(spec_dict, "marker", "already used", "door-1")
 
 
+def test_a_marker_id_outside_the_dictionary_is_rejected(spec_dict):
+    spec_dict["components"][1]["marker"] = 250  # DICT_4X4_250 has ids 0..249: the twin cannot render it
+    only_problem(spec_dict, "marker", "250", "0..249")
+    spec_dict["components"][1]["marker"] = 249
+    assert validate_data(spec_dict) == []
+
+
+def test_a_duplicate_lock_is_rejected(spec_dict):
+    spec_dict["locks"].append(dict(spec_dict["locks"][0]))
+    only_problem(spec_dict, f"locks[{len(spec_dict['locks']) - 1}]", "duplicates locks[0]")
+
+
+def test_a_duplicate_json_key_is_rejected(spec_dict):
+    text = json.dumps(spec_dict)
+    doubled = text.replace('"goal": {', '"goal": {"component": "slide-1", ', 1)  # two "component" keys
+    assert doubled != text
+    with pytest.raises(SpecError) as info:
+        spec_from_json(doubled)
+    (problem,) = info.value.problems
+    assert problem.where == "file" and "duplicate key 'component'" in problem.message
+    spec_from_json(text)  # the same spec without the duplicate loads
+
+
 def test_every_problem_is_listed_at_once(spec_dict):
     spec_dict["format"] = "other"
     spec_dict["components"][0]["kind"] = "drawer"
