@@ -6,6 +6,8 @@ from learning.agents.base import Agent
 from learning.agents.dual_agent import DualAgent, MemoryAgent
 from learning.agents.oracle_agent import OracleAgent
 from learning.agents.random_agent import RandomAgent
+from learning.belief import BeliefConfig
+from learning.dual_controller import DualControllerConfig
 from learning.errors import ConfigError, UnknownAgent
 from learning.memory.store import MemoryStore
 from models import PuzzleSpec
@@ -21,8 +23,16 @@ AGENT_NAMES = ("memory", "dual", "random", "oracle", *DEEP_AGENT_NAMES)
 baselines need a checkpoint."""
 
 
-def make_agent(name: str, spec: PuzzleSpec, memory: MemoryStore | None = None, checkpoint: str | None = None) -> Agent:
-    """A fresh agent for one puzzle; :class:`UnknownAgent` lists the names that exist."""
+def make_agent(
+    name: str,
+    spec: PuzzleSpec,
+    memory: MemoryStore | None = None,
+    checkpoint: str | None = None,
+    belief: BeliefConfig | None = None,
+) -> Agent:
+    """A fresh agent for one puzzle; :class:`UnknownAgent` lists the names that exist. ``belief`` is the
+    observation model of the belief-based agents (``memory``, ``dual``; default :class:`BeliefConfig`)."""
+    controller = DualControllerConfig(belief=belief) if belief is not None else None
     if name in DEEP_AGENT_NAMES:
         if checkpoint is None:
             raise ConfigError(f"agent {name!r} needs a checkpoint (train one with scripts/train.py --agent {name})")
@@ -36,11 +46,11 @@ def make_agent(name: str, spec: PuzzleSpec, memory: MemoryStore | None = None, c
     if name == "memory":
         if memory is None:
             raise ConfigError("agent 'memory' needs a memory (train one with scripts/train.py, pass --memory)")
-        return MemoryAgent(memory)
+        return MemoryAgent(memory, config=controller)
     if memory is not None:
         raise ConfigError(f"agent {name!r} takes no memory; --memory is for the memory agent")
     if name == "dual":
-        return DualAgent()
+        return DualAgent(controller)
     if name == "random":
         return RandomAgent()
     if name == "oracle":
