@@ -16,9 +16,10 @@ import mujoco
 import numpy as np
 from dm_control import mjcf
 
+from models import reach
 from models.errors import ModelsError
 from models.kinds import get_kind
-from models.puzzle_box import PLATE_THICKNESS, build_puzzle_box, component_prefixes, lid_to_world, yaw_quat
+from models.puzzle_box import build_puzzle_box, component_prefixes, lid_to_world, yaw_quat
 from models.spec import PuzzleSpec
 from models.xarm7 import ARM_JOINTS, XArm7Config, build_xarm7, compensate_gravity
 
@@ -48,9 +49,9 @@ class SceneConfig:
     """Where the overview camera hangs above the table, in the robot base frame [m]."""
     overview_fovy: float = 55.0
     """Vertical field of view of the overview camera [deg]: ~0.52 m x 0.69 m of lid seen from 0.5 m."""
-    min_reach: float = 0.20
+    min_reach: float = reach.MIN_REACH
     """Closest a handle may be to the robot's base axis, horizontally [m]."""
-    max_reach: float = 0.62
+    max_reach: float = reach.MAX_REACH
     """Farthest a handle may be from the robot's base axis, horizontally [m] (top-down grasps)."""
     with_markers: bool = True
     """Texture every component with its ArUco marker."""
@@ -214,33 +215,14 @@ def _names(spec: PuzzleSpec) -> SceneNames:
 def unreachable_handles(spec: PuzzleSpec, box_pose: tuple[float, float, float], config: SceneConfig) -> list[str]:
     """The components whose handle would lie outside the robot's reach with the box at ``box_pose``
     ``[x, y, yaw]`` [m, m, rad] (empty: the pose is reachable)."""
-    return _handle_problems(spec, lid_to_world(box_pose, spec.box.size[2]), config)
+    return reach.unreachable_handles(spec, box_pose, config.min_reach, config.max_reach)
 
 
 def _check_reach(spec: PuzzleSpec, T_world_lid: np.ndarray, config: SceneConfig) -> None:
-    problems = _handle_problems(spec, T_world_lid, config)
+    yaw = math.atan2(T_world_lid[1, 0], T_world_lid[0, 0])
+    problems = unreachable_handles(spec, (T_world_lid[0, 3], T_world_lid[1, 3], yaw), config)
     if problems:
         raise UnreachableBoxPose(
             f"box pose {spec.box.pose} puts handles outside the robot's reach "
             f"({config.min_reach:.2f}..{config.max_reach:.2f} m from the base axis): {', '.join(problems)}"
         )
-
-
-def _handle_problems(spec: PuzzleSpec, T_world_lid: np.ndarray, config: SceneConfig) -> list[str]:
-    problems = []
-    for c in spec.components:
-        hx, hy = get_kind(c.kind).handle_xy
-        x, y, yaw = c.pose
-        handle_in_lid = np.array(
-            [
-                x + math.cos(yaw) * hx - math.sin(yaw) * hy,
-                y + math.sin(yaw) * hx + math.cos(yaw) * hy,
-                PLATE_THICKNESS,
-                1,
-            ]
-        )
-        wx, wy = (T_world_lid @ handle_in_lid)[:2]
-        radius = math.hypot(wx, wy)
-        if not config.min_reach <= radius <= config.max_reach:
-            problems.append(f"{c.name!r} handle at {radius:.3f} m")
-    return problems

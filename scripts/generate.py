@@ -7,6 +7,8 @@
     python scripts/generate.py mjcf SPEC --out DIR  # DIR/scene.xml + assets, loadable by mujoco
 
 ``--plot`` on paper/chain/random also writes a top view of each layout (PNG beside the JSON).
+Generated boxes stand where the robot reaches every handle (at most 28 components fit); ``--anywhere``
+on chain/random keeps the default pose whatever it leaves out of reach, for the symbolic simulator.
 
 Every generated file is a pure function of the arguments: the same command writes the same bytes.
 """
@@ -20,7 +22,7 @@ from pathlib import Path
 from _cli import fail
 
 from models import LockTable, ModelsError, PuzzleSpec, SpecError, load_spec, save_spec
-from models.generator import RandomGraphConfig, generate_chain, generate_random, paper_family
+from models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random, paper_family
 
 
 def _write(spec: PuzzleSpec, path: Path, plot: bool) -> None:
@@ -38,12 +40,14 @@ def _paper(args: argparse.Namespace) -> None:
 
 def _chain(args: argparse.Namespace) -> None:
     kinds = [k.strip() for k in args.kinds.split(",") if k.strip()]
-    _write(generate_chain(kinds, seed=args.seed, name=args.name), Path(args.out), args.plot)
+    box = BoxConfig(fit_reach=not args.anywhere)
+    _write(generate_chain(kinds, seed=args.seed, name=args.name, box=box), Path(args.out), args.plot)
 
 
 def _random(args: argparse.Namespace) -> None:
     config = RandomGraphConfig(num_components=args.components, multi_locker=args.multi_locker)
-    _write(generate_random(config, seed=args.seed, name=args.name), Path(args.out), args.plot)
+    box = BoxConfig(fit_reach=not args.anywhere)
+    _write(generate_random(config, seed=args.seed, name=args.name, box=box), Path(args.out), args.plot)
 
 
 def _mjcf(args: argparse.Namespace) -> None:
@@ -91,6 +95,11 @@ def main(argv: list[str] | None = None) -> int:
     chain.add_argument("--out", required=True, help="output JSON file")
     chain.add_argument("--name", default=None, help="spec name (default: derived from kinds and seed)")
     chain.add_argument("--plot", action="store_true", help="also write a top-view PNG beside each JSON")
+    chain.add_argument(
+        "--anywhere",
+        action="store_true",
+        help="keep the box at the default pose even if the robot cannot reach every handle (symbolic only)",
+    )
     chain.set_defaults(run=_chain)
 
     rand = verbs.add_parser("random", help="a random solvable lock graph of N components")
@@ -100,6 +109,11 @@ def main(argv: list[str] | None = None) -> int:
     rand.add_argument("--out", required=True, help="output JSON file")
     rand.add_argument("--name", default=None, help="spec name (default: derived from N and seed)")
     rand.add_argument("--plot", action="store_true", help="also write a top-view PNG beside each JSON")
+    rand.add_argument(
+        "--anywhere",
+        action="store_true",
+        help="keep the box at the default pose even if the robot cannot reach every handle (symbolic only)",
+    )
     rand.set_defaults(run=_random)
 
     scene = verbs.add_parser("mjcf", help="the MuJoCo scene of a spec: DIR/scene.xml + assets")

@@ -8,13 +8,14 @@ solution opens the components in chain order (N actions).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from models.errors import GeneratorError
 from models.generator.layout import Layout, LayoutConfig
 from models.kinds import ALLOWED_NEIGHBOURS, PUZZLE_KINDS, may_neighbour
+from models.reach import MAX_REACH, MIN_REACH, fitting_box_pose
 from models.spec import Box, Component, Goal, LockRule, PuzzleSpec, file_precision
 
 MAX_LAYOUT_ATTEMPTS = 200
@@ -31,6 +32,38 @@ class BoxConfig:
     lid_size: tuple[float, float] | None = None
     """Lid (length, width) [m]; None = the smallest that holds the layout with its margin."""
     layout: LayoutConfig = field(default_factory=LayoutConfig)
+    fit_reach: bool = True
+    """Stand the box where the robot reaches every handle: at :attr:`pose` if it does, else at the
+    nearest pose that does (:func:`models.reach.fitting_box_pose`); a layout no pose fits is drawn again,
+    and more than :data:`MAX_REACHABLE_COMPONENTS` components are refused. False: keep :attr:`pose`
+    whatever it leaves out of reach (a box for the symbolic simulator only)."""
+
+
+MAX_REACHABLE_COMPONENTS = 28
+"""Most components a generated box holds with every handle within the robot's reach: the fraction of
+random layouts some pose fits falls from 20/20 at 16 components to 16/20 at 20, 2/20 at 28 and 0/20 at 32
+(seeds 0-19), with handles allowed 0.20-0.62 m from the base axis."""
+
+
+def check_reach_size(num_components: int, box: BoxConfig) -> None:
+    """Refuse a box too large for the robot's reach, unless ``box.fit_reach`` is off."""
+    if box.fit_reach and box.pose is not None and num_components > MAX_REACHABLE_COMPONENTS:
+        raise GeneratorError(
+            f"{num_components} components do not fit the robot's reach (every handle within "
+            f"{MIN_REACH:.2f}-{MAX_REACH:.2f} m of the base; at most {MAX_REACHABLE_COMPONENTS} do): for a box "
+            "the symbolic simulator alone will use, turn reach fitting off (generate.py --anywhere)"
+        )
+
+
+def fit_to_reach(spec: PuzzleSpec, box: BoxConfig) -> PuzzleSpec | None:
+    """``spec`` with its box moved where every handle is within reach (see :attr:`BoxConfig.fit_reach`);
+    None when no pose fits; ``spec`` unchanged when fitting is off or the box has no pose."""
+    if not box.fit_reach or spec.box is None or spec.box.pose is None:
+        return spec
+    pose = fitting_box_pose(spec, start=spec.box.pose)
+    if pose is None:
+        return None
+    return replace(spec, box=replace(spec.box, pose=file_precision(pose)))
 
 
 def check_chain_kinds(kinds: Sequence[str]) -> None:
@@ -110,7 +143,14 @@ def generate_chain(
     kinds = list(kinds)
     check_chain_kinds(kinds)
     box = box or BoxConfig()
-    layout = chain_layout(kinds, np.random.default_rng(seed), box.layout)
+    check_reach_size(len(kinds), box)
+    rng = np.random.default_rng(seed)
     rules = chain_rules(len(kinds))
     name = name or f"chain-{'-'.join(kinds)}-s{seed}"
-    return assemble(name, kinds, layout, rules, goal=len(kinds) - 1, box=box)
+    for _ in range(MAX_LAYOUT_ATTEMPTS):
+        spec = fit_to_reach(
+            assemble(name, kinds, chain_layout(kinds, rng, box.layout), rules, len(kinds) - 1, box), box
+        )
+        if spec is not None:
+            return spec
+    raise GeneratorError(f"no layout of the chain {kinds} fits the robot's reach in {MAX_LAYOUT_ATTEMPTS} attempts")

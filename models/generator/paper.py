@@ -18,7 +18,8 @@ from typing import Literal
 
 import numpy as np
 
-from models.generator.chain import BoxConfig, assemble, chain_layout, chain_rules
+from models.errors import GeneratorError
+from models.generator.chain import BoxConfig, assemble, chain_layout, chain_rules, fit_to_reach
 from models.kinds import KIND_NAMES, may_neighbour
 from models.spec import PuzzleSpec
 
@@ -53,9 +54,10 @@ def paper_variant(index: int, seed: int, box: BoxConfig | None = None) -> Puzzle
         raise ValueError(f"paper variant index must be in 0..{len(sequences) - 1}, got {index}")
     box = box or BoxConfig()
     layout = chain_layout(sequences[index], np.random.default_rng([seed, index]), box.layout)
-    return assemble(
+    spec = assemble(
         paper_variant_name(index), sequences[index], layout, chain_rules(PAPER_LENGTH), PAPER_LENGTH - 1, box
     )
+    return _fitted(spec, box)
 
 
 def paper_family(split: Split = "all", seed: int = 0, box: BoxConfig | None = None) -> list[PuzzleSpec]:
@@ -78,5 +80,14 @@ def paper_family(split: Split = "all", seed: int = 0, box: BoxConfig | None = No
     specs = []
     for i in wanted:
         rules = chain_rules(PAPER_LENGTH)
-        specs.append(assemble(paper_variant_name(i), sequences[i], layouts[i], rules, PAPER_LENGTH - 1, box))
+        spec = assemble(paper_variant_name(i), sequences[i], layouts[i], rules, PAPER_LENGTH - 1, box)
+        specs.append(_fitted(spec, box))
     return specs
+
+
+def _fitted(spec: PuzzleSpec, box: BoxConfig) -> PuzzleSpec:
+    """The paper's 5-component boxes always fit the reach (at the default pose, as it happens)."""
+    fitted = fit_to_reach(spec, box)
+    if fitted is None:
+        raise GeneratorError(f"{spec.name}: no box pose puts every handle within the robot's reach")
+    return fitted

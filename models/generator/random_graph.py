@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from models.errors import GeneratorError
-from models.generator.chain import MAX_LAYOUT_ATTEMPTS, BoxConfig, assemble
+from models.generator.chain import MAX_LAYOUT_ATTEMPTS, BoxConfig, assemble, check_reach_size, fit_to_reach
 from models.generator.layout import Layout
 from models.kinds import KIND_NAMES, may_neighbour
 from models.spec import PuzzleSpec
@@ -62,14 +62,17 @@ def generate_random(
         if not 0.0 <= p <= 1.0:
             raise GeneratorError(f"{label} must be in [0, 1], got {p}")
     box = box or BoxConfig()
+    check_reach_size(n, box)
     rng = np.random.default_rng(seed)
+    name = name or f"random-n{n}{'-multi' if config.multi_locker else ''}-s{seed}"
     for _ in range(MAX_LAYOUT_ATTEMPTS):
         built = _try_build(config, rng, box)
         if built is not None:
             layout, rules, goal = built
-            name = name or f"random-n{n}{'-multi' if config.multi_locker else ''}-s{seed}"
-            return assemble(name, layout.kinds, layout, rules, goal, box)
-    raise GeneratorError(f"no layout found for {n} components in {MAX_LAYOUT_ATTEMPTS} attempts")
+            spec = fit_to_reach(assemble(name, layout.kinds, layout, rules, goal, box), box)
+            if spec is not None:
+                return spec
+    raise GeneratorError(f"no layout of {n} components that fits the robot's reach in {MAX_LAYOUT_ATTEMPTS} attempts")
 
 
 def _try_build(

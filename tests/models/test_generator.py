@@ -1,4 +1,5 @@
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -9,6 +10,7 @@ from models import GeneratorError, LockTable, get_kind, validate_data
 from models.generator import (
     TEST_INDICES,
     TRAIN_INDICES,
+    BoxConfig,
     LayoutConfig,
     RandomGraphConfig,
     generate_chain,
@@ -16,8 +18,10 @@ from models.generator import (
     paper_family,
     paper_sequences,
 )
+from models.generator.chain import MAX_REACHABLE_COMPONENTS
 from models.geometry import polygon_gap
 from models.kinds import may_neighbour
+from models.reach import unreachable_handles
 
 NEIGHBOUR_GAP = LayoutConfig().neighbour_gap
 
@@ -132,3 +136,21 @@ def test_chain_with_forbidden_neighbours_or_kinds_is_a_clear_error(kinds):
 def test_random_graph_rejects_impossible_sizes(config):
     with pytest.raises(GeneratorError):
         generate_random(config, seed=0)
+
+
+@settings(max_examples=25, deadline=None)
+@given(n=st.integers(2, MAX_REACHABLE_COMPONENTS), seed=st.integers(0, 2**31))
+def test_generated_boxes_fit_the_robots_reach_at_every_accepted_size(n, seed):
+    spec = generate_random(RandomGraphConfig(n, multi_locker=n >= 4 and seed % 2 == 1), seed=seed)
+    assert unreachable_handles(spec, spec.box.pose) == [], spec.box.pose
+
+
+def test_a_box_too_large_for_the_reach_is_refused_unless_fitting_is_off():
+    with pytest.raises(GeneratorError, match="do not fit the robot's reach"):
+        generate_random(RandomGraphConfig(MAX_REACHABLE_COMPONENTS + 1), seed=0)
+    anywhere = generate_random(RandomGraphConfig(40), seed=0, box=BoxConfig(fit_reach=False))
+    assert anywhere.box.pose == (0.45, 0.0, 0.0) and unreachable_handles(anywhere, anywhere.box.pose)
+    # a 10-component layout that the default pose leaves a handle out of: the box is turned, not left
+    spec = generate_random(RandomGraphConfig(10), seed=0)
+    assert unreachable_handles(replace(spec, box=replace(spec.box, pose=(0.45, 0.0, 0.0))), (0.45, 0.0, 0.0))
+    assert unreachable_handles(spec, spec.box.pose) == []
