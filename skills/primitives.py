@@ -49,7 +49,10 @@ class PrimitiveConfig:
     approach_height: float = 0.08
     """Pre-grasp height above the grasp point [m]."""
     approach_time: float = 1.5
-    descend_time: float = 1.0
+    descend_time: float = 2.0
+    """Time of the 8 cm descent onto a handle [s]: slow enough (peak 6 cm/s) that a part standing in
+    the way (a door left leaning over its neighbour) is met softly and the force guard stops the arm
+    near its limit; at 1 s the impact put up to 270 N of true force on the wrist."""
     close_time: float = 0.6
     close_speed: float = 0.6
     """Rate at which the gripper's commanded closure ramps up while closing on a handle [1/s]: the
@@ -58,6 +61,8 @@ class PrimitiveConfig:
     actuate_time: float = 2.5
     release_time: float = 0.4
     retreat_time: float = 0.8
+    lift_time: float = 0.8
+    """Time to lift the TCP to ``transit_height`` before going to rest [s]."""
     rest_time: float = 1.5
     """Time to return to the rest posture after a toggle [s]: out of the overview camera's view, and
     every toggle starts from the same arm configuration."""
@@ -400,9 +405,10 @@ class Toggler:
             self.guard = True
 
     def _retreat_moves(self) -> None:
+        """Open to the pre-grasp closure (wide enough to let the 12 mm post go; fully open, the ~8 cm
+        fingers caught neighbouring parts on the way up), lift, and go to rest."""
         c = self.config
-        self.robot.command_gripper(0.0)
-        self._gripper(0.0, c.release_time)
+        self._gripper(c.pregrasp_closure, c.release_time)
         try:
             self.ik.set_joints(self.robot.joint_positions())
             up = self.robot.tcp_pose_in_base()
@@ -421,5 +427,20 @@ class Toggler:
             self.withdraw()
 
     def _interpolate_to_rest(self) -> None:
-        self._joint_move(np.asarray(self.rest_posture), self.config.rest_time)
-        self.robot.wait(self.config.settle_time)
+        """Lift the TCP straight up to ``transit_height``, clear of the box and anything standing on it,
+        move it to the transit waypoint, and only from there interpolate the joints to the rest posture
+        (folded over the base, out of the overview's view): interpolated from wherever the arm was, the
+        joints swept the gripper base into the arm's own link 2 (69-185 N on the wrist)."""
+        c = self.config
+        try:
+            self.ik.set_joints(self.robot.joint_positions())
+            via = self.robot.tcp_pose_in_base()
+            if via[2, 3] < c.transit_height - 0.01:
+                via[2, 3] = c.transit_height
+                self.move_to(via, c.lift_time)
+            via[:3, 3] = (*c.transit_xy, max(via[2, 3], c.transit_height))
+            self.move_to(via, c.lift_time)
+        except IKFailure:
+            pass  # as far as the arm goes: interpolate from here
+        self._joint_move(np.asarray(self.rest_posture), c.rest_time)
+        self.robot.wait(c.settle_time)

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from models.calibration import CellCalibration
+from models.reach import MIN_REACH
 from models.robot import Robot
 from skills.errors import ForceLimitExceeded, IKFailure, MarkersNotFound
 from skills.kinematics import top_down
@@ -99,12 +100,15 @@ class SceneSurvey:
 
     def _wrist_from_above(self, point: np.ndarray, height: float) -> bool:
         """Put the wrist camera ``height`` above ``point`` looking down, arriving through the toggler's
-        transit waypoint high above the workspace; False if the arm cannot, or if the force limit
-        stopped it (it then withdraws)."""
+        transit waypoint high above the workspace, the camera turned so the TCP stays at least
+        ``MIN_REACH`` from the base axis; False if the arm cannot, or if the force limit stopped it (it
+        then withdraws)."""
         T_tcp_camera = self.calibration.camera(WRIST_CAMERA).T_tcp_camera
         for yaw in (0.0, np.pi / 2, -np.pi / 2, np.pi):
             target = top_down(np.zeros(3), yaw)
             target[:3, 3] = np.asarray(point, float) + (0.0, 0.0, height) - target[:3, :3] @ T_tcp_camera[:3, 3]
+            if np.hypot(*target[:2, 3]) < MIN_REACH:
+                continue  # the camera's offset puts the gripper over the base: it meets the arm's link 2
             try:
                 self.toggler.travel_to(target, self.config.move_time)
                 return True

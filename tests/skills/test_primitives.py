@@ -8,7 +8,7 @@ from models.generator import generate_chain
 from skills import MarkerDetector, joint_model, lid_height, select_markers, upright_pose
 from skills.errors import IKFailure
 from skills.kinematics import ArmKinematics, top_down
-from skills.primitives import Toggler
+from skills.primitives import PrimitiveConfig, Toggler
 from twin.nominal_calibration import nominal_calibration
 from twin.session import TwinSession
 
@@ -44,7 +44,7 @@ def test_a_latched_part_of_each_kind_is_reported_blocked_and_stays_put(chain, na
     assert result.outcome == "blocked", result.reason
     assert result.peak_opposing_force > 5.0 and result.progress < 0.1
     assert abs(session.component_positions()[j] - before) < 0.02  # the latch held against the pull
-    assert session.robot.gripper_opening() < 0.2  # and the robot let go
+    assert session.robot.gripper_opening() <= PrimitiveConfig().pregrasp_closure + 0.05  # and the robot let go
 
 
 def test_a_free_slide_then_the_door_it_released_are_opened(chain):
@@ -56,7 +56,7 @@ def test_a_free_slide_then_the_door_it_released_are_opened(chain):
     door = toggler.toggle(models["door-1"])
     assert door.outcome == "moved", door.reason
     assert session.component_states()[1] == 1
-    assert 5.0 < door.sim_time < 12.0
+    assert 5.0 < door.sim_time < 16.0  # a slow descent and a return to rest through the transit waypoint
 
 
 def test_a_free_wheel_is_turned_open():
