@@ -52,15 +52,12 @@ def main(argv: list[str] | None = None) -> int:
     if args.agent != "memory":
         if args.checkpoint is None or args.memory is not None:
             fail(f"--agent {args.agent} trains a network: give --checkpoint FILE (and no --memory)")
+        _check_writable(Path(args.checkpoint), "--checkpoint")
         return _train_deep(args, specs)
     if args.memory is None:
         fail("the memory agent needs --memory MEM.sqlite")
     memory_path = Path(args.memory)
-    if memory_path.is_dir():
-        fail(f"--memory {memory_path} is a directory, not a memory file")
-    writable = memory_path if memory_path.exists() else memory_path.parent
-    if writable.exists() and not os.access(writable, os.W_OK):
-        fail(f"--memory {memory_path}: cannot write {'it' if memory_path.exists() else 'there'} (read-only)")
+    _check_writable(memory_path, "--memory")
     try:
         store = MemoryStore(args.memory)
         run_id = store.begin_training_run({"command": "train", **vars(args), "versions": versions()})
@@ -92,6 +89,19 @@ def main(argv: list[str] | None = None) -> int:
               file=sys.stderr)  # fmt: skip
         return 130
     return 0
+
+
+def _check_writable(path: Path, flag: str) -> None:
+    """Fail now, not after the training, if ``path`` cannot be written."""
+    if path.is_dir():
+        fail(f"{flag} {path} is a directory, not a file")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        fail(f"{flag} {path}: cannot create its directory ({err.strerror})")
+    target = path if path.exists() else path.parent
+    if not os.access(target, os.W_OK):
+        fail(f"{flag} {path}: cannot write {'it' if path.exists() else 'there'} (read-only)")
 
 
 def _train_deep(args: argparse.Namespace, specs: list) -> int:

@@ -6,6 +6,7 @@ so a checkpoint can be reloaded — and its result re-run — exactly.
 from __future__ import annotations
 
 import json
+import pickle
 import platform
 from dataclasses import asdict
 from importlib import metadata
@@ -52,6 +53,10 @@ def save_checkpoint(agent: DQNAgent | ModelBasedAgent, path: str | Path) -> Path
     return path
 
 
+def one_line(err: BaseException) -> str:
+    return " ".join(str(err).split())[:300]
+
+
 def load_checkpoint(path: str | Path, expected_agent: str | None = None) -> DQNAgent | ModelBasedAgent:
     """The agent of a checkpoint, ready to evaluate (``training = False``)."""
     path = Path(path)
@@ -67,13 +72,20 @@ def load_checkpoint(path: str | Path, expected_agent: str | None = None) -> DQNA
     if expected_agent is not None and meta["agent"] != expected_agent:
         raise CheckpointError(f"{path} holds agent {meta['agent']!r}, not {expected_agent!r}")
     agent_cls, config_cls = AGENTS[meta["agent"]]
-    raw = dict(meta["config"])
-    raw["network"] = GraphNetworkConfig(**raw["network"])
-    agent = agent_cls(config_cls(**raw))
     try:
-        _network(agent).load_state_dict(torch.load(path, weights_only=True))
-    except (RuntimeError, OSError, ValueError) as err:
-        raise CheckpointError(f"{path}: weights do not match the recorded config: {err}") from None
+        raw = dict(meta["config"])
+        raw["network"] = GraphNetworkConfig(**raw["network"])
+        agent = agent_cls(config_cls(**raw))
+    except (KeyError, TypeError, ValueError) as err:
+        raise CheckpointError(f"{meta_path} records no valid {meta['agent']} config: {err}") from None
+    try:
+        state = torch.load(path, weights_only=True)
+    except (pickle.UnpicklingError, EOFError, RuntimeError, OSError, ValueError) as err:
+        raise CheckpointError(f"{path} is not a torch checkpoint ({type(err).__name__})") from None
+    try:
+        _network(agent).load_state_dict(state)
+    except (RuntimeError, TypeError, ValueError, AttributeError) as err:
+        raise CheckpointError(f"{path}: weights do not match the recorded config: {one_line(err)}") from None
     agent.episodes = int(meta.get("episodes", 0))
     agent.training = False
     return agent

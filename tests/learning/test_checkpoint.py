@@ -55,6 +55,13 @@ def test_bad_checkpoints_are_clear_errors(tmp_path):
     path = save_checkpoint(agent, tmp_path / "dqn.pt")
     with pytest.raises(CheckpointError, match="not 'model-based'"):
         load_checkpoint(path, expected_agent="model-based")
+    meta = (tmp_path / "dqn.pt.json").read_text()
+    path.write_bytes(b"not a checkpoint")  # the .pt is garbage, its .json intact
+    with pytest.raises(CheckpointError, match="not a torch checkpoint"):
+        load_checkpoint(path)
+    (tmp_path / "dqn.pt.json").write_text(meta.replace('"network"', '"netwerk"'))
+    with pytest.raises(CheckpointError, match="no valid dqn config"):
+        load_checkpoint(path)
     (tmp_path / "dqn.pt.json").write_text("{not json")
     with pytest.raises(CheckpointError, match="JSON"):
         load_checkpoint(path)

@@ -253,3 +253,18 @@ def test_an_output_directory_of_another_configuration_is_refused_unless_forced(t
     negative = subprocess.run(list(map(str, _symbolic_trial(specs, tmp_path / "n", 1, "--seed", -1))),
                               capture_output=True, text=True)  # fmt: skip
     assert negative.returncode == 2 and "error: --seed must be >= 0, got -1" in negative.stderr
+
+
+def test_train_refuses_an_output_it_cannot_write_before_any_work(tmp_path):
+    specs = tmp_path / "specs"
+    assert run(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", specs).returncode == 0
+    spec = specs / "paper-test-0.json"
+    blocked = tmp_path / "a-file"
+    blocked.write_text("")  # a file where a directory should be: nothing can be created under it
+    for flags in (["--memory", blocked / "m.sqlite"], ["--agent", "dqn", "--checkpoint", blocked / "x.pt"]):
+        result = run(ROOT / "scripts/train.py", "--specs", spec, "--episodes", 1, *flags)
+        assert result.returncode == 2 and "cannot create its directory" in result.stderr, result.stderr
+        assert "Traceback" not in result.stderr
+    memory = tmp_path / "m.sqlite"
+    negative = run(ROOT / "scripts/train.py", "--specs", spec, "--episodes", 1, "--memory", memory, "--seed", -3)
+    assert negative.returncode == 2 and "--seed must be >= 0" in negative.stderr
