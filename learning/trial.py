@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -44,10 +45,19 @@ class RunResult:
         return asdict(self)
 
 
-def run_episode(agent: Agent, world: World, spec_name: str, seed: int, max_actions: int) -> RunResult:
+def run_episode(
+    agent: Agent,
+    world: World,
+    spec_name: str,
+    seed: int,
+    max_actions: int,
+    on_action: Callable[[ActionRecord], None] | None = None,
+) -> RunResult:
     """Let ``agent`` act on ``world`` until the goal is reached or ``max_actions`` tries are spent.
 
     The agent's random generator is ``default_rng(seed)``, so a run is reproducible from its seed.
+    ``on_action`` is called after every try (progress bars: a decision on a 40-component box takes
+    seconds, a try in the twin ten).
     """
     start = time.perf_counter()
     observation = world.observe()
@@ -63,6 +73,8 @@ def run_episode(agent: Agent, world: World, spec_name: str, seed: int, max_actio
         agent.record(index, result, observation)
         name = name_of(index) if name_of else str(index)
         actions.append(ActionRecord(name, result.moved, result.outcome, result.reason))
+        if on_action is not None:
+            on_action(actions[-1])
         repeated = len(actions) > 1 and actions[-2].component == name and actions[-2].outcome == "failed"
         failures_in_a_row = (failures_in_a_row + 1 if repeated else 1) if result.outcome == "failed" else 0
         if result.give_up or failures_in_a_row >= MAX_FAILURES_IN_A_ROW:

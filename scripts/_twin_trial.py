@@ -4,6 +4,7 @@ perception, the agent, the primitives, physics — with a timeline and, optional
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -107,6 +108,7 @@ def run_twin_trial(
     checkpoint: str | None = None,
     reality: RealityProfile | str | None = None,
     calibration: CellCalibration | None = None,
+    on_action: Callable[[Any], None] | None = None,
 ) -> dict[str, Any]:
     """One end-to-end trial; returns the contract's run entry plus a ``timeline`` and figures.
 
@@ -141,7 +143,7 @@ def run_twin_trial(
                 truth = session.data.site(session.scene.names.components[c.name].frame_site).xpos
                 pose_errors[c.name] = float(np.linalg.norm(world.closed_poses[c.marker][:2] - truth[:2]))
             agent = make_agent(agent_name, spec, memory, checkpoint, belief=CELL_BELIEF)
-            result = run_episode(agent, world, spec.name, seed, max_actions)
+            result = run_episode(agent, world, spec.name, seed, max_actions, on_action)
         except (SkillError, SimulationDiverged) as err:  # the cell could not run this trial: say why
             result = RunResult(spec.name, seed, False, len(world.log) if world else 0, 0.0,
                                ended=f"{type(err).__name__}: {err}")  # fmt: skip

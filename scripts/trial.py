@@ -69,7 +69,8 @@ def twin_figures(runs: list) -> dict:
 
 
 def _run(args, spec, seed, memory, reality, calibration, out: Path, n_jobs: int) -> dict:
-    """One run's record (a dict: the contract's run entry)."""
+    """One run's record (a dict: the contract's run entry), its actions counted on an inner bar."""
+    bar = tqdm(total=args.max_actions, desc=f"  {spec.name} seed {seed}", unit="action", leave=False, disable=None)
     try:
         if args.sim == "twin":
             from _twin_trial import run_twin_trial  # MuJoCo and rendering only when asked
@@ -77,14 +78,17 @@ def _run(args, spec, seed, memory, reality, calibration, out: Path, n_jobs: int)
             name = "rollout.mp4" if n_jobs == 1 else f"rollout-{spec.name}-s{seed}.mp4"
             video = out / name if args.video else None
             return run_twin_trial(
-                spec, seed, args.agent, memory, args.max_actions, video, args.checkpoint, reality, calibration
-            )
+                spec, seed, args.agent, memory, args.max_actions, video, args.checkpoint, reality, calibration,
+                on_action=lambda _: bar.update(),
+            )  # fmt: skip
         agent = make_agent(args.agent, spec, memory, args.checkpoint)
-        return run_episode(agent, SymbolicWorld(spec, seed), spec.name, seed,
-                           args.max_actions).to_dict()  # fmt: skip
+        world = SymbolicWorld(spec, seed)
+        return run_episode(agent, world, spec.name, seed, args.max_actions, lambda _: bar.update()).to_dict()
     except (LearningError, ModelsError, SkillError, TwinError) as err:
         fail(f"{spec.name} seed {seed}: {err}")
         raise  # unreachable: fail exits
+    finally:
+        bar.close()
 
 
 def _results(runs: list[dict], args, planned: int) -> dict:

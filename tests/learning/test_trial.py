@@ -3,7 +3,7 @@ import numpy as np
 from learning import OracleAgent, PuzzleEnvConfig, RandomAgent, SymbolicWorld, run_episode, summarise
 from learning.puzzle_env import FaultConfig
 from models import LockTable, World
-from models.generator import RandomGraphConfig, generate_random, paper_family
+from models.generator import RandomGraphConfig, generate_chain, generate_random, paper_family
 
 
 def test_symbolic_world_satisfies_the_world_protocol():
@@ -50,3 +50,10 @@ def test_summary_counts_unsolved_runs_at_the_budget():
     summary = summarise(runs, max_actions=3)
     assert summary["success_rate"] == 0.0 and summary["mean_actions"] == 3.0
     assert np.all([len(r["actions"]) == 3 for r in summary["runs"]])
+
+
+def test_on_action_sees_every_try_as_it_happens():
+    spec = generate_chain(["door", "slide", "wheel"], seed=0)
+    seen: list = []
+    result = run_episode(OracleAgent(spec), SymbolicWorld(spec, 0), spec.name, 0, 10, on_action=seen.append)
+    assert seen == result.actions and len(seen) == 3
