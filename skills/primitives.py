@@ -54,7 +54,7 @@ class PrimitiveConfig:
     the way (a door left leaning over its neighbour) is met softly and the force guard stops the arm
     near its limit; at 1 s the impact put up to 270 N of true force on the wrist."""
     close_time: float = 0.6
-    close_speed: float = 0.6
+    close_speed: float = 0.4
     """Rate at which the gripper's commanded closure ramps up while closing on a handle [1/s]: the
     servo alone snaps the fingers shut at ~2/s, and pads meeting a post at that speed put a 30 ms,
     60 N impact on the wrist."""

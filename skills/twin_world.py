@@ -38,7 +38,7 @@ from models.robot import Robot
 from skills.joint_model import JointModel, joint_model
 from skills.perception import MarkerDetector, kind_of, lid_height, upright_pose
 from skills.primitives import Toggler, ToggleResult
-from skills.scene_survey import OVERVIEW_CAMERA, SceneSurvey, SurveyConfig
+from skills.scene_survey import SceneSurvey, SurveyConfig
 
 MOVED_DISTANCE = 0.01
 """A re-observed marker this far from its closed pose has moved [m]..."""
@@ -105,7 +105,7 @@ class TwinWorld:
         order = np.random.default_rng(self.seed).permutation(sorted(self.marker_map))
         self.markers = [int(m) for m in order]
         self.closed_poses = {m: found[m].planar_pose for m in self.markers}
-        self.seen_by_overview = {m for m in self.markers if found[m].camera == OVERVIEW_CAMERA}
+        self.seen_by_overview = set(self.survey.overview_trusted)
         self.joint_models: dict[int, JointModel] = {m: self._joint_model(m) for m in self.markers}
         self.states = np.zeros(len(self.markers), dtype=np.int64)
 

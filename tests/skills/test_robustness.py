@@ -157,7 +157,7 @@ def test_a_latched_door_whose_handle_slides_out_of_a_weak_grip_is_never_read_as_
 def test_closing_on_a_handle_puts_no_impact_on_the_wrist():
     """The pads meet a wheel's post a few millimetres off their centre here; snapped shut by the servo
     they hit it with a 30 ms, 62 N true wrist force (past the 60 N safety limit, too short for the
-    filtered guard to see). Closed at a ramped command, the impact stays under 35 N."""
+    filtered guard to see). Closed at a ramped command (0.4 closure/s), it is ~30 N."""
     spec = paper_family("test", seed=0)[1]
     with TwinSession(spec, seed=0) as session:
         world = twin_world(session)
