@@ -21,9 +21,12 @@ or that is damaged (truncated, failed integrity check, malformed rows) raises
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
+import os
 import sqlite3
+import tempfile
 import time
 from collections import defaultdict
 from dataclasses import dataclass
@@ -108,29 +111,41 @@ class MemoryStore:
         return cls(path)
 
     # -- persistence -------------------------------------------------------------------------------
+    def _create(self, path: Path) -> None:
+        """Create an empty memory at ``path`` whole: built under a temporary name beside it and linked into
+        place only if ``path`` is still absent, so a concurrent trainer never opens a half-made (empty) file;
+        whoever loses the race opens the winner's."""
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        os.close(fd)
+        try:
+            conn = sqlite3.connect(name)
+            with conn:
+                conn.executescript(_SCHEMA)
+                conn.executemany(
+                    "INSERT INTO meta VALUES (?, ?)",
+                    [
+                        ("format", MEMORY_FORMAT),
+                        ("schema_version", str(SCHEMA_VERSION)),
+                        ("position_scale", repr(self.position_scale)),
+                    ],
+                )
+            conn.close()
+            with contextlib.suppress(FileExistsError):
+                os.link(name, path)
+        finally:
+            os.unlink(name)
+
     def _open_file(self, path: Path) -> None:
-        exists = path.exists()
-        if exists and path.stat().st_size == 0:  # a memory is never empty on disk: cut short or foreign
+        if not path.exists():
+            self._create(path)
+        if path.stat().st_size == 0:  # a memory is never empty on disk: cut short or foreign
             raise MemoryFileError(f"{path} is empty (0 bytes): truncated or not a puzzlebox memory")
-        if not exists:
-            path.parent.mkdir(parents=True, exist_ok=True)
         conn = None
         try:
             conn = sqlite3.connect(path, timeout=BUSY_TIMEOUT)
-            if exists:
-                self._check(conn, path)
-                self._load(conn, path)
-            else:
-                with conn:
-                    conn.executescript(_SCHEMA)
-                    conn.executemany(
-                        "INSERT INTO meta VALUES (?, ?)",
-                        [
-                            ("format", MEMORY_FORMAT),
-                            ("schema_version", str(SCHEMA_VERSION)),
-                            ("position_scale", repr(self.position_scale)),
-                        ],
-                    )
+            self._check(conn, path)
+            self._load(conn, path)
         except (sqlite3.DatabaseError, MemoryFileError) as err:
             if conn is not None:
                 conn.close()
