@@ -359,7 +359,7 @@ class Toggler:
             self.move_to(at_grasp, 0.5)
             return ToggleResult("blocked", "latched: pulled without progress", progress, peak, forces=forces)
         return ToggleResult(
-            "failed", f"only {progress:.0%} of the travel covered (slip?)", progress, peak, forces=forces
+            "failed", f"IncompleteTravel: only {progress:.0%} of the travel covered", progress, peak, forces=forces
         )
 
     def _check_grip(self, progress: float) -> None:

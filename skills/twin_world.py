@@ -196,7 +196,7 @@ class TwinWorld:
         if seen is None:
             if opening or not self.survey.last_close_up_reached:
                 return TryResult("moved")
-            return TryResult("failed", "the handle moved but the part is not back at its closed pose: slipped")
+            return TryResult("failed", "SlipDetected: the handle moved but the part is not back at its closed pose")
         return self._verdict(seen.planar_pose, marker, opening)
 
     def _verdict(self, pose: np.ndarray, marker: int, opening: bool) -> TryResult:
@@ -205,7 +205,7 @@ class TwinWorld:
         away = bool(np.linalg.norm(delta[:2]) > MOVED_DISTANCE or turn > MOVED_ANGLE)
         if away == opening:
             return TryResult("moved")
-        return TryResult("failed", "the handle moved but the marker did not: slipped")
+        return TryResult("failed", "SlipDetected: the handle moved but the marker did not")
 
     def ground_truth_name(self, index: int) -> str:
         """For logs: the spec name of component ``index`` when given, else its marker id."""

@@ -150,7 +150,7 @@ def test_a_latched_door_whose_handle_slides_out_of_a_weak_grip_is_never_read_as_
         world = twin_world(session)
         door = spec.components[spec.index_of("door-3")]  # locked closed while slide-2 is closed
         result = world.try_toggle(world.markers.index(door.marker))
-        assert result.outcome in ("failed", "blocked") and "slipped" in result.reason, result
+        assert result.outcome in ("failed", "blocked") and "slip" in result.reason.lower(), result
         assert world.log[-1].true_moved is False and world.states.tolist() == [0] * 5
 
 
