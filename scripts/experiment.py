@@ -4,6 +4,7 @@ the reality gap in the twin.
     python scripts/experiment.py {variants,episodes,noise,all} --agents memory,dqn,model-based,mt-dqn,mt-model-based \\
         --out DIR [--quick] [--runs R] [--seeds S] [--workers W]
     python scripts/experiment.py reality --out DIR [--quick] [--runs R] [--memory MEM.sqlite]
+    python scripts/experiment.py faults --out DIR [--quick] [--runs R]
 
 Writes ``DIR/<protocol>.json`` (every point, mean and std over training seeds and each seed's value,
 the settings), ``DIR/<protocol>.png`` (success and mean actions, like the paper's Fig. 3 panels) and
@@ -24,6 +25,11 @@ alone over σ; each profile's cell is calibrated from ChArUco images first. It w
 factor's level; the F/T noise at which outcome agreement drops below 99 %) and keeps every calibration and
 trial in ``DIR/calibrations/`` and ``DIR/trials/``: the same command resumes. ``--memory`` is the memory
 agent's store (default: trained into ``DIR/memory.sqlite`` on the paper training boxes).
+
+``faults`` (``scripts/_faults.py``) runs each fault class on purpose in real processes — ``trial.py``
+SIGKILLed at random moments and resumed (``--runs`` runs in the twin; ``--quick``: symbolic), concurrent
+trainers on one memory, a memory truncated at every page, the ordinary command-line mistakes — and writes
+``DIR/faults.{json,md}``: cases, detected, survived, data kept.
 """
 
 from __future__ import annotations
@@ -44,13 +50,14 @@ from learning.experiments.report import episodes_to_solve_table
 
 PLANNED = ("disassembly",)
 REALITY = "reality"
+FAULTS = "faults"
 ALL = "all"
 AGENTS = (*SYMBOLIC_AGENTS, *DEEP_AGENTS)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("protocol", choices=(*PROTOCOLS, ALL, REALITY, *PLANNED))
+    parser.add_argument("protocol", choices=(*PROTOCOLS, ALL, REALITY, FAULTS, *PLANNED))
     parser.add_argument("--agents", default=None, help=f"comma-separated, from {list(AGENTS)} (reality: memory)")
     parser.add_argument("--out", required=True, help="output directory (also the resume cache of deep jobs)")
     parser.add_argument("--quick", action="store_true", help="CI size: few runs, one training seed, short schedules")
@@ -67,6 +74,8 @@ def main(argv: list[str] | None = None) -> int:
 
     if args.protocol == REALITY:
         return _reality(args)
+    if args.protocol == FAULTS:
+        return _faults(args)
     if args.memory is not None:
         fail("--memory is for the reality protocol (the symbolic protocols train their own)")
     if args.agents is None:
@@ -153,6 +162,25 @@ def _reality(args: argparse.Namespace) -> int:
     summary = run_sweep(out, config, memory)
     print((out / "reality.md").read_text())
     print(f"reality: {summary['wall_time_s']:.0f} s -> {out}/")
+    return 0
+
+
+def _faults(args: argparse.Namespace) -> int:
+    from _faults import FaultsConfig, run_faults
+
+    if args.agents is not None or args.seeds is not None or args.workers is not None or args.memory is not None:
+        fail("the faults protocol takes only --out, --quick and --runs")
+    config = FaultsConfig().quick() if args.quick else FaultsConfig()
+    if args.runs is not None:
+        if args.runs < 2:
+            fail(f"--runs must be >= 2 (a kill lands between two runs), got {args.runs}")
+        config = replace(config, trial_runs=args.runs)
+    out = Path(args.out)
+    write_json(out / "faults.config.json", {"command": "experiment", **vars(args), "faults": asdict(config),
+                                            "versions": versions()})  # fmt: skip
+    summary = run_faults(out, config)
+    print((out / "faults.md").read_text())
+    print(f"faults: {summary['wall_time_s']:.0f} s -> {out}/")
     return 0
 
 

@@ -1,0 +1,285 @@
+"""The fault suite of ``experiment.py faults``: each fault class run on purpose, in real processes, with its
+figure — cases run, detected (said so, in one line), survived (no traceback, the command went on or stopped
+cleanly), data kept (nothing finished was lost or duplicated).
+
+Classes so far:
+
+- ``trial killed``: ``trial.py`` SIGKILLed at random moments of a trial, then ``--resume``d; its results
+  compared with an uninterrupted run's (wall times aside).
+- ``concurrent trainers``: 2 and 4 ``train.py`` on one memory file; every episode in the memory and its log.
+- ``memory truncated``: a trained memory cut at every SQLite page boundary (and inside the first page),
+  opened by ``trial.py``: refused in one line each time.
+- ``command-line mistakes``: each ordinary mistake a user makes, one line and exit 2.
+
+Writes ``DIR/faults.json`` and ``DIR/faults.md`` (one table, linked from the README).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from _cli import write_json
+
+from learning.memory import MemoryStore
+
+ROOT = Path(__file__).resolve().parents[1]
+SCRIPTS = ROOT / "scripts"
+
+
+@dataclass(frozen=True)
+class FaultsConfig:
+    """Sizes of the fault suite."""
+
+    sim: str = "twin"
+    """Simulator of the killed trial: ``twin`` (the issue's figure) or ``symbolic`` (seconds)."""
+    trial_runs: int = 20
+    """Runs of the killed trial (on paper-test-0; seeds 0..runs-1)."""
+    kills: int = 10
+    """SIGKILLs, each at a random moment of its own trial, each followed by a resume."""
+    trainer_episodes: int = 4
+    """Episodes per concurrent trainer."""
+    seed: int = 0
+    """Seeds the kill moments."""
+
+    def quick(self) -> FaultsConfig:
+        return FaultsConfig(sim="symbolic", trial_runs=60, kills=3, trainer_episodes=2, seed=self.seed)
+
+
+@dataclass
+class FaultRow:
+    """One fault class's figure."""
+
+    fault: str
+    cases: int
+    detected: str
+    survived: str
+    data_kept: str
+    notes: str = ""
+
+
+def _python(*args: Any, timeout: float = 1800) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, *map(str, args)], capture_output=True, text=True, timeout=timeout)
+
+
+def _one_line_error(result: subprocess.CompletedProcess) -> bool:
+    lines = [line for line in result.stderr.splitlines() if line.strip() and not line.startswith("\r")]
+    errors = [line for line in lines if line.startswith("error: ")]
+    return result.returncode == 2 and len(errors) == 1 and "Traceback" not in result.stderr
+
+
+def _without_times(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: _without_times(v) for k, v in value.items() if "wall" not in k}
+    if isinstance(value, list):
+        return [_without_times(v) for v in value]
+    return value
+
+
+def _specs(out: Path) -> Path:
+    specs = out / "specs"
+    if not (specs / "paper-test-0.json").exists():
+        _python(SCRIPTS / "generate.py", "paper", "--split", "all", "--out", specs).check_returncode()
+    return specs
+
+
+def killed_trial(out: Path, config: FaultsConfig) -> FaultRow:
+    """SIGKILL ``trial.py`` at ``config.kills`` random moments (each in its own directory), resume each, and
+    compare with an uninterrupted run."""
+    spec = _specs(out) / "paper-test-0.json"
+    base = [SCRIPTS / "trial.py", "--specs", spec, "--sim", config.sim, "--agent", "oracle",
+            "--runs", config.trial_runs, "--seed", 0, "--max-actions", 30]  # fmt: skip
+    whole_dir = out / "killed-trial" / "whole"
+    if not (whole_dir / "results.json").exists():
+        shutil.rmtree(whole_dir, ignore_errors=True)
+        _python(*base, "--out", whole_dir).check_returncode()
+    whole = _without_times(json.loads((whole_dir / "results.json").read_text()))
+    rng = np.random.default_rng(config.seed)
+    lost = duplicated = identical = resumed = 0
+    moments = []
+    for k in range(config.kills):
+        target = out / "killed-trial" / f"kill-{k}"
+        shutil.rmtree(target, ignore_errors=True)
+        at = int(rng.integers(1, config.trial_runs))  # kill once this many runs are recorded
+        proc = subprocess.Popen([sys.executable, *map(str, base), "--out", str(target)],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+        while proc.poll() is None and len(list((target / "runs").glob("*.json"))) < at:
+            time.sleep(0.01)
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+        kept = sorted(p.name for p in (target / "runs").glob("*.json")) if (target / "runs").is_dir() else []
+        moments.append(len(kept))
+        result = _python(*base, "--out", target, "--resume")
+        resumed += result.returncode == 0
+        got = json.loads((target / "results.json").read_text()) if (target / "results.json").exists() else {}
+        names = [f"{r['spec']}-{r['seed']}" for r in got.get("runs", [])]
+        lost += config.trial_runs - len(set(names))
+        duplicated += len(names) - len(set(names))
+        identical += _without_times(got) == whole
+    return FaultRow(
+        "trial.py killed (SIGKILL) and resumed",
+        config.kills,
+        "n/a (a kill cannot be seen)",
+        f"{resumed}/{config.kills} resumed",
+        f"{lost} runs lost, {duplicated} duplicated; {identical}/{config.kills} results identical to an "
+        "uninterrupted run (wall times aside)",
+        f"{config.sim}, {config.trial_runs} runs; killed with {moments} runs recorded",
+    )
+
+
+def concurrent_trainers(out: Path, config: FaultsConfig, trainers: int) -> FaultRow:
+    """``trainers`` processes of ``train.py`` on one new memory file at once."""
+    specs = sorted(_specs(out).glob("paper-train-*.json"))
+    memory = out / "concurrent" / f"{trainers}" / "memory.sqlite"
+    shutil.rmtree(memory.parent, ignore_errors=True)
+    memory.parent.mkdir(parents=True)
+    procs = [
+        subprocess.Popen(
+            [
+                sys.executable,
+                str(SCRIPTS / "train.py"),
+                "--specs",
+                *map(str, specs),
+                "--episodes",
+                str(config.trainer_episodes),
+                "--memory",
+                str(memory),
+                "--seed",
+                str(100 * k),
+            ],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+        )  # fmt: skip
+        for k in range(trainers)
+    ]
+    errors = [p.communicate(timeout=1800)[1] for p in procs]
+    ok = sum(p.returncode == 0 for p in procs)
+    store = MemoryStore.open_existing(memory)
+    logged = sum(len(r["episodes"]) for r in store.training_log())
+    wanted = trainers * config.trainer_episodes
+    store.close()
+    return FaultRow(
+        f"{trainers} concurrent train.py on one memory",
+        trainers,
+        "n/a (not a fault: must just work)",
+        f"{ok}/{trainers} trainers succeeded" + ("" if ok == trainers else f" ({errors})"),
+        f"{store.num_episodes}/{wanted} episodes in the memory, {logged}/{wanted} in its log",
+    )
+
+
+def truncated_memory(out: Path) -> FaultRow:
+    """A trained memory cut at every page boundary (and mid first page), each opened by ``trial.py``."""
+    specs = _specs(out)
+    memory = out / "truncated" / "memory.sqlite"
+    if not memory.exists():
+        memory.parent.mkdir(parents=True, exist_ok=True)
+        _python(SCRIPTS / "train.py", "--specs", *sorted(specs.glob("paper-train-*.json")), "--episodes", 9,
+                "--memory", memory).check_returncode()  # fmt: skip
+    data = memory.read_bytes()
+    page = int.from_bytes(data[16:18], "big") or 65536
+    cuts = [0, 50, page // 2, *range(page, len(data), page)]
+    detected = survived = 0
+    for cut in cuts:
+        cut_file = memory.parent / f"cut-{cut}.sqlite"
+        cut_file.write_bytes(data[:cut])
+        result = _python(SCRIPTS / "trial.py", "--specs", specs / "paper-test-0.json", "--sim", "symbolic",
+                         "--agent", "memory", "--memory", cut_file, "--runs", 1, "--seed", 0, "--max-actions", 30,
+                         "--out", memory.parent / f"trial-{cut}", "--force")  # fmt: skip
+        detected += _one_line_error(result)
+        survived += "Traceback" not in result.stderr
+        cut_file.unlink()
+    return FaultRow(
+        "memory file truncated at every page",
+        len(cuts),
+        f"{detected}/{len(cuts)} refused in one line (exit 2)",
+        f"{survived}/{len(cuts)} without a traceback",
+        "the trial never ran on a damaged memory",
+        f"{len(data)} bytes, {page}-byte pages",
+    )
+
+
+def cli_mistakes(out: Path) -> FaultRow:
+    """Ordinary command-line mistakes: each must be one ``error:`` line and exit 2."""
+    specs = _specs(out)
+    spec = specs / "paper-test-0.json"
+    a_file = out / "cli" / "a-file"
+    a_file.parent.mkdir(parents=True, exist_ok=True)
+    a_file.write_text("")
+    broken = out / "cli" / "broken.json"
+    broken.write_text('{"format": "puzzlebox-spec/1", "format": "x"}')
+    bad_pt = out / "cli" / "bad.pt"
+    bad_pt.write_bytes(b"not a checkpoint")
+    trial = [SCRIPTS / "trial.py", "--specs", spec, "--sim", "symbolic", "--runs", 1, "--max-actions", 5]
+    cases = {
+        "--out names a file": [*trial, "--seed", 0, "--agent", "dual", "--out", a_file],
+        "negative --seed": [*trial, "--seed", -1, "--agent", "dual", "--out", out / "cli" / "o1"],
+        "unknown agent": [*trial, "--seed", 0, "--agent", "genius", "--out", out / "cli" / "o2"],
+        "spec with a duplicate key": [SCRIPTS / "trial.py", "--specs", broken, "--sim", "symbolic", "--runs", 1,
+                                      "--max-actions", 5, "--seed", 0, "--agent", "dual", "--out", out / "cli" / "o3"],
+        "no such memory": [*trial, "--seed", 0, "--agent", "memory", "--memory", out / "cli" / "none.sqlite",
+                           "--out", out / "cli" / "o4"],
+        "a .pt that is not a checkpoint": [*trial, "--seed", 0, "--agent", "dqn", "--checkpoint", bad_pt, "--out",
+                                           out / "cli" / "o5"],
+        "memory under a file": [SCRIPTS / "train.py", "--specs", spec, "--episodes", 1, "--memory", a_file / "m"],
+        "unknown reality profile": [*trial[:4], "twin", *trial[5:], "--seed", 0, "--agent", "oracle",
+                                    "--reality", "stormy", "--out", out / "cli" / "o6"],
+        "random box too large to reach": [SCRIPTS / "generate.py", "random", "--components", 40, "--seed", 0,
+                                          "--out", out / "cli" / "r.json"],
+    }  # fmt: skip
+    if bad_pt.exists():
+        Path(str(bad_pt) + ".json").write_text('{"format": "nothing"}')
+    failed = []
+    for name, args in cases.items():
+        if not _one_line_error(_python(*args)):
+            failed.append(name)
+    return FaultRow(
+        "command-line mistakes",
+        len(cases),
+        f"{len(cases) - len(failed)}/{len(cases)} one line, exit 2",
+        f"{len(cases) - len(failed)}/{len(cases)} without a traceback",
+        "n/a",
+        ", ".join(cases) + (f"; NOT one line: {failed}" if failed else ""),
+    )
+
+
+def run_faults(out: Path, config: FaultsConfig) -> dict[str, Any]:
+    """Run every fault class; write ``DIR/faults.{json,md}`` after each (nothing lost if interrupted)."""
+    start = time.perf_counter()
+    rows: list[FaultRow] = []
+    steps = [
+        lambda: cli_mistakes(out),
+        lambda: truncated_memory(out),
+        lambda: concurrent_trainers(out, config, 2),
+        lambda: concurrent_trainers(out, config, 4),
+        lambda: killed_trial(out, config),
+    ]
+    summary: dict[str, Any] = {}
+    for step in steps:
+        rows.append(step())
+        summary = {"config": asdict(config), "rows": [asdict(r) for r in rows],
+                   "wall_time_s": time.perf_counter() - start}  # fmt: skip
+        write_json(out / "faults.json", summary)
+        (out / "faults.md").write_text(markdown(rows))
+    return summary
+
+
+def markdown(rows: list[FaultRow]) -> str:
+    lines = [
+        "# Fault suite",
+        "",
+        "Each fault run on purpose in real processes (`python scripts/experiment.py faults --out DIR`).",
+        "",
+        "| fault | cases | detected | survived | data kept | notes |",
+        "|---|---|---|---|---|---|",
+    ]
+    lines += [f"| {r.fault} | {r.cases} | {r.detected} | {r.survived} | {r.data_kept} | {r.notes} |" for r in rows]
+    return "\n".join(lines) + "\n"
