@@ -157,12 +157,8 @@ def _reality(args: argparse.Namespace) -> int:
         if not memory.is_file():
             fail(f"--memory {memory}: no such file (train one with scripts/train.py, or leave it out)")
     out = Path(args.out)
-    write_json(out / "reality.config.json", {"command": "experiment", **vars(args), "sweep": asdict(config),
-                                             "versions": versions()})  # fmt: skip
-    summary = run_sweep(out, config, memory)
-    print((out / "reality.md").read_text())
-    print(f"reality: {summary['wall_time_s']:.0f} s -> {out}/")
-    return 0
+    _write_config(out, "reality", args, sweep=asdict(config))
+    return _report(out, "reality", run_sweep(out, config, memory))
 
 
 def _faults(args: argparse.Namespace) -> int:
@@ -176,11 +172,18 @@ def _faults(args: argparse.Namespace) -> int:
             fail(f"--runs must be >= 2 (a kill lands between two runs), got {args.runs}")
         config = replace(config, trial_runs=args.runs)
     out = Path(args.out)
-    write_json(out / "faults.config.json", {"command": "experiment", **vars(args), "faults": asdict(config),
-                                            "versions": versions()})  # fmt: skip
-    summary = run_faults(out, config)
-    print((out / "faults.md").read_text())
-    print(f"faults: {summary['wall_time_s']:.0f} s -> {out}/")
+    _write_config(out, "faults", args, faults=asdict(config))
+    return _report(out, "faults", run_faults(out, config))
+
+
+def _write_config(out: Path, name: str, args: argparse.Namespace, **settings: Any) -> None:
+    """``DIR/<name>.config.json``: the command line, the resolved settings and the versions, beside the results."""
+    write_json(out / f"{name}.config.json", {"command": "experiment", **vars(args), **settings, "versions": versions()})
+
+
+def _report(out: Path, name: str, summary: dict[str, Any]) -> int:
+    print((out / f"{name}.md").read_text())
+    print(f"{name}: {summary['wall_time_s']:.0f} s -> {out}/")
     return 0
 
 
