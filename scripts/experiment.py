@@ -146,11 +146,7 @@ def _reality(args: argparse.Namespace) -> int:
         fail(f"the reality protocol runs the memory agent only, got --agents {args.agents}")
     if args.seeds is not None or args.workers is not None:
         fail("--seeds and --workers are for the symbolic protocols")
-    config = SweepConfig().quick() if args.quick else SweepConfig()
-    if args.runs is not None:
-        if args.runs < 1:
-            fail(f"--runs must be >= 1, got {args.runs}")
-        config = replace(config, placements=args.runs)
+    config = _with_runs(SweepConfig().quick() if args.quick else SweepConfig(), args.runs, "placements", 1)
     memory = None
     if args.memory is not None:
         memory = Path(args.memory)
@@ -166,14 +162,20 @@ def _faults(args: argparse.Namespace) -> int:
 
     if args.agents is not None or args.seeds is not None or args.workers is not None or args.memory is not None:
         fail("the faults protocol takes only --out, --quick and --runs")
-    config = FaultsConfig().quick() if args.quick else FaultsConfig()
-    if args.runs is not None:
-        if args.runs < 2:
-            fail(f"--runs must be >= 2 (a kill lands between two runs), got {args.runs}")
-        config = replace(config, trial_runs=args.runs)
+    config = _with_runs(FaultsConfig().quick() if args.quick else FaultsConfig(), args.runs, "trial_runs", 2,
+                        " (a kill lands between two runs)")  # fmt: skip
     out = Path(args.out)
     _write_config(out, "faults", args, faults=asdict(config))
     return _report(out, "faults", run_faults(out, config))
+
+
+def _with_runs(config: Any, runs: int | None, field: str, minimum: int, why: str = "") -> Any:
+    """``config`` with ``--runs`` in ``field`` (unchanged without it); below ``minimum`` is a one-line error."""
+    if runs is None:
+        return config
+    if runs < minimum:
+        fail(f"--runs must be >= {minimum}{why}, got {runs}")
+    return replace(config, **{field: runs})
 
 
 def _write_config(out: Path, name: str, args: argparse.Namespace, **settings: Any) -> None:
