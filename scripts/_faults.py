@@ -10,6 +10,8 @@ Classes so far:
 - ``memory truncated``: a trained memory cut at every SQLite page boundary (and inside the first page),
   opened by ``trial.py``: refused in one line each time.
 - ``command-line mistakes``: each ordinary mistake a user makes, one line and exit 2.
+- the twin's faults (:data:`TWIN_FAULTS`): frames dropped, occluded, noised; F/T noise; parts that jam;
+  handles that slip — one oracle trial each, which must end with its reason named (or solve anyway).
 
 Writes ``DIR/faults.json`` and ``DIR/faults.md`` (one table, linked from the README).
 """
@@ -251,6 +253,53 @@ def cli_mistakes(out: Path) -> FaultRow:
     )
 
 
+TWIN_FAULTS: dict[str, dict[str, dict[str, Any]]] = {
+    "camera: every frame dropped": {"camera": {"dropped_frame_probability": 1.0}},
+    "every free part jams on every try": {"physics": {"jam_probability": 1.0}},
+    "camera: occluders in every frame": {"camera": {"occluder_probability": 1.0, "occluder_count": 6}},
+    "camera: image noise sigma 25 DN": {"camera": {"noise_sigma": 25.0}},
+    "F/T noise sigma 30 N": {"force_torque": {"force_noise": 30.0}},
+    "handles slip out of the pads (pad mu 0.02)": {"physics": {"pad_friction": 0.02}},
+}
+"""The twin's faults, each a reality profile (ideal plus this), run as one oracle trial of paper-test-0."""
+QUICK_TWIN_FAULTS = ("camera: every frame dropped", "every free part jams on every try")
+
+
+def twin_faults(out: Path, config: FaultsConfig) -> list[FaultRow]:
+    """One twin trial per fault of :data:`TWIN_FAULTS` (the quick suite: :data:`QUICK_TWIN_FAULTS`): did the
+    run end with its reason named (or solve anyway), without a traceback, with its record kept?"""
+    from twin.reality import IDEAL
+
+    spec = _specs(out) / "paper-test-0.json"
+    names = QUICK_TWIN_FAULTS if config.sim == "symbolic" else tuple(TWIN_FAULTS)
+    rows = []
+    for k, name in enumerate(names):
+        profile = IDEAL.to_dict()
+        profile["name"] = f"fault-{k}"
+        for section, values in TWIN_FAULTS[name].items():
+            profile[section].update(values)
+        path = out / "twin" / f"fault-{k}.json"
+        write_json(path, profile)
+        result = _python(SCRIPTS / "trial.py", "--specs", spec, "--sim", "twin", "--agent", "oracle", "--runs", 1,
+                         "--seed", 0, "--max-actions", 6, "--reality", path, "--out", out / "twin" / f"trial-{k}",
+                         "--force")  # fmt: skip
+        results = out / "twin" / f"trial-{k}" / "results.json"
+        runs = json.loads(results.read_text())["runs"] if results.exists() else []
+        run = runs[0] if runs else {}
+        failed = {a["reason"].split(":")[0] for a in run.get("timeline", []) if a["outcome"] == "failed"}
+        said = "solved anyway" if run.get("solved") else f"ended: {run.get('ended') or 'out of actions'}"
+        rows.append(FaultRow(
+            f"twin: {name}", 1,
+            said + (f"; failed tries named {sorted(failed)}" if failed else ""),
+            "1/1 without a traceback" if result.returncode == 0 and "Traceback" not in result.stderr else
+            f"0/1 (exit {result.returncode})",
+            "1/1 run recorded" if runs else "0/1 run recorded",
+            f"{run.get('num_actions', 0)} actions, agreement "
+            f"{json.loads(results.read_text()).get('outcome_agreement', 0):.0%}" if runs else "",
+        ))  # fmt: skip
+    return rows
+
+
 def run_faults(out: Path, config: FaultsConfig) -> dict[str, Any]:
     """Run every fault class; write ``DIR/faults.{json,md}`` after each (nothing lost if interrupted)."""
     start = time.perf_counter()
@@ -262,9 +311,11 @@ def run_faults(out: Path, config: FaultsConfig) -> dict[str, Any]:
         lambda: concurrent_trainers(out, config, 4),
         lambda: killed_trial(out, config),
     ]
+    steps.append(lambda: twin_faults(out, config))
     summary: dict[str, Any] = {}
     for step in steps:
-        rows.append(step())
+        made = step()
+        rows.extend(made if isinstance(made, list) else [made])
         summary = {"config": asdict(config), "rows": [asdict(r) for r in rows],
                    "wall_time_s": time.perf_counter() - start}  # fmt: skip
         write_json(out / "faults.json", summary)

@@ -128,13 +128,15 @@ def test_the_fault_suite_detects_survives_and_keeps_every_case(tmp_path):
     )  # fmt: skip
     assert result.returncode == 0, result.stderr
     rows = {r["fault"]: r for r in json.loads((out / "faults.json").read_text())["rows"]}
-    assert len(rows) == 5
+    assert len(rows) == 7  # 5 classes of the tools + the quick suite's 2 twin faults
     for row in rows.values():
         for figure in (row["detected"], row["survived"], row["data_kept"]):
             for done, of in re.findall(r"(\d+)/(\d+)", figure):
                 assert done == of, row
     assert "0 runs lost, 0 duplicated" in rows["trial.py killed (SIGKILL) and resumed"]["data_kept"]
-    assert (out / "faults.md").read_text().count("\n| ") == 6  # header + 5 rows
+    assert (out / "faults.md").read_text().count("\n| ") == 8  # header + 7 rows
+    blank = rows["twin: camera: every frame dropped"]
+    assert blank["detected"].startswith("ended: MarkersNotFound") and blank["data_kept"] == "1/1 run recorded"
     bad = subprocess.run(
         [sys.executable, str(ROOT / "scripts/experiment.py"), "faults", "--out", str(out), "--runs", "1"],
         capture_output=True, text=True,
