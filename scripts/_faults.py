@@ -220,6 +220,7 @@ def cli_mistakes(out: Path) -> FaultRow:
     broken.write_text('{"format": "puzzlebox-spec/1", "format": "x"}')
     bad_pt = out / "cli" / "bad.pt"
     bad_pt.write_bytes(b"not a checkpoint")
+    Path(str(bad_pt) + ".json").write_text('{"format": "nothing"}')
     trial = [SCRIPTS / "trial.py", "--specs", spec, "--sim", "symbolic", "--runs", 1, "--max-actions", 5]
     cases = {
         "--out names a file": [*trial, "--seed", 0, "--agent", "dual", "--out", a_file],
@@ -237,8 +238,6 @@ def cli_mistakes(out: Path) -> FaultRow:
         "random box too large to reach": [SCRIPTS / "generate.py", "random", "--components", 40, "--seed", 0,
                                           "--out", out / "cli" / "r.json"],
     }  # fmt: skip
-    if bad_pt.exists():
-        Path(str(bad_pt) + ".json").write_text('{"format": "nothing"}')
     failed = []
     for name, args in cases.items():
         if not _one_line_error(_python(*args)):
@@ -283,8 +282,9 @@ def twin_faults(out: Path, config: FaultsConfig) -> list[FaultRow]:
         result = _python(SCRIPTS / "trial.py", "--specs", spec, "--sim", "twin", "--agent", "oracle", "--runs", 1,
                          "--seed", 0, "--max-actions", 6, "--reality", path, "--out", out / "twin" / f"trial-{k}",
                          "--force")  # fmt: skip
-        results = out / "twin" / f"trial-{k}" / "results.json"
-        runs = json.loads(results.read_text())["runs"] if results.exists() else []
+        results_path = out / "twin" / f"trial-{k}" / "results.json"
+        results = json.loads(results_path.read_text()) if results_path.exists() else {}
+        runs = results.get("runs", [])
         run = runs[0] if runs else {}
         failed = {a["reason"].split(":")[0] for a in run.get("timeline", []) if a["outcome"] == "failed"}
         said = "solved anyway" if run.get("solved") else f"ended: {run.get('ended') or 'out of actions'}"
@@ -295,7 +295,7 @@ def twin_faults(out: Path, config: FaultsConfig) -> list[FaultRow]:
             f"0/1 (exit {result.returncode})",
             "1/1 run recorded" if runs else "0/1 run recorded",
             f"{run.get('num_actions', 0)} actions, agreement "
-            f"{json.loads(results.read_text()).get('outcome_agreement', 0):.0%}" if runs else "",
+            f"{results.get('outcome_agreement', 0):.0%}" if runs else "",
         ))  # fmt: skip
     return rows
 

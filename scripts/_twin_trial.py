@@ -98,6 +98,26 @@ def annotate(frame: np.ndarray, detector: MarkerDetector) -> np.ndarray:
     return out
 
 
+def evaluation_world(
+    session: TwinSession, robot: Any = None, calibration: CellCalibration | None = None, seed: int = 0
+) -> TwinWorld:
+    """The world a twin trial runs on ``session`` (through ``robot``, default the session's): the spec's
+    goal and markers, ``calibration`` (default: the nominal one, exact only under ``ideal``), and — for
+    scoring only, never for deciding — the simulator's component states and names."""
+    spec = session.spec
+    by_marker = {c.marker: i for i, c in enumerate(spec.components)}
+    return TwinWorld(
+        robot if robot is not None else session.robot,
+        calibration if calibration is not None else nominal_calibration(session),
+        {c.marker: c.kind for c in spec.components},
+        spec.components[spec.index_of(spec.goal.component)].marker,
+        goal_state=spec.goal.state,
+        seed=seed,
+        ground_truth=lambda m: int(session.component_states()[by_marker[m]]),
+        names={c.marker: c.name for c in spec.components},
+    )
+
+
 def run_twin_trial(
     spec: PuzzleSpec,
     seed: int,
@@ -128,16 +148,7 @@ def run_twin_trial(
         world = None
         pose_errors: dict[str, float] = {}
         try:
-            world = TwinWorld(
-                robot,
-                calibration if calibration is not None else nominal_calibration(session),
-                {c.marker: c.kind for c in spec.components},
-                spec.components[spec.index_of(spec.goal.component)].marker,
-                goal_state=spec.goal.state,
-                seed=seed,
-                ground_truth=lambda m: int(session.component_states()[by_marker[m]]),
-                names={c.marker: c.name for c in spec.components},
-            )
+            world = evaluation_world(session, robot, calibration, seed)
             watch.doing = lambda: f"{world.toggler.phase}, action {len(world.log) + 1}"
             for c in spec.components:  # perceived closed pose against the simulator's (evaluation only)
                 truth = session.data.site(session.scene.names.components[c.name].frame_site).xpos

@@ -10,7 +10,7 @@ SQLite after every episode (one transaction each, the episode's training-log row
 interrupted run keeps every finished episode and the log always matches the memory; training an
 existing memory continues it, and several trainers may share one file. ``MEM.sqlite.train.json`` is an
 export of the file's training log (every run's resolved arguments and versions, every episode's
-outcome), rewritten after every episode. Ctrl-C or SIGTERM stops after the current episode.
+outcome), written when training ends or stops. Ctrl-C or SIGTERM stops after the current episode.
 """
 
 from __future__ import annotations
@@ -79,9 +79,11 @@ def main(argv: list[str] | None = None) -> int:
                 result = run_episode(agent, SymbolicWorld(spec, args.seed + e), spec.name, args.seed + e,
                                      args.max_actions)  # fmt: skip
                 solved, done = solved + result.solved, done + 1
-                write_json(log_path, {"memory": args.memory, "runs": store.training_log()})
         except KeyboardInterrupt:
             pass
+    # the log is in the memory file, episode by episode; its export is written once, at the end (reading
+    # the whole log after every episode made a long training quadratic)
+    write_json(log_path, {"memory": args.memory, "runs": store.training_log()})
     store.close()
     print(f"trained {done} episode(s), {solved} solved; memory holds {store.num_episodes} -> {args.memory}")
     if done < args.episodes:

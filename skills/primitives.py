@@ -157,8 +157,9 @@ class Toggler:
         """What the arm is doing (for the reasons of failed tries)."""
         self.progress = 0.0
         """Measured progress of the current toggle's actuation so far (kept when a stop ends it)."""
-        self._grasp_closure = 1.0
-        self._closures: collections.deque[float] = collections.deque()
+        c = self.config
+        self._closures: collections.deque[float] = collections.deque(maxlen=max(2, round(c.slip_window / c.tick) + 1))
+        """Gripper closures over the last ``slip_window`` of the toggle in progress (the slip test)."""
         self.peak_force = 0.0
         """Largest filtered force magnitude since the last :meth:`reset_force_watch` [N]."""
         self.guard = True
@@ -293,9 +294,10 @@ class Toggler:
         self.move_to(at_grasp, c.descend_time)
         self.phase = "grasping"
         self._close_slowly()
-        self._grasp_closure = self.robot.gripper_opening()
-        self._closures = collections.deque([self._grasp_closure], maxlen=max(2, round(c.slip_window / c.tick) + 1))
-        if self._grasp_closure >= c.empty_grasp_closure:
+        grasp_closure = self.robot.gripper_opening()
+        self._closures.clear()
+        self._closures.append(grasp_closure)
+        if grasp_closure >= c.empty_grasp_closure:
             raise GraspFailure(f"the gripper closed on nothing at {np.round(at_grasp[:3, 3], 3).tolist()}")
 
         self.phase = "actuating"

@@ -145,8 +145,9 @@ class SceneSurvey:
     def locate(self, expected: set[int]) -> dict[int, MarkerDetection]:
         """One detection per expected marker id (see the module docstring), the arm back at rest."""
         found = self._unique(self.overview(), expected)
-        self.overview_trusted = set(found) - set(self._off_the_lid(found))
-        if not self.config.close_up_all and set(found) == expected and not self._off_the_lid(found):
+        off_the_lid = set(self._off_the_lid(found))
+        self.overview_trusted = set(found) - off_the_lid
+        if not self.config.close_up_all and set(found) == expected and not off_the_lid:
             return found
         moved_arm = False
         try:

@@ -50,7 +50,6 @@ def apply_physics(
     component_dofs: np.ndarray,
     component_bodies: np.ndarray,
     latch_eqs: np.ndarray,
-    gripper_actuator: int,
 ) -> bool:
     """Scale the model's fields by ``draw``; True if anything changed (then call ``mj_setConst``)."""
     changed = False

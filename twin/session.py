@@ -152,7 +152,6 @@ class TwinSession:
             np.array([m.joint(c.joint).dofadr[0] for c in component_names], dtype=np.int64),
             np.array([m.body(c.body).id for c in component_names], dtype=np.int64),
             self.latches.eq_ids,
-            self.gripper_actuator,
         )
         size = (self.config.render.width, self.config.render.height)
         lenses = {}
