@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import sqlite3
 import subprocess
 import sys
@@ -144,7 +145,8 @@ def test_training_a_read_only_memory_is_one_line_before_any_work(tmp_path):
     memory.chmod(0o444)
     immutable = False
     if os.geteuid() == 0:  # root writes read-only files: make it immutable instead, where the file system can
-        immutable = subprocess.run(["chattr", "+i", memory], capture_output=True).returncode == 0
+        chattr = shutil.which("chattr")
+        immutable = chattr is not None and subprocess.run([chattr, "+i", memory], capture_output=True).returncode == 0
         if not immutable:
             pytest.skip("running as root on a file system without chattr: a read-only file is writable")
     try:
@@ -155,6 +157,6 @@ def test_training_a_read_only_memory_is_one_line_before_any_work(tmp_path):
         )  # fmt: skip
     finally:
         if immutable:
-            subprocess.run(["chattr", "-i", memory], check=True)
+            subprocess.run([chattr, "-i", memory], check=True)
     assert result.returncode == 2 and "read-only" in result.stderr and "Traceback" not in result.stderr
     assert MemoryStore.open_existing(memory).num_episodes == 1
