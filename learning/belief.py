@@ -11,6 +11,10 @@ the component is *held* iff ``h`` is a locker hypothesis ``(m, s')`` with ``x_m 
 likelihood is noise-aware: ``P(no move | free) = jam_probability`` (epsilon) and
 ``P(move | held) = false_move_probability`` (delta), so one false failure does not eliminate the
 truth; both zero give the paper's exact elimination.
+
+Bitset form: a joint state is also an int bitmask ``x`` (bit ``c`` = state of ``c``), and the lockers
+are read as one ``(2N, 2N)`` matrix (:meth:`Belief.locker_matrix`), so the planner and the exploration
+get every component's marginal in a state with one gather instead of a Python loop per component.
 """
 
 from __future__ import annotations
@@ -64,6 +68,11 @@ def default_prior(num_components: int, prior_independent: float = 0.7) -> np.nda
         for c in range(n):
             probs[c, :, 1 + 2 * c : 3 + 2 * c] = 0.0
     return probs
+
+
+def state_bits(x: int, num_components: int) -> np.ndarray:
+    """The 0/1 state vector ``(N,)`` of bitmask ``x`` (bit ``c`` = state of component ``c``)."""
+    return (x >> np.arange(num_components, dtype=np.int64)) & 1
 
 
 def block_entropy(p: np.ndarray) -> np.ndarray:
@@ -152,6 +161,25 @@ class Belief:
     def entropy(self) -> float:
         """Total entropy of the belief [nats]: the sum over the 2N independent blocks."""
         return float(block_entropy(self.probs).sum())
+
+    def locker_matrix(self) -> np.ndarray:
+        """``(2N, 2N)`` view: entry ``[2c + s_c, 2m + s_m] = P(Z[c, s_c] = (m, s_m))``.
+
+        A view of :attr:`probs` (no copy), so it follows every :meth:`update` without being rebuilt.
+        """
+        n = self.num_components
+        return self.probs.reshape(2 * n, 2 * n + 1)[:, 1:]
+
+    def free_vector(self, x: int) -> np.ndarray:
+        """``(N,)``: marginal probability that each component is free in the joint state of bitmask ``x``.
+
+        Equals :meth:`probability_free` for every component (the self-locking entries are zero, so
+        summing over every ``m`` adds only zeros to the reference's sum over ``m != c``).
+        """
+        n = self.num_components
+        rows = 2 * np.arange(n) + state_bits(x, n)  # [2c + x_c]: the block each component is in
+        held = self.locker_matrix()[rows[:, None], rows[None, :]].sum(axis=1)  # sum_m P(Z[c, x_c] = (m, x_m))
+        return np.clip(1.0 - held, 0.0, 1.0)
 
     def free_probabilities(self, states_bits: np.ndarray) -> np.ndarray:
         """``(S, N)`` marginal probability that each component is free in each of ``S`` joint states.

@@ -8,24 +8,25 @@ Nodes are joint states (bitmask ``x``, bit ``c`` = state of component ``c``); th
 The paper finds best paths with Dijkstra per successor state. Here, up to
 :data:`EXACT_MAX_COMPONENTS` components, ``V`` is computed for all ``2^N`` states at once by
 vectorised value iteration (exact: the Bellman fixed point of the same max-product problem).
-Beyond that, a best-first search from each successor with an expansion budget, as the authors'
-release does, gives a lower bound on ``V``.
+Above, :class:`learning.best_first.BestFirstPlanner` runs A* on int bitmask states from each
+successor, expanding states lazily, with an admissible heuristic and the exact values of earlier
+searches' best paths. A search that ends within ``max_expansions`` is exact; one that reaches it
+(as the authors' release caps its Dijkstra) gives a lower bound on ``V``: the best path found so far.
 """
 
 from __future__ import annotations
 
-import heapq
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from learning.belief import Belief
+from learning.best_first import BestFirstPlanner
 
 SMALL_N = 10
 """Up to this N, the free table is one fancy-indexed gather; above, the doubling construction."""
 EXACT_MAX_COMPONENTS = 18
-"""Largest N planned exactly over all 2^N states (2^18 states x N floats: ~40 MB)."""
+"""Largest N planned by value iteration over all 2^N states (2^18 states x N floats: ~40 MB)."""
 
 
 @dataclass(frozen=True)
@@ -35,7 +36,8 @@ class PlannerConfig:
     gamma: float = 0.9
     """Discount per action (the authors' release: 0.90), so shorter plans win at equal probability."""
     max_expansions: int = 300
-    """Best-first search budget per successor state when N > EXACT_MAX_COMPONENTS (release: 300)."""
+    """Best-first search budget per searched state when N > EXACT_MAX_COMPONENTS (release: 300). A search
+    that reaches it returns the best path found so far (a lower bound on V), else it is exact."""
 
 
 def free_table(belief: Belief) -> np.ndarray:
@@ -53,17 +55,19 @@ def free_table(belief: Belief) -> np.ndarray:
         c_idx, m_idx = np.arange(n)[None, :, None], np.arange(n)[None, None, :]
         held = locker_probs[c_idx, bits[:, :, None], m_idx, bits[:, None, :]].sum(axis=2)
         return np.clip(1.0 - held.T, 0.0, 1.0)
+    # held[c, own, x]: one doubling per locker m for every (c, own) at once, in place; the sums run
+    # over m in the same order as one (c, own) at a time, so the table is bit for bit the same
+    held = np.zeros((n, 2, size))
+    for m in range(n):
+        k = 1 << m
+        held[:, :, k : 2 * k] = held[:, :, :k] + locker_probs[:, :, m, 1, None]
+        held[:, :, :k] += locker_probs[:, :, m, 0, None]
     free = np.empty((n, size))
-    for c in range(n):
-        held_by_own_state = []
-        for own in (0, 1):
-            held = np.zeros(1)
-            for m in range(n):
-                held = np.concatenate([held + locker_probs[c, own, m, 0], held + locker_probs[c, own, m, 1]])
-            held_by_own_state.append(held)
-        own_bit = (index >> c) & 1
-        free[c] = 1.0 - np.where(own_bit == 1, held_by_own_state[1], held_by_own_state[0])
-    return np.clip(free, 0.0, 1.0)
+    for c in range(n):  # component c's own bit picks its block: halves of stride 2^c
+        out, by_own = free[c].reshape(-1, 2, 1 << c), held[c].reshape(2, -1, 2, 1 << c)
+        np.subtract(1.0, by_own[0, :, 0], out=out[:, 0])
+        np.subtract(1.0, by_own[1, :, 1], out=out[:, 1])
+    return np.clip(free, 0.0, 1.0, out=free)
 
 
 def state_values(belief: Belief, goal: int, goal_state: int, gamma: float) -> np.ndarray:
@@ -84,69 +88,40 @@ def value_iteration(free: np.ndarray, goal: int, goal_state: int, gamma: float) 
     index = np.arange(size)
     is_goal = ((index >> goal) & 1) == goal_state
     step = gamma * free  # (N, 2^N): gamma * P(c free | x)
-    values = is_goal.astype(np.float64)
-    for _ in range(size):  # converges far sooner: each sweep extends the best paths by one action
-        new = values.copy()
+    values = is_goal.astype(np.float64)  # goal states stay 1: every step * V is below gamma < 1
+    for _ in range(size):  # converges far sooner: each sweep extends the best paths by one action or more
+        changed = False
         for c in range(n):
-            toggled = values.reshape(-1, 2, 1 << c)[:, ::-1, :].reshape(-1)  # V(x ^ (1 << c))
-            np.maximum(new, step[c] * toggled, out=new)
-        new[is_goal] = 1.0
-        if np.array_equal(new, values):
+            # in place (Gauss-Seidel): values only grow and never pass the least fixed point, so this
+            # ends at the same fixed point, bit for bit, as updating all of them from the last sweep
+            candidate = step[c] * values.reshape(-1, 2, 1 << c)[:, ::-1, :].reshape(-1)  # gamma P V(x ^ c)
+            if not changed and np.any(candidate > values):
+                changed = True
+            np.maximum(values, candidate, out=values)
+        if not changed:
             break
-        values = new
     return values
 
 
 def exploit_values(
     belief: Belief, states: np.ndarray, goal: int, goal_state: int, config: PlannerConfig | None = None
 ) -> np.ndarray:
-    """``Q_exploit`` for every action from joint state ``states`` (0/1 per component)."""
+    """``Q_exploit`` for every action from joint state ``states`` (0/1 per component): value iteration
+    up to :data:`EXACT_MAX_COMPONENTS`, A* per successor (:class:`BestFirstPlanner`) above."""
     config = config or PlannerConfig()
-    n = belief.num_components
     x = bitmask(states)
-    if n <= EXACT_MAX_COMPONENTS:
-        values = state_values(belief, goal, goal_state, config.gamma)
-        free = np.array([belief.probability_free(states, c) for c in range(n)])
-        return config.gamma * free * values[[x ^ (1 << c) for c in range(n)]]
+    if belief.num_components <= EXACT_MAX_COMPONENTS:
+        return _sweep_values(belief, states, x, goal, goal_state, config.gamma)
     return _best_first_values(belief, x, goal, goal_state, config)
 
 
-def _bits(x: int, n: int) -> np.ndarray:
-    return (x >> np.arange(n)) & 1
+def _sweep_values(belief: Belief, states: np.ndarray, x: int, goal: int, goal_state: int, gamma: float) -> np.ndarray:
+    n = belief.num_components
+    values = state_values(belief, goal, goal_state, gamma)
+    free = np.array([belief.probability_free(states, c) for c in range(n)])
+    return gamma * free * values[[x ^ (1 << c) for c in range(n)]]
 
 
 def _best_first_values(belief: Belief, x: int, goal: int, goal_state: int, config: PlannerConfig) -> np.ndarray:
-    n = belief.num_components
-    q = np.zeros(n)
-    for c in range(n):
-        p = belief.probability_free(_bits(x, n), c)
-        if p <= 0.0:
-            continue
-        q[c] = config.gamma * p * _best_path_value(belief, x ^ (1 << c), goal, goal_state, config)
-    return q
-
-
-def _best_path_value(belief: Belief, start: int, goal: int, goal_state: int, config: PlannerConfig) -> float:
-    """Dijkstra on cost ``-log(gamma * P)`` from ``start``; 0 if no goal within the expansion budget."""
-    n = belief.num_components
-    step_cost = -math.log(config.gamma)
-    best = {start: 0.0}
-    frontier = [(0.0, start)]
-    expansions = 0
-    while frontier and expansions < config.max_expansions:
-        cost, x = heapq.heappop(frontier)
-        if cost > best.get(x, math.inf):
-            continue
-        if ((x >> goal) & 1) == goal_state:
-            return math.exp(-cost)
-        expansions += 1
-        bits = _bits(x, n)
-        for c in range(n):
-            p = belief.probability_free(bits, c)
-            if p <= 0.0:
-                continue
-            nxt, new_cost = x ^ (1 << c), cost + step_cost - math.log(p)
-            if new_cost < best.get(nxt, math.inf):
-                best[nxt] = new_cost
-                heapq.heappush(frontier, (new_cost, nxt))
-    return 0.0
+    """``Q_exploit`` by best-first search alone, ``config.max_expansions`` per search (a lower bound)."""
+    return BestFirstPlanner(belief, goal, goal_state, config.gamma).exploit_values(x, config.max_expansions)

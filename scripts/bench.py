@@ -3,7 +3,8 @@
     python scripts/bench.py --out FILE
 
 - agent decision latency: median and 90th percentile milliseconds per dual-controller decision on
-  random lock graphs of N = 5, 10, 16 components (beliefs as they evolve during real episodes);
+  random lock graphs of N = 5, 10, 16, 32 components (beliefs as they evolve during real episodes;
+  boxes beyond the robot's reach are generated for the symbolic simulator, as ``generate.py --anywhere``);
 - symbolic environment: steps per second of ``PuzzleEnv.step`` with random actions;
 - twin: scene build + compile time; bare ``mj_step`` rate on the compiled paper scene (one step per
   call, as a Python user steps, and ``nstep`` in C) beside the twin's rate on the same model, with
@@ -28,15 +29,18 @@ from _cli import versions, write_json  # noqa: E402
 
 from learning import DualAgent, PuzzleEnv, PuzzleEnvConfig, SymbolicWorld  # noqa: E402
 from models.generator import RandomGraphConfig, generate_random  # noqa: E402
+from models.generator.chain import MAX_REACHABLE_COMPONENTS, BoxConfig  # noqa: E402
 
-SIZES = (5, 10, 16)
+SIZES = (5, 10, 16, 32)
 
 
 def decision_latency(n: int, episodes: int, max_decisions: int) -> dict[str, float]:
     """Time every ``choose`` of the dual agent over a few episodes on random N-component graphs."""
     times = []
     for episode in range(episodes):
-        spec = generate_random(RandomGraphConfig(n, multi_locker=n >= 4), seed=episode)
+        # past the robot's reach only the layout check differs; smaller boxes keep their seeds' graphs
+        box = BoxConfig(fit_reach=False) if n > MAX_REACHABLE_COMPONENTS else None
+        spec = generate_random(RandomGraphConfig(n, multi_locker=n >= 4), seed=episode, box=box)
         world = SymbolicWorld(spec, episode)
         agent = DualAgent()
         observation = world.observe()
