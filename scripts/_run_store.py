@@ -20,6 +20,8 @@ from typing import Any
 
 from _cli import fail, versions, write_json
 
+from learning.runner import RecordStore
+
 RECORDS = "runs"
 
 
@@ -34,6 +36,8 @@ class RunStore:
             fail(f"--out {out} is a file, not a directory")
         self.out, self.experiment = out, experiment
         self.records_dir = out / RECORDS
+        self.records = RecordStore(self.records_dir)
+        """Where each finished run's record is kept (``learning.runner``)."""
         config_path = out / "config.json"
         holds = [p for p in (config_path, out / "results.json") if p.exists()] + self._record_paths()
         if holds and not force:
@@ -70,20 +74,6 @@ class RunStore:
             return {}
         config.pop("versions", None)
         return config
-
-    def get(self, key: str) -> dict[str, Any] | None:
-        """The record of run ``key`` if it finished earlier, else None."""
-        path = self.records_dir / f"{key}.json"
-        if not path.exists():
-            return None
-        try:
-            return json.loads(path.read_text(encoding="utf-8"))
-        except json.JSONDecodeError:
-            return None  # cannot happen with atomic writes; rerun the run rather than trust it
-
-    def put(self, key: str, record: dict[str, Any]) -> None:
-        """Keep the record of a finished run (atomically: a kill leaves it whole or absent)."""
-        write_json(self.records_dir / f"{key}.json", record)
 
     def write_results(self, results: dict[str, Any]) -> Path:
         return write_json(self.out / "results.json", results)

@@ -3,6 +3,7 @@ perception, the agent, the primitives, physics — with a timeline and, optional
 
 from __future__ import annotations
 
+import hashlib
 import time
 from collections.abc import Callable
 from dataclasses import asdict
@@ -86,6 +87,37 @@ class TrueForceWatch:
             self.peak, self.peak_during = magnitude, self.doing()
 
 
+class SensedDigest:
+    """Evaluation only: a SHA-256 over everything the pipeline sensed (joint positions, wrenches, camera
+    images), in the order it asked for them — a trial's fingerprint. Two executions of one task (in-process,
+    in a worker, on Ray, after a resume) that agree on it sensed the same world and acted the same."""
+
+    def __init__(self, robot) -> None:
+        self._robot = robot
+        self._digest = hashlib.sha256()
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._robot, name)
+
+    def joint_positions(self) -> np.ndarray:
+        q = self._robot.joint_positions()
+        self._digest.update(np.ascontiguousarray(q, dtype=np.float64).tobytes())
+        return q
+
+    def wrench(self) -> np.ndarray:
+        w = self._robot.wrench()
+        self._digest.update(np.ascontiguousarray(w, dtype=np.float64).tobytes())
+        return w
+
+    def capture(self, camera: str):
+        image = self._robot.capture(camera)
+        self._digest.update(camera.encode() + (b"-" if image is None else np.ascontiguousarray(image.rgb).tobytes()))
+        return image
+
+    def hexdigest(self) -> str:
+        return self._digest.hexdigest()
+
+
 def annotate(frame: np.ndarray, detector: MarkerDetector) -> np.ndarray:
     """The frame with every detected marker outlined and labelled with its id."""
     out = np.ascontiguousarray(frame.copy())
@@ -145,6 +177,7 @@ def run_twin_trial(
             writer = VideoWriter(video, fps=1 / VIDEO_PERIOD)
             robot = RecordingRobot(robot, renderer, writer, session)
         robot = watch = TrueForceWatch(robot, session)
+        robot = sensed = SensedDigest(robot)
         world = None
         pose_errors: dict[str, float] = {}
         try:
@@ -172,6 +205,7 @@ def run_twin_trial(
     entry["reality"] = session.reality.name
     entry["peak_true_wrist_force_n"] = watch.peak
     entry["peak_true_wrist_force_during"] = watch.peak_during
+    entry["sensed_sha256"] = sensed.hexdigest()
     entry["timeline"] = [
         {**asdict(a), "component": spec.components[by_marker[a.marker]].name,
          "pose_error_m": pose_errors.get(spec.components[by_marker[a.marker]].name)}

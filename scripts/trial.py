@@ -2,7 +2,8 @@
 
     python scripts/trial.py --specs FILE... [--memory MEM.sqlite] --sim {symbolic,twin} --runs K --seed S \
                             --max-actions M --out DIR [--agent NAME] [--video] \
-                            [--reality ideal|realistic|harsh|FILE.json] [--calibration FILE.json]
+                            [--reality ideal|realistic|harsh|FILE.json] [--calibration FILE.json] \
+                            [--workers K | --ray auto|ADDRESS] [--resume | --force]
 
 ``--sim twin`` runs each trial end to end in the MuJoCo twin (ArUco perception, the agent, mink
 primitives, F/T outcomes) and adds a per-action ``timeline`` to each run (sensed outcome beside the
@@ -13,6 +14,13 @@ friction, jams, slips, the box placed anywhere reachable; default ``ideal``), ``
 cell's camera calibration made by ``scripts/calibrate.py`` (default: the nominal, datasheet
 calibration, exact only under ``ideal``); a calibration made for another cell (another profile,
 ``cell_seed`` or box height) is refused.
+
+Runs are tasks of ``learning.runner``: ``--workers K`` runs them in K worker processes (default: one per
+core for ``--sim twin``; in-process for ``--sim symbolic``, whose runs last less than handing them over),
+``--workers 1`` in this process (with a progress bar per run's actions), ``--ray auto`` on a local Ray
+cluster and ``--ray HOST:PORT`` on a running one. A run's record is the same on each (wall times aside:
+``sensed_sha256`` fingerprints everything the twin's pipeline sensed), so a resume may use another.
+A run that raises is named with its key and the others go on (exit 1; ``--resume`` retries it).
 
 Run ``r`` on every spec uses seed ``S + r`` for the world (component order, faults) and the agent.
 ``DIR/config.json`` records the resolved arguments and package versions, so the result can be re-run.
@@ -28,15 +36,16 @@ import argparse
 import sys
 from pathlib import Path
 
+import _trial_task
 from _cli import fail
 from _interrupt import StopRequests
 from _run_store import RunStore
 from tqdm import tqdm
 
-from learning import AGENT_NAMES, LearningError, SymbolicWorld, make_agent, run_episode, summarise
+from learning import AGENT_NAMES, LearningError, make_agent, summarise
 from learning.memory import MemoryStore
-from models import ModelsError, SpecError, load_spec
-from skills.errors import SkillError
+from learning.runner import InlineExecutor, RunnerError, make_executor, run_tasks
+from models import SpecError, load_spec
 from twin.errors import TwinError
 
 SIMS = ("symbolic", "twin")
@@ -68,35 +77,55 @@ def twin_figures(runs: list) -> dict:
     }
 
 
-def _run(args, spec, seed, memory, reality, calibration, out: Path, n_jobs: int) -> dict:
-    """One run's record (a dict: the contract's run entry), its actions counted on an inner bar."""
-    bar = tqdm(total=args.max_actions, desc=f"  {spec.name} seed {seed}", unit="action", leave=False, disable=None)
-    try:
-        if args.sim == "twin":
-            from _twin_trial import run_twin_trial  # MuJoCo and rendering only when asked
-
-            name = "rollout.mp4" if n_jobs == 1 else f"rollout-{spec.name}-s{seed}.mp4"
-            video = out / name if args.video else None
-            return run_twin_trial(
-                spec, seed, args.agent, memory, args.max_actions, video, args.checkpoint, reality, calibration,
-                on_action=lambda _: bar.update(),
-            )  # fmt: skip
-        agent = make_agent(args.agent, spec, memory, args.checkpoint)
-        world = SymbolicWorld(spec, seed)
-        return run_episode(agent, world, spec.name, seed, args.max_actions, lambda _: bar.update()).to_dict()
-    except (LearningError, ModelsError, SkillError, TwinError) as err:
-        fail(f"{spec.name} seed {seed}: {err}")
-        raise  # unreachable: fail exits
-    finally:
-        bar.close()
-
-
 def _results(runs: list[dict], args, planned: int) -> dict:
     results = summarise(runs, args.max_actions)
     if args.sim == "twin":
         results.update(twin_figures(runs))
     results["runs_done"], results["runs_planned"] = len(runs), planned
     return results
+
+
+def _tasks(args, specs, reality, calibration, out: Path) -> list:
+    """One task per spec and seed; run ``r`` of every spec uses seed ``--seed + r``."""
+    tasks = []
+    for i, spec in enumerate(specs):
+        for r in range(args.runs):
+            seed = args.seed + r
+            video = None
+            if args.video:
+                name = "rollout.mp4" if len(specs) * args.runs == 1 else f"rollout-{spec.name}-s{seed}.mp4"
+                video = str((out / name).resolve())
+            tasks.append(_trial_task.trial_task(
+                f"{i:03d}-{spec.name}-seed{seed}", spec, seed, sim=args.sim, agent=args.agent,
+                max_actions=args.max_actions, memory=args.memory, checkpoint=args.checkpoint,
+                reality=reality.to_dict() if reality is not None else None,
+                calibration=calibration.to_dict() if calibration is not None else None, video=video,
+            ))  # fmt: skip
+    return tasks
+
+
+def _solved(records: dict[str, dict]) -> str:
+    return f"solved {sum(r['solved'] for r in records.values())}/{len(records)}"
+
+
+class _ActionBar:
+    """The inner progress bar of an in-process trial: one tick per action, a new bar per run."""
+
+    def __init__(self, max_actions: int) -> None:
+        self.max_actions, self.bar = max_actions, None
+
+    def start(self, name: str) -> None:
+        self.close()
+        self.bar = tqdm(total=self.max_actions, desc=f"  {name}", unit="action", leave=False, disable=None)
+
+    def __call__(self, _action) -> None:
+        if self.bar is not None:
+            self.bar.update()
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -115,6 +144,10 @@ def main(argv: list[str] | None = None) -> int:
         "--reality", default="ideal", help="twin reality profile: ideal, realistic, harsh or a JSON file"
     )
     parser.add_argument("--calibration", default=None, help="camera calibration from scripts/calibrate.py (twin)")
+    parser.add_argument(
+        "--workers", type=int, default=None, help="worker processes (default: one per core for twin, 1 = in-process)"
+    )
+    parser.add_argument("--ray", default=None, metavar="auto|ADDRESS", help="run on Ray: auto = a local cluster")
     parser.add_argument("--resume", action="store_true", help="continue the runs already in --out (same arguments)")
     parser.add_argument("--force", action="store_true", help="delete the results already in --out first")
     args = parser.parse_args(argv)
@@ -124,6 +157,8 @@ def main(argv: list[str] | None = None) -> int:
         fail("--runs and --max-actions must be >= 1")
     if args.seed < 0:
         fail(f"--seed must be >= 0, got {args.seed}")
+    if args.workers is not None and (args.workers < 1 or args.ray is not None):
+        fail("--workers must be >= 1, and goes without --ray" if args.workers < 1 else "give --workers or --ray")
     if args.agent not in AGENT_NAMES:
         fail(f"unknown agent {args.agent!r}. Available agents: {sorted(AGENT_NAMES)}")
     if (args.agent == "memory") != (args.memory is not None):
@@ -155,35 +190,48 @@ def main(argv: list[str] | None = None) -> int:
             except CalibrationError as err:
                 fail(f"--calibration {args.calibration} for spec {spec.name}: {err}")
 
-    try:
+    try:  # what every run needs is checked once here: a bad memory or checkpoint is one line, not N errors
         memory = MemoryStore.open_existing(args.memory) if args.memory else None
+        make_agent(args.agent, specs[0], memory, args.checkpoint)
     except LearningError as err:
         fail(str(err))
 
     out = Path(args.out)
-    experiment = {"command": "trial", **{k: v for k, v in vars(args).items() if k not in ("out", "resume", "force")}}
+    not_results = ("out", "resume", "force", "workers", "ray")  # where and how it runs changes no record
+    experiment = {"command": "trial", **{k: v for k, v in vars(args).items() if k not in not_results}}
+    workers = args.workers or (None if args.sim == "twin" else 1)  # symbolic runs last less than a hand-over
+    try:
+        executor = make_executor(workers, args.ray)
+    except RunnerError as err:
+        fail(str(err))
     store = RunStore(out, experiment, resume=args.resume, force=args.force)
-    jobs = [(i, spec, args.seed + r) for i, spec in enumerate(specs) for r in range(args.runs)]
-    runs: list[dict] = []
-    with StopRequests("run") as stop:
-        try:
-            for i, spec, seed in tqdm(jobs, desc=f"{args.agent} {args.sim} trials", unit="run", disable=None):
-                if stop.requested:
-                    break
-                key = f"{i:03d}-{spec.name}-seed{seed}"
-                record = store.get(key)
-                if record is None:
-                    record = _run(args, spec, seed, memory, reality, calibration, out, len(jobs))
-                    store.put(key, record)
-                runs.append(record)
-                store.write_results(_results(runs, args, len(jobs)))
-        except KeyboardInterrupt:
-            stop.requested = True
-    results = _results(runs, args, len(jobs))
+    tasks = _tasks(args, specs, reality, calibration, out)
+    found: dict[str, dict] = {}
+    keys = [t.key for t in tasks]
+
+    def keep(task, record) -> None:
+        found[task.key] = record
+        store.write_results(_results([found[k] for k in keys if k in found], args, len(tasks)))
+
+    try:
+        with StopRequests("run") as stop, executor:
+            inner = isinstance(executor, InlineExecutor)  # per-action bars only where the trial runs here
+            _trial_task.set_action_hook(_ActionBar(args.max_actions) if inner else None)
+            report = run_tasks(tasks, store.records, executor, stop=lambda: stop.requested, on_record=keep,
+                               postfix=_solved, desc=f"{args.agent} {args.sim} trials")  # fmt: skip
+    except RunnerError as err:
+        fail(str(err))
+    runs = list(report.records.values())
+    results = _results(runs, args, len(tasks))
     store.write_results(results)
-    if len(runs) < len(jobs):
+    if report.failures:  # each was named as it failed, above the progress bar
+        key, error = next(iter(report.failures.items()))
+        print(f"error: {len(report.failures)} run(s) failed (first: {key}: {error.splitlines()[0]}); {len(runs)} kept "
+              f"in {out}; --resume retries the failed ones", file=sys.stderr)  # fmt: skip
+        return 1
+    if report.stopped:
         print(
-            f"stopped: {len(runs)} of {len(jobs)} run(s) kept in {out}; continue with the same command and --resume",
+            f"stopped: {len(runs)} of {len(tasks)} run(s) kept in {out}; continue with the same command and --resume",
             file=sys.stderr,
         )
         return 130

@@ -1,0 +1,30 @@
+"""The task runner: executes pure, seeded, picklable tasks in-process, in a local process pool or on a
+Ray cluster, writes each task's record atomically the moment it ends, and on a rerun computes only what
+is missing. It knows nothing of what a task does (DESIGN.md: composing a trial is the scripts' wiring).
+
+Example::
+
+    tasks = [Task(f"seed{s}", my_module.run_one, {"seed": s}) for s in range(40)]
+    with make_executor(workers=2) as executor:
+        report = run_tasks(tasks, RecordStore(out / "runs"), executor)
+"""
+
+from learning.runner.errors import RunnerError
+from learning.runner.executors import Completion, Executor, InlineExecutor, PoolExecutor, RayExecutor, make_executor
+from learning.runner.records import RecordStore
+from learning.runner.run import RunReport, run_tasks
+from learning.runner.task import Task
+
+__all__ = [
+    "Completion",
+    "Executor",
+    "InlineExecutor",
+    "PoolExecutor",
+    "RayExecutor",
+    "RecordStore",
+    "RunReport",
+    "RunnerError",
+    "Task",
+    "make_executor",
+    "run_tasks",
+]

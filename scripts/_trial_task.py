@@ -1,0 +1,125 @@
+"""One trial as a runner task (``learning.runner.Task``): a pure function of JSON settings — the spec, the
+seed, the agent and what it learned (memory or checkpoint, by path and content hash), the simulator, the
+reality profile and calibration, the budget — returning the contract's run entry. The same settings give
+the same record in-process, in a worker pool, on Ray and after a resume (wall times aside).
+
+What is costly to load and the same for every task of a run (the memory) is opened once per worker."""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Mapping
+from functools import lru_cache
+from pathlib import Path
+from typing import Any, Protocol
+
+from learning import SymbolicWorld, make_agent, run_episode
+from learning.memory import MemoryStore
+from learning.runner import Task
+from models import PuzzleSpec
+from models.spec import spec_from_dict
+
+TIMING_KEYS = ("wall_time", "wall_time_s", "wall_time_per_trial_s_max", "wall_time_per_trial_s_mean", "sim_over_wall")
+"""Record and summary fields that measure this machine's speed, not the trial: the only ones that differ
+between two executions of one task."""
+
+
+def file_sha256(path: str | Path) -> str:
+    """SHA-256 of a file's bytes (a memory or checkpoint is part of a task's settings by content)."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def trial_task(
+    key: str,
+    spec: PuzzleSpec,
+    seed: int,
+    *,
+    sim: str,
+    agent: str,
+    max_actions: int,
+    memory: str | None = None,
+    checkpoint: str | None = None,
+    reality: dict[str, Any] | None = None,
+    calibration: dict[str, Any] | None = None,
+    video: str | None = None,
+) -> Task:
+    """The task of one run (``reality`` and ``calibration`` as their ``to_dict()``; twin only)."""
+    settings = {
+        "sim": sim, "spec": spec.to_dict(), "seed": seed, "agent": agent, "max_actions": max_actions,
+        "memory": str(Path(memory).resolve()) if memory else None,
+        "memory_sha256": file_sha256(memory) if memory else None,
+        "checkpoint": str(Path(checkpoint).resolve()) if checkpoint else None,
+        "checkpoint_sha256": file_sha256(checkpoint) if checkpoint else None,
+        "reality": reality, "calibration": calibration, "video": video,
+    }  # fmt: skip
+    return Task(key, run_trial, settings)
+
+
+@lru_cache(maxsize=4)
+def _memory(path: str) -> MemoryStore:
+    return MemoryStore.open_existing(path)
+
+
+def run_trial(settings: Mapping[str, Any]) -> dict[str, Any]:
+    """Run the trial ``settings`` describe (see :func:`trial_task`); returns its run entry."""
+    spec = spec_from_dict(settings["spec"])
+    if _hook is not None:
+        _hook.start(f"{spec.name} seed {settings['seed']}")
+    try:
+        return _run(spec, settings)
+    finally:
+        if _hook is not None:
+            _hook.close()
+
+
+def _run(spec: PuzzleSpec, settings: Mapping[str, Any]) -> dict[str, Any]:
+    memory = _memory(settings["memory"]) if settings["memory"] else None
+    if settings["sim"] == "twin":
+        from _twin_trial import run_twin_trial  # MuJoCo and rendering only when asked
+
+        from models.calibration import CellCalibration
+        from twin.reality import RealityProfile
+
+        reality = RealityProfile.from_dict(settings["reality"]) if settings["reality"] else None
+        calibration = CellCalibration.from_dict(settings["calibration"]) if settings["calibration"] else None
+        video = Path(settings["video"]) if settings["video"] else None
+        return run_twin_trial(spec, settings["seed"], settings["agent"], memory, settings["max_actions"], video,
+                              settings["checkpoint"], reality, calibration, on_action=_on_action)  # fmt: skip
+    agent = make_agent(settings["agent"], spec, memory, settings["checkpoint"])
+    world = SymbolicWorld(spec, settings["seed"])
+    return run_episode(agent, world, spec.name, settings["seed"], settings["max_actions"], _on_action).to_dict()
+
+
+class ActionHook(Protocol):
+    """Follows the actions of trials run in this process (trial.py's inner progress bar)."""
+
+    def start(self, name: str) -> None: ...
+    def __call__(self, action: Any) -> None: ...
+    def close(self) -> None: ...
+
+
+_hook: ActionHook | None = None
+
+
+def set_action_hook(hook: ActionHook | None) -> None:
+    """Follow every action of the trials run in this process with ``hook`` (None: stop following)."""
+    global _hook
+    _hook = hook
+
+
+def _on_action(action: Any) -> None:
+    if _hook is not None:
+        _hook(action)
+
+
+def without_timing(value: Any) -> Any:
+    """``value`` (a record or a summary) without the fields that measure the machine's speed."""
+    if isinstance(value, dict):
+        return {k: without_timing(v) for k, v in value.items() if k not in TIMING_KEYS}
+    if isinstance(value, list):
+        return [without_timing(v) for v in value]
+    return value
