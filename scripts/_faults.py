@@ -10,6 +10,10 @@ Classes so far:
 - ``memory truncated``: a trained memory cut at every SQLite page boundary (and inside the first page),
   opened by ``trial.py``: refused in one line each time.
 - ``command-line mistakes``: each ordinary mistake a user makes, one line and exit 2.
+- ``worker killed``: one worker of ``trial.py --workers 2`` SIGKILLed mid-trial: the driver says so, starts
+  another, reruns the run it held; every run recorded once, results identical to an uninterrupted run.
+- ``physics diverges``: the twin's velocities made infinite mid-trial in every run: each run ends with
+  ``SimulationDiverged`` named, its record kept, and the trial goes on to the next run.
 - the twin's faults (:data:`TWIN_FAULTS`): frames dropped, occluded, noised; F/T noise; parts that jam;
   handles that slip — one oracle trial each, which must end with its reason named (or solve anyway).
 
@@ -19,6 +23,7 @@ Writes ``DIR/faults.json`` and ``DIR/faults.md`` (one table, linked from the REA
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import signal
 import subprocess
@@ -49,11 +54,16 @@ class FaultsConfig:
     """SIGKILLs, each at a random moment of its own trial, each followed by a resume."""
     trainer_episodes: int = 4
     """Episodes per concurrent trainer."""
+    worker_runs: int = 6
+    """Runs of each trial whose worker is killed (paper-test-0, ``--workers 2``)."""
+    worker_kills: int = 3
+    """Trials in which one worker is SIGKILLed (each at a random moment)."""
     seed: int = 0
     """Seeds the kill moments."""
 
     def quick(self) -> FaultsConfig:
-        return FaultsConfig(sim="symbolic", trial_runs=60, kills=3, trainer_episodes=2, seed=self.seed)
+        return FaultsConfig(sim="symbolic", trial_runs=60, kills=3, trainer_episodes=2, worker_runs=400,
+                            worker_kills=1, seed=self.seed)  # fmt: skip
 
 
 @dataclass
@@ -134,6 +144,105 @@ def killed_trial(out: Path, config: FaultsConfig) -> FaultRow:
         f"{lost} runs lost, {duplicated} duplicated; {identical}/{config.kills} results identical to an "
         "uninterrupted run (wall times aside)",
         f"{config.sim}, {config.trial_runs} runs; killed with {moments} runs recorded",
+    )
+
+
+def _pool_workers(driver: int) -> list[int]:
+    """Process ids of the pool workers of process ``driver`` (its spawned children, not the resource tracker)."""
+    workers = []
+    for child in Path(f"/proc/{driver}/task/{driver}/children").read_text().split():
+        try:
+            command = Path(f"/proc/{child}/cmdline").read_bytes().replace(b"\0", b" ")
+        except OSError:
+            continue
+        if b"spawn_main" in command:
+            workers.append(int(child))
+    return workers
+
+
+def killed_worker(out: Path, config: FaultsConfig) -> FaultRow:
+    """SIGKILL one pool worker of a ``trial.py --workers 2`` at ``config.worker_kills`` random moments."""
+    spec = _specs(out) / "paper-test-0.json"
+    base = [SCRIPTS / "trial.py", "--specs", spec, "--sim", config.sim, "--agent", "oracle",
+            "--runs", config.worker_runs, "--seed", 0, "--max-actions", 30]  # fmt: skip
+    whole_dir = out / "killed-worker" / "whole"
+    if not (whole_dir / "results.json").exists():
+        shutil.rmtree(whole_dir, ignore_errors=True)
+        _python(*base, "--workers", 1, "--out", whole_dir).check_returncode()
+    whole = _without_times(json.loads((whole_dir / "results.json").read_text()))
+    rng = np.random.default_rng(config.seed + 1)
+    killed = detected = survived = lost = duplicated = identical = 0
+    for k in range(config.worker_kills):
+        target = out / "killed-worker" / f"kill-{k}"
+        shutil.rmtree(target, ignore_errors=True)
+        at = int(rng.integers(0, config.worker_runs // 2))  # kill once this many runs are recorded
+        proc = subprocess.Popen([sys.executable, *map(str, base), "--workers", "2", "--out", str(target)],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)  # fmt: skip
+        workers: list[int] = []
+        while proc.poll() is None and not (len(list((target / "runs").glob("*.json"))) >= at and workers):
+            workers = _pool_workers(proc.pid)
+            time.sleep(0.01)
+        if workers and proc.poll() is None:
+            os.kill(workers[0], signal.SIGKILL)
+            killed += 1
+        _, stderr = proc.communicate(timeout=1800)
+        detected += "a worker died" in stderr
+        survived += proc.returncode == 0 and "Traceback" not in stderr
+        got = json.loads((target / "results.json").read_text()) if (target / "results.json").exists() else {}
+        names = [f"{r['spec']}-{r['seed']}" for r in got.get("runs", [])]
+        lost += config.worker_runs - len(set(names))
+        duplicated += len(names) - len(set(names))
+        identical += _without_times(got) == whole
+    n = config.worker_kills
+    return FaultRow(
+        "a trial.py pool worker killed (SIGKILL)",
+        n,
+        f"{detected}/{killed} said (a worker died)",
+        f"{survived}/{n} finished (exit 0, no traceback)",
+        f"{lost} runs lost, {duplicated} duplicated; {identical}/{n} results identical to an uninterrupted run",
+        f"{config.sim}, {config.worker_runs} runs, --workers 2; {killed}/{n} kills landed before the trial ended",
+    )
+
+
+DIVERGE_AT_S = 3.0
+"""Simulated time at which :func:`physics_divergence` makes the twin's velocities infinite [s] (mid-survey)."""
+
+_DIVERGING_TRIAL = f"""
+import sys
+sys.path.insert(0, {str(SCRIPTS)!r})
+import numpy as np
+from twin.session import TwinSession
+after_steps = TwinSession._after_steps
+def diverging(self):
+    if self.data.time > {DIVERGE_AT_S} and not getattr(self, "_diverged", False):
+        self._diverged = True
+        self.data.qvel[:] = np.inf  # MuJoCo flags it (BADQVEL) at the next step
+    after_steps(self)
+TwinSession._after_steps = diverging
+import trial
+sys.exit(trial.main(sys.argv[1:]))
+"""
+
+
+def physics_divergence(out: Path, runs: int = 3) -> FaultRow:
+    """A twin trial of ``runs`` runs in which the physics of every run blows up at :data:`DIVERGE_AT_S`."""
+    spec = _specs(out) / "paper-test-0.json"
+    target = out / "diverged"
+    result = subprocess.run(
+        [sys.executable, "-c", _DIVERGING_TRIAL, "--specs", str(spec), "--sim", "twin", "--agent", "oracle", "--runs",
+         str(runs), "--seed", "0", "--max-actions", "6", "--workers", "1", "--out", str(target), "--force"],
+        capture_output=True, text=True, timeout=1800,
+    )  # fmt: skip
+    path = target / "results.json"
+    got = json.loads(path.read_text()) if path.exists() else {}
+    named = sum((r.get("ended") or "").startswith("SimulationDiverged") for r in got.get("runs", []))
+    return FaultRow(
+        "twin: physics diverges (velocities made infinite)",
+        runs,
+        f"{named}/{runs} runs ended naming SimulationDiverged",
+        f"{runs if result.returncode == 0 and 'Traceback' not in result.stderr else 0}/{runs} without a traceback",
+        f"{len(got.get('runs', []))}/{runs} runs recorded",
+        f"at t = {DIVERGE_AT_S} s of every run; e.g. {got['runs'][0]['ended'][:80]!r}" if got.get("runs") else "",
     )
 
 
@@ -310,6 +419,8 @@ def run_faults(out: Path, config: FaultsConfig) -> dict[str, Any]:
         lambda: concurrent_trainers(out, config, 2),
         lambda: concurrent_trainers(out, config, 4),
         lambda: killed_trial(out, config),
+        lambda: killed_worker(out, config),
+        lambda: physics_divergence(out),
     ]
     steps.append(lambda: twin_faults(out, config))
     summary: dict[str, Any] = {}

@@ -136,26 +136,31 @@ class PoolExecutor:
         in_flight: dict[Future, Task] = {}
         try:
             while pending or suspects or in_flight:
-                if suspects:
-                    if not in_flight and not stop():
-                        self._submit(suspects.popleft(), in_flight)
-                else:
-                    while pending and len(in_flight) < self.workers and not stop():
-                        self._submit(pending.popleft(), in_flight)
-                if not in_flight:
+                broken = False
+                try:
+                    if suspects:
+                        if not in_flight and not stop():
+                            self._submit(suspects, in_flight)
+                    else:
+                        while pending and len(in_flight) < self.workers and not stop():
+                            self._submit(pending, in_flight)
+                except BrokenProcessPool:  # a worker died since the last look: its task is still in flight
+                    broken = True
+                if not in_flight and not broken:
                     return
-                done, _ = wait(in_flight, timeout=0.5, return_when=FIRST_COMPLETED)
                 dead = []
-                for future in done:
-                    task = in_flight.pop(future)
-                    try:
-                        ok, payload = future.result()
-                    except BrokenProcessPool:
-                        dead.append(task)
+                if not broken:
+                    done, _ = wait(in_flight, timeout=0.5, return_when=FIRST_COMPLETED)
+                    for future in done:
+                        task = in_flight.pop(future)
+                        try:
+                            ok, payload = future.result()
+                        except BrokenProcessPool:
+                            dead.append(task)
+                            continue
+                        yield Completion(task, ok, payload, deaths.get(task.key, 0) + 1)
+                    if not dead:
                         continue
-                    yield Completion(task, ok, payload, deaths.get(task.key, 0) + 1)
-                if not dead:
-                    continue
                 for future, task in list(in_flight.items()):  # the rest died with the pool, or just finished
                     try:
                         ok, payload = future.result()
@@ -164,7 +169,7 @@ class PoolExecutor:
                         continue
                     yield Completion(task, ok, payload, deaths.get(task.key, 0) + 1)
                 in_flight.clear()
-                if len(dead) == 1:  # alone in the pool: this task killed its worker
+                if len(dead) == 1:  # the only task lost with the pool: count it against this task
                     task = dead[0]
                     deaths[task.key] = deaths.get(task.key, 0) + 1
                     if deaths[task.key] >= self.max_attempts:
@@ -180,9 +185,11 @@ class PoolExecutor:
             self._pool = None
             raise
 
-    def _submit(self, task: Task, in_flight: dict[Future, Task]) -> None:
+    def _submit(self, queue: deque[Task], in_flight: dict[Future, Task]) -> None:
+        """Hand the next task of ``queue`` to the pool (left in ``queue`` if the pool is broken)."""
         assert self._pool is not None
-        in_flight[self._pool.submit(execute, task.function, dict(task.settings))] = task
+        future = self._pool.submit(execute, queue[0].function, dict(queue[0].settings))
+        in_flight[future] = queue.popleft()
 
     def _restart(self, to_go: int) -> None:
         self._shutdown(cancel=True)
