@@ -1,0 +1,144 @@
+"""Faults run on purpose, in real processes: the fault suite itself, and the faults not tested elsewhere.
+
+Where each fault class of issue 11 is tested:
+- a trial SIGKILLed / SIGTERMed and resumed; an output of another configuration; CLI mistakes:
+  ``tests/scripts/test_trial_cli.py``, ``tests/scripts/test_generate_cli.py``;
+- concurrent trainers on one memory, a memory truncated or read-only: ``tests/learning/test_memory_log.py``;
+- a task that raises, a pool worker that dies: ``tests/learning/test_runner.py`` and here (a real worker of a
+  real ``trial.py``);
+- physics that diverges, a video killed in mid-write: here;
+- the twin's faults (frames dropped, F/T noise, jams, slips): ``tests/skills/test_robustness.py`` and the suite.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+
+def python(*args, timeout=900):
+    return subprocess.run([sys.executable, *map(str, args)], capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.fixture(scope="module")
+def specs(tmp_path_factory):
+    out = tmp_path_factory.mktemp("specs")
+    assert python(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", out).returncode == 0
+    return out
+
+
+def test_the_quick_fault_suite_detects_survives_and_keeps_every_case(tmp_path):
+    """Every class at full marks, in one table (symbolic kills, the quick twin faults)."""
+    out = tmp_path / "faults"
+    result = python(ROOT / "scripts/experiment.py", "faults", "--out", out, "--quick")
+    assert result.returncode == 0, result.stderr
+    rows = {r["fault"]: r for r in json.loads((out / "faults.json").read_text())["rows"]}
+    assert len(rows) == 9  # 7 classes of the tools + the quick suite's 2 twin faults
+    for row in rows.values():
+        for figure in (row["detected"], row["survived"], row["data_kept"]):
+            for done, of in re.findall(r"(\d+)/(\d+)", figure):
+                assert done == of, row
+    assert "0 runs lost, 0 duplicated" in rows["trial.py killed (SIGKILL) and resumed"]["data_kept"]
+    assert "0 runs lost, 0 duplicated" in rows["a trial.py pool worker killed (SIGKILL)"]["data_kept"]
+    assert (out / "faults.md").read_text().count("\n| ") == 10  # header + 9 rows
+    blank = rows["twin: camera: every frame dropped"]
+    assert blank["detected"].startswith("ended: MarkersNotFound") and blank["data_kept"] == "1/1 run recorded"
+    bad = python(ROOT / "scripts/experiment.py", "faults", "--out", out, "--runs", "1")
+    assert bad.returncode == 2 and "--runs must be >= 2" in bad.stderr
+
+
+def test_a_killed_pool_worker_is_replaced_and_no_run_is_lost(specs, tmp_path):
+    from _faults import _pool_workers
+
+    def trial(out, *flags):
+        return [sys.executable, ROOT / "scripts/trial.py", "--specs", *sorted(specs.glob("*.json")), "--sim",
+                "symbolic", "--agent", "dual", "--runs", 120, "--seed", 4, "--max-actions", 30, "--out", out,
+                *flags]  # fmt: skip
+
+    assert subprocess.run(list(map(str, trial(tmp_path / "whole", "--workers", 1)))).returncode == 0
+    proc = subprocess.Popen(
+        list(map(str, trial(tmp_path / "killed", "--workers", 2))), stderr=subprocess.PIPE, text=True
+    )
+    workers: list[int] = []
+    while proc.poll() is None and not workers:
+        workers = _pool_workers(proc.pid)
+        time.sleep(0.01)
+    time.sleep(0.5)  # let it record a few runs
+    assert proc.poll() is None, "the trial ended before a worker could be killed"
+    os.kill(workers[0], signal.SIGKILL)
+    _, stderr = proc.communicate(timeout=600)
+    assert proc.returncode == 0 and "a worker died" in stderr and "Traceback" not in stderr
+    got, want = (json.loads((tmp_path / d / "results.json").read_text()) for d in ("killed", "whole"))
+    assert got["runs_done"] == got["runs_planned"] == 360
+    assert [r["seed"] for r in got["runs"]] == [r["seed"] for r in want["runs"]]
+    assert [r["actions"] for r in got["runs"]] == [r["actions"] for r in want["runs"]]
+
+
+def test_physics_that_diverges_ends_the_run_with_its_name_and_keeps_the_record(specs):
+    """Velocities made infinite mid-survey: MuJoCo flags it at the next step, the session raises
+    SimulationDiverged, and the trial records the run as ended for that reason (no traceback)."""
+    from _twin_trial import run_twin_trial
+
+    from models import load_spec
+    from twin.errors import SimulationDiverged
+    from twin.session import TwinSession
+
+    spec = load_spec(specs / "paper-test-0.json")
+    with TwinSession(spec, seed=0) as session:
+        session.advance(0.1)
+        session.data.qvel[:] = np.inf
+        with pytest.raises(SimulationDiverged, match="BADQVEL"):
+            session.advance(0.01)
+
+    after_steps = TwinSession._after_steps
+
+    def diverging(self):
+        if self.data.time > 2.0 and not getattr(self, "_diverged", False):
+            self._diverged = True
+            self.data.qvel[:] = np.inf
+        after_steps(self)
+
+    TwinSession._after_steps = diverging
+    try:
+        record = run_twin_trial(spec, 0, "oracle", None, 6, None)
+    finally:
+        TwinSession._after_steps = after_steps
+    assert record["ended"].startswith("SimulationDiverged: MuJoCo warning") and not record["solved"]
+    assert record["sim_time_s"] < 2.1 and json.dumps(record), "the record is whole and JSON"
+
+
+def test_a_video_killed_in_mid_write_never_appears_under_its_final_name(specs, tmp_path):
+    """SIGKILL while the rollout is being encoded: only a hidden temporary is left, the resume removes it
+    and publishes a whole video under the final name."""
+    import imageio_ffmpeg
+
+    out = tmp_path / "out"
+    command = [sys.executable, ROOT / "scripts/trial.py", "--specs", specs / "paper-test-0.json", "--sim", "twin",
+               "--agent", "oracle", "--runs", 1, "--seed", 0, "--max-actions", 6, "--video", "--out", out]  # fmt: skip
+    proc = subprocess.Popen(list(map(str, command)), stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline and proc.poll() is None and not list(out.glob(".rollout*")):
+        time.sleep(0.05)
+    time.sleep(1.0)  # frames are being written
+    assert proc.poll() is None, "the trial ended before the kill"
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    assert not (out / "rollout.mp4").exists() and list(out.glob(".rollout*")), "only the hidden partial is left"
+    resumed = python(*command[1:], "--resume")
+    assert resumed.returncode == 0, resumed.stderr
+    assert not list(out.glob(".rollout*")), "the killed run's partial video is removed"
+    reader = imageio_ffmpeg.read_frames(str(out / "rollout.mp4"))
+    meta = next(reader)
+    assert meta["size"] == (640, 480) and sum(1 for _ in reader) > 100, "a whole video: every frame decodes"
