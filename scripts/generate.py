@@ -3,6 +3,7 @@
     python scripts/generate.py paper --split {train,test,all} --out DIR     # DIR/<name>.json
     python scripts/generate.py chain --kinds door,slide,wheel --seed S --out FILE
     python scripts/generate.py random --components N --seed S [--multi-locker] --out FILE
+    python scripts/generate.py random|chain ... --count N --out DIR [--workers K | --ray auto|ADDRESS]
     python scripts/generate.py validate FILE...     # exit 1 and one line per problem if any is invalid
     python scripts/generate.py mjcf SPEC --out DIR  # DIR/scene.xml + assets, loadable by mujoco
 
@@ -10,7 +11,12 @@
 Generated boxes stand where the robot reaches every handle (at most 28 components fit); ``--anywhere``
 on chain/random keeps the default pose whatever it leaves out of reach, for the symbolic simulator.
 
-Every generated file is a pure function of the arguments: the same command writes the same bytes.
+``--count N`` on chain/random writes a dataset: N specs with seeds S..S+N-1 in the directory ``--out``
+(``<name>.json`` each) and ``manifest.json`` (name, seed, file, SHA-256, shortest solution), generated
+in parallel (``--workers K``, default one per core for 64 specs or more; ``--ray auto|ADDRESS``).
+
+Every generated file is a pure function of the arguments: the same command writes the same bytes (with
+any number of workers).
 """
 
 from __future__ import annotations
@@ -20,6 +26,7 @@ import sys
 from pathlib import Path
 
 from _cli import fail
+from tqdm import tqdm
 
 from models import LockTable, ModelsError, PuzzleSpec, SpecError, load_spec, save_spec
 from models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random, paper_family
@@ -40,11 +47,54 @@ def _paper(args: argparse.Namespace) -> None:
 
 def _chain(args: argparse.Namespace) -> None:
     kinds = [k.strip() for k in args.kinds.split(",") if k.strip()]
+    if args.count is not None:
+        return _dataset(args, {"generator": "chain", "kinds": kinds})
     box = BoxConfig(fit_reach=not args.anywhere)
     _write(generate_chain(kinds, seed=args.seed, name=args.name, box=box), Path(args.out), args.plot)
 
 
+def _dataset(args: argparse.Namespace, generator: dict) -> None:
+    """``--count N``: N specs (seeds S..S+N-1) and a manifest in the directory ``--out``, made in parallel."""
+    from _dataset import spec_task, write_manifest, write_spec
+    from _interrupt import StopRequests
+
+    from learning.runner import RunnerError, make_executor
+
+    if args.count < 1:
+        fail(f"--count must be >= 1, got {args.count}")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        fail(f"--out {out} is a file; with --count it names a directory")
+    generator = {**generator, "name": args.name, "anywhere": args.anywhere, "seed": args.seed}
+    tasks = [spec_task(f"s{args.seed + i}", {**generator, "seed": args.seed + i}) for i in range(args.count)]
+    entries = []
+    try:
+        executor = make_executor(args.workers or (1 if args.count < 64 else None), args.ray)
+        with StopRequests("spec") as stop, executor:
+            bar = tqdm(total=len(tasks), desc=f"{generator['generator']} specs", unit="spec", disable=None)
+            for done in executor.run(tasks, lambda: stop.requested):
+                if not done.ok:
+                    fail(f"seed {done.task.settings['seed']}: {str(done.payload).splitlines()[0]}")
+                path = write_spec(out, done.payload)
+                if args.plot:
+                    from _spec_plot import plot_spec
+
+                    plot_spec(load_spec(path), path.with_suffix(".png"))
+                entries.append(done.payload["entry"])
+                bar.update()
+            bar.close()
+    except RunnerError as err:
+        fail(str(err))
+    if len(entries) < len(tasks):
+        print(f"stopped: {len(entries)} of {len(tasks)} spec(s) written in {out}; no manifest", file=sys.stderr)
+        return 130
+    path = write_manifest(out, {**generator, "seed": args.seed, "count": args.count}, entries)
+    print(f"wrote {len(entries)} specs and {path}")
+
+
 def _random(args: argparse.Namespace) -> None:
+    if args.count is not None:
+        return _dataset(args, {"generator": "random", "components": args.components, "multi_locker": args.multi_locker})
     config = RandomGraphConfig(num_components=args.components, multi_locker=args.multi_locker)
     box = BoxConfig(fit_reach=not args.anywhere)
     _write(generate_random(config, seed=args.seed, name=args.name, box=box), Path(args.out), args.plot)
@@ -78,6 +128,12 @@ def _validate(args: argparse.Namespace) -> int:
     return 1 if invalid else 0
 
 
+def _dataset_flags(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--count", type=int, default=None, help="N specs, seeds S..S+N-1: --out is a directory")
+    parser.add_argument("--workers", type=int, default=None, help="with --count: worker processes (default: cores)")
+    parser.add_argument("--ray", default=None, metavar="auto|ADDRESS", help="with --count: generate on Ray")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     verbs = parser.add_subparsers(dest="verb", required=True)
@@ -100,6 +156,7 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="keep the box at the default pose even if the robot cannot reach every handle (symbolic only)",
     )
+    _dataset_flags(chain)
     chain.set_defaults(run=_chain)
 
     rand = verbs.add_parser("random", help="a random solvable lock graph of N components")
@@ -114,6 +171,7 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="keep the box at the default pose even if the robot cannot reach every handle (symbolic only)",
     )
+    _dataset_flags(rand)
     rand.set_defaults(run=_random)
 
     scene = verbs.add_parser("mjcf", help="the MuJoCo scene of a spec: DIR/scene.xml + assets")
@@ -126,6 +184,8 @@ def main(argv: list[str] | None = None) -> int:
     validate.set_defaults(run=_validate)
 
     args = parser.parse_args(argv)
+    if getattr(args, "count", None) is None and (getattr(args, "workers", None) or getattr(args, "ray", None)):
+        fail("--workers and --ray go with --count (a dataset)")
     try:
         return args.run(args) or 0
     except ModelsError as err:

@@ -24,6 +24,9 @@ from typing import Any, Protocol
 from learning.runner.errors import RunnerError
 from learning.runner.task import Task, execute
 
+MAX_BARREN_RESTARTS = 5
+"""Pool restarts in a row with no task finished after which the pool gives up (workers that cannot start)."""
+
 ONE_THREAD = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 """Thread-count variables set to 1 for workers: one worker per core, no BLAS threads fighting over them."""
 
@@ -134,6 +137,7 @@ class PoolExecutor:
         suspects: deque[Task] = deque()  # in flight when a worker died: rerun alone, to learn which one kills
         deaths: dict[str, int] = {}
         in_flight: dict[Future, Task] = {}
+        restarts_at_last_completion = self.restarts
         try:
             while pending or suspects or in_flight:
                 broken = False
@@ -158,6 +162,7 @@ class PoolExecutor:
                         except BrokenProcessPool:
                             dead.append(task)
                             continue
+                        restarts_at_last_completion = self.restarts
                         yield Completion(task, ok, payload, deaths.get(task.key, 0) + 1)
                     if not dead:
                         continue
@@ -179,6 +184,11 @@ class PoolExecutor:
                         suspects.appendleft(task)
                 else:
                     suspects.extend(dead)
+                if self.restarts - restarts_at_last_completion >= MAX_BARREN_RESTARTS:
+                    raise RunnerError(
+                        f"the pool's workers died {MAX_BARREN_RESTARTS} times in a row without finishing a task: "
+                        "they cannot start or every task kills them (run with one worker to see the error)"
+                    )
                 self._restart(len(pending) + len(suspects))
         except BaseException:
             self._shutdown(cancel=True)

@@ -118,3 +118,52 @@ def test_mjcf_refuses_an_invalid_spec_without_traceback(tmp_path):
     bad.write_text("{}")
     result = generate("mjcf", bad, "--out", tmp_path / "scene")
     assert result.returncode == 2 and "Traceback" not in result.stderr and "format" in result.stderr
+
+
+# -- datasets: --count N --------------------------------------------------------------------------------
+
+
+def _tree(directory: Path) -> dict[str, bytes]:
+    return {p.name: p.read_bytes() for p in sorted(directory.iterdir())}
+
+
+def test_a_dataset_is_byte_identical_across_runs_and_worker_counts(tmp_path):
+    args = ("random", "--components", 7, "--multi-locker", "--seed", 40, "--count", 10)
+    for name, workers in (("a", 1), ("b", 2), ("c", 1)):
+        result = generate(*args, "--out", tmp_path / name, "--workers", workers)
+        assert result.returncode == 0, result.stderr
+    assert _tree(tmp_path / "a") == _tree(tmp_path / "b") == _tree(tmp_path / "c")
+    manifest = json.loads((tmp_path / "a" / "manifest.json").read_text())
+    assert manifest["count"] == 10 and [e["seed"] for e in manifest["specs"]] == list(range(40, 50))
+    from models import LockTable, load_spec
+
+    for entry in manifest["specs"]:
+        path = tmp_path / "a" / entry["file"]
+        spec = load_spec(path)
+        assert spec.name == entry["name"] and len(spec.components) == entry["components"] == 7
+        import hashlib
+
+        assert hashlib.sha256(path.read_bytes()).hexdigest() == entry["sha256"]
+        plan = LockTable.from_spec(spec).shortest_solution()
+        assert entry["shortest_solution"] == [spec.components[i].name for i in plan]
+    single = generate("random", "--components", 7, "--multi-locker", "--seed", 43, "--out", tmp_path / "one.json")
+    assert single.returncode == 0
+    assert (tmp_path / "one.json").read_bytes() == (tmp_path / "a" / "random-n7-multi-s43.json").read_bytes(), (
+        "spec i of a dataset is the single spec of seed S + i"
+    )
+
+
+def test_chain_datasets_and_dataset_mistakes(tmp_path):
+    ok = generate("chain", "--kinds", "door,slide,wheel", "--seed", 0, "--count", 3, "--out", tmp_path / "c")
+    assert ok.returncode == 0, ok.stderr
+    assert len(json.loads((tmp_path / "c" / "manifest.json").read_text())["specs"]) == 3
+    (tmp_path / "file").write_text("x")
+    for args, message in (
+        (("random", "--components", 5, "--seed", 0, "--count", 0, "--out", tmp_path / "d"), "--count must be >= 1"),
+        (("random", "--components", 5, "--seed", 0, "--workers", 2, "--out", tmp_path / "e.json"), "go with --count"),
+        (("random", "--components", 5, "--seed", 0, "--count", 2, "--out", tmp_path / "file"), "is a file"),
+        (("chain", "--kinds", "door,wheel", "--seed", 0, "--count", 2, "--out", tmp_path / "f"), "cannot lock"),
+    ):
+        bad = generate(*args)
+        assert bad.returncode == 2 and message in bad.stderr and "Traceback" not in bad.stderr, (args, bad.stderr)
+        assert len(bad.stderr.strip().splitlines()) == 1
