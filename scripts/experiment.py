@@ -2,7 +2,7 @@
 the reality gap in the twin.
 
     python scripts/experiment.py {variants,episodes,noise,all} --agents memory,dqn,model-based,mt-dqn,mt-model-based \\
-        --out DIR [--quick] [--runs R] [--seeds S] [--workers W]
+        --out DIR [--quick] [--runs R] [--seeds S] [--workers W | --ray auto|ADDRESS]
     python scripts/experiment.py reality --out DIR [--quick] [--runs R] [--memory MEM.sqlite]
     python scripts/experiment.py faults --out DIR [--quick] [--runs R]
 
@@ -13,8 +13,10 @@ protocols (sharing the deep agents' training) and adds ``DIR/all.md`` with the e
 table and the wall time of every part.
 
 The deep agents (``dqn``, ``model-based``, ``mt-dqn``, ``mt-model-based``; torch) train as jobs, one
-per agent, training seed and training-variant count, ``--workers`` at a time (default: one per
-core). Every finished job is saved in ``DIR/jobs/`` at once: run the same command again after an
+per agent, training seed and training-variant count, as tasks of ``learning.runner``: ``--workers`` at a
+time (default: one per
+core; ``--ray auto|ADDRESS``: on Ray). Every finished job is saved in ``DIR/jobs/`` at once: run the same
+command again after an
 interruption and it resumes, reusing every finished job.
 
 ``reality`` (``scripts/_reality_sweep.py``) runs the memory agent end to end in the twin on the paper
@@ -64,6 +66,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--runs", type=int, default=None, help="runs per unseen variant (default 50)")
     parser.add_argument("--seeds", type=int, default=None, help="training seeds (default 3)")
     parser.add_argument("--workers", type=int, default=None, help="parallel deep-agent jobs (default: cores)")
+    parser.add_argument("--ray", default=None, metavar="auto|ADDRESS", help="deep-agent jobs on Ray (auto: local)")
     parser.add_argument(
         "--poses", choices=POSE_ENCODINGS, default="relative",
         help="where the deep agents' graph network sees poses: relative (edges, default) or absolute (nodes, "
@@ -115,7 +118,7 @@ def main(argv: list[str] | None = None) -> int:
             timings[f"{protocol}: symbolic agents"] = time.perf_counter() - t0
         if deep:
             jobs = [job for protocol in protocols for job in jobs_for(protocol, deep, config, schedule, args.poses)]
-            records, summary = run_jobs(jobs, config, out, args.workers)
+            records, summary = run_jobs(jobs, config, out, args.workers, args.ray)
             timings["deep agents (all their jobs)"] = summary["wall_time_s"]
             print(f"deep agents: {summary['computed']} job(s) run, {summary['reused']} reused from {out}/jobs")
             for protocol in protocols:

@@ -19,9 +19,6 @@ file made with other settings is recomputed, never mixed in.
 from __future__ import annotations
 
 import json
-import multiprocessing
-import os
-import queue
 import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
@@ -29,10 +26,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from tqdm import tqdm
 
 from learning.agents.factory import DEEP_AGENT_NAMES
-from learning.errors import ConfigError
+from learning.errors import ConfigError, LearningError
 from learning.experiments.protocol import (
     ProtocolConfig,
     Score,
@@ -41,9 +37,9 @@ from learning.experiments.protocol import (
     training_layout,
 )
 from learning.experiments.symbolic_protocols import CONDITIONS
+from learning.runner import RecordStore, Task, make_executor, run_tasks
 from learning.symbolic_world import SymbolicWorld
 from learning.trial import run_episode
-from models.atomic import write_text_atomically
 from models.generator import TRAIN_INDICES
 
 DEEP_AGENTS = DEEP_AGENT_NAMES
@@ -153,10 +149,8 @@ def _evaluate(agent: Any, config: ProtocolConfig, condition: str) -> dict[str, f
     return {"success_rate": score.success_rate, "mean_actions": score.mean_actions, "runs": score.runs}
 
 
-def run_job(job: TrainingJob, config: ProtocolConfig, out_dir: str, progress: Any = None) -> dict[str, Any]:
-    """Train and evaluate one job; write ``OUT/jobs/<key>.json`` (+ ``.pt``) atomically; the record.
-
-    ``progress`` (a queue) receives the number of training episodes done as they finish."""
+def run_job(job: TrainingJob, config: ProtocolConfig, out_dir: str) -> dict[str, Any]:
+    """Train and evaluate one job, write its network to ``OUT/jobs/<key>.pt`` atomically; its record."""
     import torch
 
     from learning.baselines import GraphNetworkConfig, make_learner, save_checkpoint
@@ -167,18 +161,13 @@ def run_job(job: TrainingJob, config: ProtocolConfig, out_dir: str, progress: An
     evaluations, training_solved = [], []
     done = 0
     for checkpoint in job.evaluate_at:
-        chunk = range(done, checkpoint)
-        for e0 in range(chunk.start, chunk.stop, 10):  # report progress every 10 episodes
-            training_solved += _train(agent, job, range(e0, min(e0 + 10, chunk.stop)), config)
-            if progress is not None:
-                progress.put(min(e0 + 10, chunk.stop) - e0)
+        training_solved += _train(agent, job, range(done, checkpoint), config)
         done = checkpoint
         conditions = CONDITIONS if checkpoint == job.conditions_at else (NONE,)
         for condition in conditions:
             evaluations.append({"episodes": checkpoint, "condition": condition, **_evaluate(agent, config, condition)})
-    jobs_dir = Path(out_dir) / "jobs"
-    save_checkpoint(agent, jobs_dir / f"{job.key}.pt")
-    record = {
+    save_checkpoint(agent, Path(out_dir) / "jobs" / f"{job.key}.pt")
+    return {
         "settings": _settings(job, config),
         "evaluations": evaluations,
         "training_solved": int(np.sum(training_solved)),
@@ -186,61 +175,65 @@ def run_job(job: TrainingJob, config: ProtocolConfig, out_dir: str, progress: An
         "wall_time_s": time.perf_counter() - start,
         "checkpoint": f"{job.key}.pt",
     }
-    write_text_atomically(jobs_dir / f"{job.key}.json", json.dumps(record, indent=1))
-    return record
+
+
+def run_job_task(settings: dict[str, Any], context: dict[str, Any]) -> dict[str, Any]:
+    """:func:`run_job` as a runner task: ``settings`` is :func:`_settings`'s (as JSON), ``context`` the
+    output directory."""
+    fields = dict(settings["job"])
+    fields["evaluate_at"] = tuple(fields["evaluate_at"])
+    job = TrainingJob(**fields)
+    config = ProtocolConfig(runs_per_variant=settings["runs_per_variant"], success_actions=settings["success_actions"],
+                            max_actions=settings["max_actions"])  # fmt: skip
+    return json.loads(json.dumps(run_job(job, config, context["out_dir"])))  # tuples -> lists, as stored
+
+
+def job_task(job: TrainingJob, config: ProtocolConfig, out_dir: Path) -> Task:
+    """The runner task of ``job``: its record is ``OUT/jobs/<key>.json``, its network ``<key>.pt``."""
+    settings = json.loads(json.dumps(_settings(job, config)))
+    return Task(job.key, run_job_task, settings, context={"out_dir": str(out_dir)})
 
 
 def cached_record(job: TrainingJob, config: ProtocolConfig, out_dir: Path) -> dict[str, Any] | None:
     """The finished record of ``job`` in ``out_dir`` if it was made with the same settings."""
-    path = out_dir / "jobs" / f"{job.key}.json"
-    try:
-        record = json.loads(path.read_text())
-    except (OSError, json.JSONDecodeError):
-        return None
-    settings = json.loads(json.dumps(_settings(job, config)))  # tuples -> lists, as stored
-    return record if record.get("settings") == settings else None
+    return RecordStore(Path(out_dir) / "jobs").get(job_task(job, config, out_dir))
 
 
 def run_jobs(
-    jobs: Sequence[TrainingJob], config: ProtocolConfig, out_dir: Path, workers: int | None = None
+    jobs: Sequence[TrainingJob],
+    config: ProtocolConfig,
+    out_dir: Path,
+    workers: int | None = None,
+    ray: str | None = None,
 ) -> tuple[dict[str, dict[str, Any]], dict[str, Any]]:
-    """Run (or reuse) every job, ``workers`` at a time, longest first, with a progress bar in training
-    episodes. Returns the records by job key and a summary (reused, computed, wall time)."""
-    unique = {job.key: job for job in jobs}
-    records: dict[str, dict[str, Any]] = {}
-    todo = []
-    for key, job in unique.items():
-        cached = cached_record(job, config, out_dir)
-        if cached is None:
-            todo.append(job)
-        else:
-            records[key] = cached
-    todo.sort(key=lambda j: (-j.episodes, j.agent.startswith("model"), j.key))
-    start = time.perf_counter()
-    workers = max(1, min(workers or os.cpu_count() or 1, len(todo) or 1))
-    if todo:
-        context = multiprocessing.get_context("spawn")  # torch and fork do not mix
-        with context.Manager() as manager, context.Pool(workers) as pool:
-            progress = manager.Queue()
-            pending = {job.key: pool.apply_async(run_job, (job, config, str(out_dir), progress)) for job in todo}
-            total = sum(job.episodes for job in todo)
-            with tqdm(total=total, desc=f"deep agents ({len(todo)} jobs)", unit="episode", disable=None) as bar:
-                while pending:
-                    try:
-                        bar.update(progress.get(timeout=0.5))
-                    except queue.Empty:
-                        pass
-                    for key in [k for k, result in pending.items() if result.ready()]:
-                        records[key] = pending.pop(key).get()  # re-raises a job's error here
-                        bar.set_postfix_str(f"{len(records)}/{len(unique)} jobs")
+    """Run (or reuse) every job on the task runner — ``workers`` processes (default: one per core; 1:
+    in-process) or Ray (``ray``: ``auto`` or an address) — longest first. Returns the records by job key
+    and a summary (reused, computed, wall time).
+
+    Raises:
+        LearningError: a job failed (after every other job finished and was kept).
+    """
+    unique = sorted(
+        {job.key: job for job in jobs}.values(), key=lambda j: (-j.episodes, j.agent.startswith("model"), j.key)
+    )
+    tasks = [job_task(job, config, out_dir) for job in unique]
+    with make_executor(workers, ray) as executor:
+        report = run_tasks(
+            tasks, RecordStore(Path(out_dir) / "jobs"), executor, desc=f"deep agents ({len(tasks)} jobs)"
+        )
+    if report.failures:
+        key, error = next(iter(report.failures.items()))
+        raise LearningError(f"{len(report.failures)} deep job(s) failed; {key}: {error.splitlines()[0]}")
+    if report.stopped:
+        raise LearningError(f"interrupted: {len(report.records)} of {len(tasks)} deep jobs kept in {out_dir}/jobs")
     summary = {
-        "jobs": len(unique),
-        "reused": len(unique) - len(todo),
-        "computed": len(todo),
-        "workers": workers,
-        "wall_time_s": time.perf_counter() - start,
+        "jobs": len(tasks),
+        "reused": len(report.reused),
+        "computed": len(report.computed),
+        "workers": executor.workers,
+        "wall_time_s": report.wall_time_s,
     }
-    return records, summary
+    return report.records, summary
 
 
 def _score(records: Sequence[dict[str, Any]], episodes: int, condition: str) -> dict[str, Any] | None:

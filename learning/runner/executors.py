@@ -66,7 +66,7 @@ class InlineExecutor:
         for task in tasks:
             if stop():
                 return
-            ok, payload = execute(task.function, task.settings)
+            ok, payload = execute(task.function, task.settings, task.context)
             yield Completion(task, ok, payload)
 
 
@@ -198,7 +198,8 @@ class PoolExecutor:
     def _submit(self, queue: deque[Task], in_flight: dict[Future, Task]) -> None:
         """Hand the next task of ``queue`` to the pool (left in ``queue`` if the pool is broken)."""
         assert self._pool is not None
-        future = self._pool.submit(execute, queue[0].function, dict(queue[0].settings))
+        task = queue[0]
+        future = self._pool.submit(execute, task.function, dict(task.settings), task.context)
         in_flight[future] = queue.popleft()
 
     def _restart(self, to_go: int) -> None:
@@ -261,7 +262,9 @@ class RayExecutor:
             while pending or in_flight:
                 while pending and len(in_flight) < window and not stop():
                     task = pending.popleft()
-                    ref = self._remote.options(num_cpus=task.cpus).remote(task.function, dict(task.settings))
+                    ref = self._remote.options(num_cpus=task.cpus).remote(
+                        task.function, dict(task.settings), task.context
+                    )
                     in_flight[ref] = task
                 if not in_flight:
                     return

@@ -27,12 +27,16 @@ class Task:
         settings: everything the record depends on, JSON-able (seed included). A stored record made
             with other settings is recomputed, never mixed in.
         cpus: CPU cores the task occupies (what Ray reserves for it).
+        context: where the task puts side outputs (e.g. a directory for a checkpoint), JSON-able, passed as
+            ``function(settings, context)`` when given; not part of the settings' hash: moving a results
+            directory does not make its records stale.
     """
 
     key: str
-    function: Callable[[Mapping[str, Any]], dict[str, Any]]
+    function: Callable[..., dict[str, Any]]
     settings: Mapping[str, Any] = field(default_factory=dict)
     cpus: float = 1.0
+    context: Mapping[str, Any] | None = None
 
     def __post_init__(self) -> None:
         if not _KEY.match(self.key):
@@ -55,12 +59,14 @@ class Task:
         return self._hash  # type: ignore[attr-defined]
 
 
-def execute(function: Callable[[Mapping[str, Any]], dict[str, Any]], settings: Mapping[str, Any]) -> tuple[bool, Any]:
+def execute(
+    function: Callable[..., dict[str, Any]], settings: Mapping[str, Any], context: Mapping[str, Any] | None = None
+) -> tuple[bool, Any]:
     """Run one task where the executor put it: ``(True, record)``, or ``(False, "Type: message\\n<traceback>")``
     for an exception — returned rather than raised, so that no exception type has to survive pickling."""
     import traceback
 
     try:
-        return True, function(settings)
+        return True, function(settings) if context is None else function(settings, context)
     except Exception as err:  # noqa: BLE001 - any task error is reported with its key, not raised
         return False, f"{type(err).__name__}: {err}\n{traceback.format_exc()}"

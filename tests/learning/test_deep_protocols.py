@@ -47,9 +47,11 @@ def _record(job, config, success):
 
 
 def test_a_cached_job_is_reused_only_with_identical_settings(tmp_path):
+    from learning.experiments.deep_protocols import job_task
+    from learning.runner import RecordStore
+
     job = jobs_for("episodes", ["dqn"], CONFIG, SCHEDULE)[0]
-    (tmp_path / "jobs").mkdir()
-    (tmp_path / "jobs" / f"{job.key}.json").write_text(json.dumps(_record(job, CONFIG, lambda x: 1.0)))
+    RecordStore(tmp_path / "jobs").put(job_task(job, CONFIG, tmp_path), _record(job, CONFIG, lambda x: 1.0))
     assert cached_record(job, CONFIG, tmp_path) is not None
     assert cached_record(job, ProtocolConfig(runs_per_variant=3, training_seeds=2), tmp_path) is None
     (tmp_path / "jobs" / f"{job.key}.json").write_text("{truncated")
