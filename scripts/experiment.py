@@ -13,10 +13,9 @@ protocols (sharing the deep agents' training) and adds ``DIR/all.md`` with the e
 table and the wall time of every part.
 
 The deep agents (``dqn``, ``model-based``, ``mt-dqn``, ``mt-model-based``; torch) train as jobs, one
-per agent, training seed and training-variant count, as tasks of ``learning.runner``: ``--workers`` at a
-time (default: one per
-core; ``--ray auto|ADDRESS``: on Ray). Every finished job is saved in ``DIR/jobs/`` at once: run the same
-command again after an
+per agent, training seed and training-variant count, as tasks of ``learning.runner``: ``--workers`` at
+a time (default: one per core; ``--ray auto|ADDRESS``: on Ray). Every finished job is saved in
+``DIR/jobs/`` at once: run the same command again after an
 interruption and it resumes, reusing every finished job.
 
 ``reality`` (``scripts/_reality_sweep.py``) runs the memory agent end to end in the twin on the paper
