@@ -54,30 +54,32 @@ def trial_task(
         "memory_sha256": file_sha256(memory) if memory else None,
         "checkpoint": str(Path(checkpoint).resolve()) if checkpoint else None,
         "checkpoint_sha256": file_sha256(checkpoint) if checkpoint else None,
-        "reality": reality, "calibration": calibration, "video": video,
+        "reality": reality, "calibration": calibration,
     }  # fmt: skip
-    return Task(key, run_trial, settings)
+    return Task(key, run_trial, settings, context={"video": video} if video else None)
 
 
 @lru_cache(maxsize=4)
-def _memory(path: str) -> MemoryStore:
+def _memory(path: str, sha256: str) -> MemoryStore:
+    """The memory at ``path`` opened once per process and content (trials only read it)."""
     return MemoryStore.open_existing(path)
 
 
-def run_trial(settings: Mapping[str, Any]) -> dict[str, Any]:
-    """Run the trial ``settings`` describe (see :func:`trial_task`); returns its run entry."""
+def run_trial(settings: Mapping[str, Any], context: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """Run the trial ``settings`` describe (see :func:`trial_task`); returns its run entry. ``context`` may name
+    a ``video`` file to record (where the rollout goes does not change the record)."""
     spec = spec_from_dict(settings["spec"])
     if _hook is not None:
         _hook.start(f"{spec.name} seed {settings['seed']}")
     try:
-        return _run(spec, settings)
+        return _run(spec, settings, (context or {}).get("video"))
     finally:
         if _hook is not None:
             _hook.close()
 
 
-def _run(spec: PuzzleSpec, settings: Mapping[str, Any]) -> dict[str, Any]:
-    memory = _memory(settings["memory"]) if settings["memory"] else None
+def _run(spec: PuzzleSpec, settings: Mapping[str, Any], video: str | None) -> dict[str, Any]:
+    memory = _memory(settings["memory"], settings["memory_sha256"]) if settings["memory"] else None
     if settings["sim"] == "twin":
         from _twin_trial import run_twin_trial  # MuJoCo and rendering only when asked
 
@@ -86,8 +88,8 @@ def _run(spec: PuzzleSpec, settings: Mapping[str, Any]) -> dict[str, Any]:
 
         reality = RealityProfile.from_dict(settings["reality"]) if settings["reality"] else None
         calibration = CellCalibration.from_dict(settings["calibration"]) if settings["calibration"] else None
-        video = Path(settings["video"]) if settings["video"] else None
-        return run_twin_trial(spec, settings["seed"], settings["agent"], memory, settings["max_actions"], video,
+        return run_twin_trial(spec, settings["seed"], settings["agent"], memory, settings["max_actions"],
+                              Path(video) if video else None,
                               settings["checkpoint"], reality, calibration, on_action=_on_action)  # fmt: skip
     agent = make_agent(settings["agent"], spec, memory, settings["checkpoint"])
     world = SymbolicWorld(spec, settings["seed"])
