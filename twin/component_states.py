@@ -37,9 +37,10 @@ class ComponentStates:
 
     def update(self, q: np.ndarray) -> bool:
         """Update from joint positions ``q`` [rad or m]; True if any state changed."""
-        flips = np.flatnonzero(np.where(self.states == 0, q >= self.open_at, q <= self.close_at))
-        if flips.size == 0:  # the common case, kept cheap: this runs every few physics steps
+        flipping = np.where(self.states == 0, q >= self.open_at, q <= self.close_at)
+        if not flipping.any():  # the common case, kept cheap: this runs every few physics steps
             return False
+        flips = np.flatnonzero(flipping)
         self.states = self.states.copy()
         self.states[flips] ^= 1
         return True

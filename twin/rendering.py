@@ -16,7 +16,13 @@ on an OSMesa context (measured with mujoco 3.17.0). So when EGL fails, :class:`R
 :class:`~twin.errors.RenderingError` telling to start the process with ``MUJOCO_GL=osmesa``.
 
 Shadows are off unless asked for (:attr:`RenderConfig.shadows`): on the CPU they make a frame 3-4x
-slower (DESIGN.md) and ArUco detection does not need them.
+slower (DESIGN.md) and ArUco detection does not need them. Without them the shadow map is allocated at
+1x1 instead of the model's 4096x4096: it is never drawn into, and its allocation was 40-120 ms of the
+~0.2 s a render context took to make on llvmpipe.
+
+A renderer can draw another model whose render resources are the same (:func:`render_resources_key`: the
+meshes, textures and materials a render context uploads, and the visual settings it copies) with
+:meth:`Renderer.rebind`; :mod:`twin.renderer_pool` keeps renderers across the sessions of a process that way.
 
 Camera conventions
 ------------------
@@ -31,6 +37,7 @@ from __future__ import annotations
 
 import atexit
 import contextlib
+import hashlib
 import importlib
 import math
 import os
@@ -52,6 +59,7 @@ __all__ = [
     "camera_pose_in_world",
     "gl_backend",
     "pinhole_intrinsics",
+    "render_resources_key",
 ]
 
 GL_BACKENDS: tuple[str, ...] = ("egl", "osmesa", "glfw")
@@ -188,6 +196,41 @@ def pinhole_intrinsics(model: mujoco.MjModel, cam: int, width: int, height: int)
     return np.array([[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]])
 
 
+# What mjr_makeContext uploads or copies from a model: mesh, texture, height-field, skin and flex buffers, the
+# materials' texture bindings (MjrContext.mat_texid...) and a display list per plane geom (its size and
+# material). The visual settings it copies follow below.
+_RESOURCE_PREFIXES = ("mesh_", "tex_", "hfield_", "skin_", "flex_", "mat_")
+_GEOM_RESOURCES = ("geom_type", "geom_size", "geom_dataid", "geom_matid")
+
+
+def _bound_visual(model: mujoco.MjModel, config: RenderConfig) -> tuple[int, int, int]:
+    """The offscreen buffer size [px] and shadow map size [texels] a renderer sets on the model it draws."""
+    global_ = model.vis.global_
+    shadowsize = int(model.vis.quality.shadowsize) if config.shadows else 1  # unused: see the module docstring
+    return max(int(global_.offwidth), config.width), max(int(global_.offheight), config.height), shadowsize
+
+
+def render_resources_key(model: mujoco.MjModel, config: RenderConfig) -> str:
+    """A fingerprint of everything a render context built for ``model`` holds, bar what depends on the
+    model's extent (fog and shadow clipping, which :meth:`Renderer.rebind` sets): two models with the same key
+    render identically through one context. SHA-256 over the resource arrays (~1 ms for the paper scenes)."""
+    digest = hashlib.sha256(repr(config).encode())
+    for name in sorted(dir(model)):
+        if name.startswith(_RESOURCE_PREFIXES) or name in _GEOM_RESOURCES:
+            value = getattr(model, name)
+            if isinstance(value, np.ndarray):
+                digest.update(f"{name}{value.shape}{value.dtype}".encode())
+                digest.update(np.ascontiguousarray(value).tobytes())
+    vis = model.vis
+    offwidth, offheight, shadowsize = _bound_visual(model, config)
+    settings = (
+        vis.global_.linewidth, offwidth, offheight, shadowsize, vis.quality.offsamples, vis.quality.numslices,
+        vis.quality.numstacks, vis.quality.numquads, vis.map.shadowscale, tuple(vis.rgba.fog),
+    )  # fmt: skip
+    digest.update(repr(settings).encode())
+    return digest.hexdigest()
+
+
 def camera_pose_in_world(data: mujoco.MjData, cam: int) -> np.ndarray:
     """``T_world_camera`` of camera ``cam`` in state ``data``, OpenCV camera frame (see
     :meth:`Renderer.camera_pose_in_world`; ``data`` needs its camera poses computed: ``mj_forward``, or
@@ -224,17 +267,11 @@ class Renderer:
         # Set first so that close() and __del__ work whatever fails below.
         self._gl_context = None
         self._mjr_context: mujoco.MjrContext | None = None
-        self._model = model
         self._config = config
         self._backend = gl_backend()
-        names = (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_CAMERA, i) for i in range(model.ncam))
-        self._camera_ids = {name: i for i, name in enumerate(names) if name}
-        global_ = model.vis.global_
-        global_.offwidth = max(int(global_.offwidth), config.width)
-        global_.offheight = max(int(global_.offheight), config.height)
-
-        self._scene = mujoco.MjvScene(model, maxgeom=config.max_geoms)
-        self._scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = config.shadows
+        self.resources_key = render_resources_key(model, config)
+        """:func:`render_resources_key` of the models this renderer can draw."""
+        self._bind(model)
         self._option = mujoco.MjvOption()
         self._camera = mujoco.MjvCamera()
         self._camera.type = mujoco.mjtCamera.mjCAMERA_FIXED
@@ -253,6 +290,35 @@ class Renderer:
                 + _context_hint(self._backend)
             ) from exc
         _track(self)
+
+    def _bind(self, model: mujoco.MjModel) -> None:
+        """Draw ``model`` from now on: its cameras, a fresh abstract scene, its visual settings adjusted."""
+        config = self._config
+        self._model = model
+        names = (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_CAMERA, i) for i in range(model.ncam))
+        self._camera_ids = {name: i for i, name in enumerate(names) if name}
+        global_ = model.vis.global_
+        global_.offwidth, global_.offheight, model.vis.quality.shadowsize = _bound_visual(model, config)
+        self._scene = mujoco.MjvScene(model, maxgeom=config.max_geoms)
+        self._scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = config.shadows
+
+    def rebind(self, model: mujoco.MjModel) -> None:
+        """Draw ``model`` instead, through the same OpenGL and render contexts: frames are then the same as a
+        new renderer of ``model`` would draw (the context's extent-dependent settings are set from it).
+
+        Raises:
+            RenderingError: if the renderer is closed, or ``model``'s render resources differ (another key).
+        """
+        if self._mjr_context is None:
+            raise RenderingError("rebind() called on a closed Renderer; create a new one")
+        if render_resources_key(model, self._config) != self.resources_key:
+            raise RenderingError("rebind() needs a model with the same meshes, textures, materials and visual settings")
+        self._bind(model)
+        # mjr_makeContext copies these from the model's extent (float32 in the context, as here)
+        extent, vis_map = model.stat.extent, model.vis.map
+        self._mjr_context.fogStart = extent * vis_map.fogstart
+        self._mjr_context.fogEnd = extent * vis_map.fogend
+        self._mjr_context.shadowClip = extent * vis_map.shadowclip
 
     @property
     def model(self) -> mujoco.MjModel:

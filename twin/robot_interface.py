@@ -40,6 +40,7 @@ class RobotInterface:
         m = session.model
         self.camera_names: tuple[str, ...] = session.cameras.names
         self._ctrl_range = m.actuator_ctrlrange[session.arm_actuators].copy()
+        self._low, self._high = self._ctrl_range[:, 0] - 1e-9, self._ctrl_range[:, 1] + 1e-9  # what is accepted
         driver = m.joint(names.gripper_actuator.replace("fingers", "right_driver_joint"))
         self._gripper_qpos, self._gripper_range = driver.qposadr[0], driver.range.copy()
 
@@ -96,11 +97,12 @@ class RobotInterface:
         q = np.asarray(q, dtype=float)
         if q.shape != (7,):
             raise CommandError(f"need 7 joint targets, got shape {q.shape}")
-        if not np.all(np.isfinite(q)):
+        if not np.isfinite(q).all():
             raise CommandError(f"joint targets must be finite, got {q}")
-        low, high = self._ctrl_range[:, 0], self._ctrl_range[:, 1]
-        outside = np.flatnonzero((q < low - 1e-9) | (q > high + 1e-9))
+        low, high = self._low, self._high
+        outside = np.flatnonzero((q < low) | (q > high))
         if outside.size:
+            low, high = self._ctrl_range[:, 0], self._ctrl_range[:, 1]
             detail = ", ".join(f"joint{i + 1}={q[i]:.3f} not in [{low[i]:.3f}, {high[i]:.3f}]" for i in outside)
             raise CommandError(f"joint targets outside the servo ranges: {detail}")
         self._session.servos.command_joints(q)

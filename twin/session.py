@@ -32,7 +32,7 @@ import numpy as np
 from models import PuzzleSpec, get_kind
 from models.calibration import CameraCalibration
 from models.placement import placed, sample_reachable_pose
-from models.scene import Scene, SceneConfig, build_scene
+from models.scene import Scene, SceneConfig
 from models.xarm7 import HOME_QPOS
 from twin.cell import apply_cell, draw_cell
 from twin.component_states import ComponentStates, HysteresisConfig
@@ -44,6 +44,7 @@ from twin.physics_draws import apply_physics, draw_physics, subtree_bodies
 from twin.reality import RealityProfile, load_profile
 from twin.rendering import RenderConfig, pinhole_intrinsics
 from twin.robot_interface import RobotInterface
+from twin.scene_cache import compiled_scene
 from twin.sensors.cameras import Cameras, true_lens
 from twin.sensors.encoders import JointEncoders
 from twin.sensors.force_torque import ForceTorqueSensor
@@ -113,8 +114,8 @@ class TwinSession:
             rng = np.random.default_rng(self._streams["placement"])
             spec = placed(spec, sample_reachable_pose(spec, rng, self.reality.placement, self.config.scene))
         self.spec = spec
-        self.scene: Scene = build_scene(spec, self.config.scene)
-        self.model = self.scene.compile()
+        self.scene: Scene
+        self.scene, self.model = compiled_scene(spec, self.config.scene)  # a copy: this session's own
         self.nominal_model = copy.deepcopy(self.model)
         """The model as designed: the nominal kinematics and cameras (what calibration starts from)."""
         self.data = mujoco.MjData(self.model)
@@ -246,10 +247,24 @@ class TwinSession:
         """Advance by ``seconds`` of simulated time (rounded to whole steps) [s]."""
         self.step(max(1, round(seconds / self.timestep)))
 
+    def _steps(self, k: int) -> None:
+        """``k`` ``mj_step``, the sensors computed in the last one only: nothing can read them in between, and
+        the wrist F/T sensor's post-constraint pass was ~15 % of a step. (A step computes the sensors of the state
+        it starts from, so ``sensordata`` after it is what computing them at every step gives: bit for bit.)"""
+        m, d = self.model, self.data
+        if k > 1:
+            flags = m.opt.disableflags
+            m.opt.disableflags = flags | mujoco.mjtDisableBit.mjDSBL_SENSOR
+            try:
+                mujoco.mj_step(m, d, nstep=k - 1)
+            finally:
+                m.opt.disableflags = flags
+        mujoco.mj_step(m, d)
+
     def _run(self, k: int) -> None:
         """``k`` physics steps, stopping at each F/T sample and queued command on the way."""
         if self._plain:
-            mujoco.mj_step(self.model, self.data, nstep=k)
+            self._steps(k)
             return
         every = self.ft.sample_steps
         while k > 0:
@@ -259,7 +274,7 @@ class TwinSession:
             due = self.servos.steps_to_next()
             if due is not None:
                 j = min(j, due)
-            mujoco.mj_step(self.model, self.data, nstep=j)
+            self._steps(j)
             k -= j
             self.servos.apply_due()
             if every and round(self.data.time / self.timestep) % every == 0:
@@ -274,7 +289,7 @@ class TwinSession:
         if changed:
             self.latches.apply(d, self.states.states, self._jammed())  # rules change only when a state does
         counts = d.warning.number
-        if np.any(counts > self._warnings):
+        if (counts > self._warnings).any():
             new = [i for i in np.flatnonzero(counts > self._warnings) if i in _PHYSICS_WARNINGS]
             self._warnings = counts.copy()
             if new:

@@ -22,6 +22,7 @@ import mujoco
 import numpy as np
 
 from models.robot import CameraImage
+from twin import renderer_pool
 from twin.errors import UnknownCamera
 from twin.reality import CameraReality
 from twin.rendering import MUJOCO_TO_OPENCV, RenderConfig, Renderer, pinhole_intrinsics
@@ -150,7 +151,7 @@ class Cameras:
         if c.dropped_frame_probability > 0 and rng.random() < c.dropped_frame_probability:
             return None
         if self._renderer is None:
-            self._renderer = Renderer(self._model, self.render_config)
+            self._renderer = renderer_pool.acquire(self._model, self.render_config)
         rgb = self._renderer.render(self._data, camera)
         lens = self._lenses[camera]
         if lens.map_x is not None:
@@ -207,6 +208,7 @@ class Cameras:
             self._rngs[name].bit_generator.state = rng_state
 
     def close(self) -> None:
+        """Give the renderer back to the process's pool (the next session of this spec draws with it)."""
         if self._renderer is not None:
-            self._renderer.close()
+            renderer_pool.release(self._renderer)
             self._renderer = None
