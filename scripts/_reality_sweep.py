@@ -7,15 +7,16 @@ box at ``placements`` random reachable placements (seeds ``seed .. seed + placem
 placements at every level). A second sweep raises the F/T force noise alone, to find the noise at which
 outcome agreement drops below 99 %.
 
-Nothing is lost: each calibration and each trial is written to ``DIR/calibrations/`` and ``DIR/trials/``
-as soon as it is made (atomically), and the same command resumes after an interruption, reusing them.
-The summary (``DIR/reality.json``, ``.md``, ``.png``) is rewritten after every profile.
+Calibrations and trials are tasks of ``learning.runner`` (``--workers K`` processes, default one per
+core, or ``--ray``). Nothing is lost: each calibration and each trial is written to ``DIR/calibrations/``
+and ``DIR/trials/`` as soon as it is made (atomically), and the same command resumes after an
+interruption, reusing them. The summary (``DIR/reality.json``, ``.md``, ``.png``) is rewritten after every
+trial, a profile's point appearing once all its trials are in.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import time
 from collections.abc import Iterator
@@ -25,15 +26,15 @@ from typing import Any
 
 from _calibration_run import calibrate_cell
 from _cli import write_json
-from _twin_trial import run_twin_trial
-from tqdm import tqdm
+from _trial_task import trial_task
 from trial import twin_figures
 
-from learning import MemoryAgent, SymbolicWorld, run_episode, summarise
+from learning import LearningError, MemoryAgent, SymbolicWorld, run_episode, summarise
 from learning.memory import MemoryStore
-from models import PuzzleSpec
+from learning.runner import RecordStore, RunReport, Task, make_executor, run_tasks
 from models.calibration import CellCalibration
 from models.generator import paper_family
+from models.spec import spec_from_dict
 from twin.reality import RealityProfile
 from twin.reality_levels import ALL, FACTORS, force_noise_profile, profile_at
 
@@ -93,66 +94,81 @@ def ensure_memory(path: Path, config: SweepConfig) -> Path:
     return path
 
 
-def run_sweep(out: Path, config: SweepConfig, memory_path: Path | None = None) -> dict[str, Any]:
-    """Run (or resume) the sweep into ``out``; returns the summary also written to ``out/reality.json``."""
+def run_sweep(
+    out: Path, config: SweepConfig, memory_path: Path | None = None, workers: int | None = None, ray: str | None = None
+) -> dict[str, Any]:
+    """Run (or resume) the sweep into ``out`` on the task runner (``workers`` processes, default one per core,
+    or Ray); returns the summary also written to ``out/reality.json``.
+
+    Raises:
+        LearningError: a calibration or trial failed (every other one is kept for the resume).
+    """
     out.mkdir(parents=True, exist_ok=True)
     memory_path = ensure_memory(memory_path or out / "memory.sqlite", config)
-    memory = MemoryStore.open_existing(str(memory_path))
     specs = paper_family("test", seed=0)
     points = list(config.points())
     profiles = {p.name: p for _, _, p in points}
-    summary: dict[str, Any] = {"config": dataclasses.asdict(config), "memory": str(memory_path), "points": []}
-    per_profile: dict[str, dict[str, Any]] = {}
     start = time.perf_counter()
-    total = len(profiles) * len(specs) * config.placements
-    with tqdm(total=total, desc="reality sweep", unit="trial", disable=None) as bar:
+    with make_executor(workers, ray) as executor:
+        calibrations = [Task(name, calibration_task, {"spec": specs[0].to_dict(), "profile": profile.to_dict()})
+                        for name, profile in profiles.items()]  # fmt: skip
+        done = run_tasks(calibrations, RecordStore(out / "calibrations"), executor, desc="calibrations")
+        _raise_failures(done)
+        trials, by_profile = [], {}
         for name, profile in profiles.items():
-            calibration, calibration_figures = _calibration(out, profile, specs[0])
-            runs = []
+            calibration = done.records[name]["calibration"]
             for spec in specs:
-                for r in range(config.placements):
-                    runs.append(_trial(out, profile, calibration, spec, config.seed + r, memory, config.max_actions))
-                    bar.update()
-            per_profile[name] = _figures(runs, config.max_actions, calibration_figures)
-            summary["points"] = [
-                {"series": s, "level": lv, "profile": p.name, **per_profile[p.name]}
-                for s, lv, p in points
-                if p.name in per_profile
-            ]
-            summary["force_noise_threshold_n"] = force_noise_threshold(summary["points"])
-            summary["wall_time_s"] = time.perf_counter() - start
-            write_report(summary, out)
-    memory.close()
-    return summary
+                CellCalibration.from_dict(calibration).check_cell(name, profile.cell_seed, spec.box.size[2], spec.name)
+                for seed in range(config.seed, config.seed + config.placements):
+                    key = f"{name}-{spec.name}-seed{seed}"
+                    trials.append(trial_task(
+                        key, spec, seed, sim="twin", agent="memory", max_actions=config.max_actions,
+                        memory=str(memory_path), reality=profile.to_dict(), calibration=calibration,
+                    ))  # fmt: skip
+                    by_profile[key] = name
+        found: dict[str, dict[str, Any]] = {}
+
+        def summary() -> dict[str, Any]:
+            per_profile = {}
+            for name in profiles:
+                runs = [found[t.key] for t in trials if by_profile[t.key] == name and t.key in found]
+                if len(runs) == len(specs) * config.placements:  # a profile's point once all its trials are in
+                    per_profile[name] = _figures(runs, config.max_actions, done.records[name]["figures"])
+            return {
+                "config": dataclasses.asdict(config), "memory": str(memory_path),
+                "points": [{"series": s, "level": lv, "profile": p.name, **per_profile[p.name]}
+                           for s, lv, p in points if p.name in per_profile],
+                "force_noise_threshold_n": None, "wall_time_s": time.perf_counter() - start,
+            }  # fmt: skip
+
+        def keep(task: Task, record: dict[str, Any]) -> None:
+            found[task.key] = record
+            result = summary()
+            result["force_noise_threshold_n"] = force_noise_threshold(result["points"])
+            write_report(result, out)
+
+        report = run_tasks(trials, RecordStore(out / "trials"), executor, on_record=keep, desc="reality sweep",
+                           postfix=lambda r: f"solved {sum(x['solved'] for x in r.values())}/{len(r)}")  # fmt: skip
+        _raise_failures(report)
+    found.update(report.records)
+    result = summary()
+    result["force_noise_threshold_n"] = force_noise_threshold(result["points"])
+    write_report(result, out)
+    return result
 
 
-def _calibration(out: Path, profile: RealityProfile, spec: PuzzleSpec) -> tuple[CellCalibration, dict[str, Any]]:
-    path = out / "calibrations" / f"{profile.name}.json"
-    figures_path = path.with_name(path.name + ".figures.json")
-    if path.exists() and figures_path.exists():
-        return CellCalibration.load(path), json.loads(figures_path.read_text())
-    run = calibrate_cell(spec, profile)
-    run.calibration.save(path)
-    write_json(figures_path, run.figures)
-    return run.calibration, run.figures
+def calibration_task(settings: dict[str, Any]) -> dict[str, Any]:
+    """Calibrate the cell of a profile (a runner task): the calibration and its figures."""
+    run = calibrate_cell(spec_from_dict(settings["spec"]), RealityProfile.from_dict(settings["profile"]))
+    return {"calibration": run.calibration.to_dict(), "figures": run.figures}
 
 
-def _trial(
-    out: Path,
-    profile: RealityProfile,
-    calibration: CellCalibration,
-    spec: PuzzleSpec,
-    seed: int,
-    memory: MemoryStore,
-    max_actions: int,
-) -> dict[str, Any]:
-    path = out / "trials" / profile.name / f"{spec.name}-seed{seed}.json"
-    if path.exists():
-        return json.loads(path.read_text())
-    calibration.check_cell(profile.name, profile.cell_seed, spec.box.size[2], spec=spec.name)
-    entry = run_twin_trial(spec, seed, "memory", memory, max_actions, None, reality=profile, calibration=calibration)
-    write_json(path, entry)
-    return entry
+def _raise_failures(report: RunReport) -> None:
+    if report.failures:
+        key, error = next(iter(report.failures.items()))
+        raise LearningError(f"{len(report.failures)} task(s) failed, the others kept; {key}: {error.splitlines()[0]}")
+    if report.stopped:
+        raise LearningError(f"interrupted: {len(report.records)} finished task(s) kept; run the same command again")
 
 
 def _figures(runs: list[dict[str, Any]], max_actions: int, calibration: dict[str, Any]) -> dict[str, Any]:

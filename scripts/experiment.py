@@ -3,7 +3,7 @@ the reality gap in the twin.
 
     python scripts/experiment.py {variants,episodes,noise,all} --agents memory,dqn,model-based,mt-dqn,mt-model-based \\
         --out DIR [--quick] [--runs R] [--seeds S] [--workers W | --ray auto|ADDRESS]
-    python scripts/experiment.py reality --out DIR [--quick] [--runs R] [--memory MEM.sqlite]
+    python scripts/experiment.py reality --out DIR [--quick] [--runs R] [--memory MEM.sqlite] [--workers W | --ray ...]
     python scripts/experiment.py faults --out DIR [--quick] [--runs R]
 
 Writes ``DIR/<protocol>.json`` (every point, mean and std over training seeds and each seed's value,
@@ -146,8 +146,10 @@ def _reality(args: argparse.Namespace) -> int:
 
     if args.agents not in (None, "memory"):
         fail(f"the reality protocol runs the memory agent only, got --agents {args.agents}")
-    if args.seeds is not None or args.workers is not None:
-        fail("--seeds and --workers are for the symbolic protocols")
+    if args.seeds is not None:
+        fail("--seeds is for the symbolic protocols")
+    if args.workers is not None and args.workers < 1:
+        fail("--workers must be >= 1")
     config = _with_runs(SweepConfig().quick() if args.quick else SweepConfig(), args.runs, "placements", 1)
     memory = None
     if args.memory is not None:
@@ -156,13 +158,17 @@ def _reality(args: argparse.Namespace) -> int:
             fail(f"--memory {memory}: no such file (train one with scripts/train.py, or leave it out)")
     out = Path(args.out)
     _write_config(out, "reality", args, sweep=asdict(config))
-    return _report(out, "reality", run_sweep(out, config, memory))
+    try:
+        summary = run_sweep(out, config, memory, args.workers, args.ray)
+    except LearningError as err:
+        fail(str(err))
+    return _report(out, "reality", summary)
 
 
 def _faults(args: argparse.Namespace) -> int:
     from _faults import FaultsConfig, run_faults
 
-    if args.agents is not None or args.seeds is not None or args.workers is not None or args.memory is not None:
+    if any(v is not None for v in (args.agents, args.seeds, args.workers, args.ray, args.memory)):
         fail("the faults protocol takes only --out, --quick and --runs")
     config = _with_runs(FaultsConfig().quick() if args.quick else FaultsConfig(), args.runs, "trial_runs", 2,
                         " (a kill lands between two runs)")  # fmt: skip

@@ -13,7 +13,7 @@ from typing import Any
 
 from learning.runner.errors import RunnerError
 
-_KEY = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9._+=-]{0,199}$")
+_KEY = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9._+=@-]{0,199}$")
 
 
 @dataclass(frozen=True)
@@ -21,7 +21,7 @@ class Task:
     """``function(settings)`` returns the task's record (a JSON-able dict).
 
     Attributes:
-        key: unique among a run's tasks and a file name (letters, digits, ``._+=-``; not hidden): its
+        key: unique among a run's tasks and a file name (letters, digits, ``._+=@-``; not hidden): its
             record is ``KEY.json``.
         function: a module-level function, pickled by reference (a lambda or a closure is refused).
         settings: everything the record depends on, JSON-able (seed included). A stored record made
@@ -40,7 +40,7 @@ class Task:
 
     def __post_init__(self) -> None:
         if not _KEY.match(self.key):
-            raise RunnerError(f"task key {self.key!r} is not a file name (letters, digits, ._+=-; not hidden)")
+            raise RunnerError(f"task key {self.key!r} is not a file name (letters, digits, ._+=@-; not hidden)")
         name = getattr(self.function, "__qualname__", "")
         if "<" in name or not getattr(self.function, "__module__", None):
             raise RunnerError(f"task {self.key}: {name or self.function!r} is not a module-level function")

@@ -93,11 +93,12 @@ def test_quick_reality_sweep_calibrates_each_cell_runs_placed_boxes_and_resumes(
         assert len(point["unsolved_reasons"]) == round(3 * (1 - point["success_rate"]))
     assert (tmp_path / "reality.png").read_bytes().startswith(b"\x89PNG")
     assert "| force-torque | 1 | 3 |" in (tmp_path / "reality.md").read_text()
-    trials = sorted((tmp_path / "trials").rglob("*.json"))
-    assert len(trials) == 6 and len(list((tmp_path / "calibrations").glob("*.json"))) == 4
-    poses = {(t.name, tuple(json.loads(t.read_text())["box_pose"])) for t in trials}
+    trials = sorted((tmp_path / "trials").glob("*.json"))
+    assert len(trials) == 6 and len(list((tmp_path / "calibrations").glob("*.json"))) == 2
+    records = [json.loads(t.read_text())["record"] for t in trials]
+    poses = {(r["spec"], r["seed"], tuple(r["box_pose"])) for r in records}
     assert len(poses) == 3  # each level meets the same placements (common random numbers)...
-    assert all(0.30 <= x <= 0.60 and abs(y) <= 0.30 for _, (x, y, _) in poses)  # ... drawn in the workspace
+    assert all(0.30 <= x <= 0.60 and abs(y) <= 0.30 for _, _, (x, y, _) in poses)  # ... drawn in the workspace
     stamps = [t.stat().st_mtime_ns for t in trials]
     again = experiment("reality", "--out", tmp_path, "--quick")  # resumes: every trial reused
     assert again.returncode == 0, again.stderr
