@@ -103,17 +103,28 @@ def _specs(out: Path) -> Path:
     return specs
 
 
+def _uninterrupted(directory: Path, base: list[Any]) -> Any:
+    """The results of ``base`` run to the end in ``directory`` (computed once), wall times aside."""
+    if not (directory / "results.json").exists():
+        shutil.rmtree(directory, ignore_errors=True)
+        _python(*base, "--out", directory).check_returncode()
+    return _without_times(json.loads((directory / "results.json").read_text()))
+
+
+def _lost_and_duplicated(results_path: Path, planned: int) -> tuple[dict[str, Any], int, int]:
+    """A resumed trial's results, its runs missing of ``planned`` and its runs recorded twice."""
+    got = json.loads(results_path.read_text()) if results_path.exists() else {}
+    names = [f"{r['spec']}-{r['seed']}" for r in got.get("runs", [])]
+    return got, planned - len(set(names)), len(names) - len(set(names))
+
+
 def killed_trial(out: Path, config: FaultsConfig) -> FaultRow:
     """SIGKILL ``trial.py`` at ``config.kills`` random moments (each in its own directory), resume each, and
     compare with an uninterrupted run."""
     spec = _specs(out) / "paper-test-0.json"
     base = [SCRIPTS / "trial.py", "--specs", spec, "--sim", config.sim, "--agent", "oracle",
             "--runs", config.trial_runs, "--seed", 0, "--max-actions", 30]  # fmt: skip
-    whole_dir = out / "killed-trial" / "whole"
-    if not (whole_dir / "results.json").exists():
-        shutil.rmtree(whole_dir, ignore_errors=True)
-        _python(*base, "--out", whole_dir).check_returncode()
-    whole = _without_times(json.loads((whole_dir / "results.json").read_text()))
+    whole = _uninterrupted(out / "killed-trial" / "whole", base)
     rng = np.random.default_rng(config.seed)
     lost = duplicated = identical = resumed = 0
     moments = []
@@ -131,10 +142,8 @@ def killed_trial(out: Path, config: FaultsConfig) -> FaultRow:
         moments.append(len(kept))
         result = _python(*base, "--out", target, "--resume")
         resumed += result.returncode == 0
-        got = json.loads((target / "results.json").read_text()) if (target / "results.json").exists() else {}
-        names = [f"{r['spec']}-{r['seed']}" for r in got.get("runs", [])]
-        lost += config.trial_runs - len(set(names))
-        duplicated += len(names) - len(set(names))
+        got, missing, twice = _lost_and_duplicated(target / "results.json", config.trial_runs)
+        lost, duplicated = lost + missing, duplicated + twice
         identical += _without_times(got) == whole
     return FaultRow(
         "trial.py killed (SIGKILL) and resumed",
@@ -165,11 +174,7 @@ def killed_worker(out: Path, config: FaultsConfig) -> FaultRow:
     spec = _specs(out) / "paper-test-0.json"
     base = [SCRIPTS / "trial.py", "--specs", spec, "--sim", config.sim, "--agent", "oracle",
             "--runs", config.worker_runs, "--seed", 0, "--max-actions", 30]  # fmt: skip
-    whole_dir = out / "killed-worker" / "whole"
-    if not (whole_dir / "results.json").exists():
-        shutil.rmtree(whole_dir, ignore_errors=True)
-        _python(*base, "--workers", 1, "--out", whole_dir).check_returncode()
-    whole = _without_times(json.loads((whole_dir / "results.json").read_text()))
+    whole = _uninterrupted(out / "killed-worker" / "whole", [*base, "--workers", 1])
     rng = np.random.default_rng(config.seed + 1)
     killed = detected = survived = lost = duplicated = identical = 0
     for k in range(config.worker_kills):
@@ -188,10 +193,8 @@ def killed_worker(out: Path, config: FaultsConfig) -> FaultRow:
         _, stderr = proc.communicate(timeout=1800)
         detected += "a worker died" in stderr
         survived += proc.returncode == 0 and "Traceback" not in stderr
-        got = json.loads((target / "results.json").read_text()) if (target / "results.json").exists() else {}
-        names = [f"{r['spec']}-{r['seed']}" for r in got.get("runs", [])]
-        lost += config.worker_runs - len(set(names))
-        duplicated += len(names) - len(set(names))
+        got, missing, twice = _lost_and_duplicated(target / "results.json", config.worker_runs)
+        lost, duplicated = lost + missing, duplicated + twice
         identical += _without_times(got) == whole
     n = config.worker_kills
     return FaultRow(

@@ -11,19 +11,14 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from _trial_task import without_timing  # noqa: E402
 
 
 def sweep(*args, timeout=600):
     return subprocess.run([sys.executable, str(ROOT / "scripts/sweep.py"), *map(str, args)], capture_output=True,
                           text=True, timeout=timeout)  # fmt: skip
-
-
-def _without_times(value):
-    if isinstance(value, dict):
-        return {k: _without_times(v) for k, v in value.items() if "wall" not in k}
-    if isinstance(value, list):
-        return [_without_times(v) for v in value]
-    return value
 
 
 RECIPE = {"generator": "random", "components": 6, "multi_locker": True, "seed": 0, "count": 2}
@@ -75,7 +70,7 @@ def test_a_sweep_killed_half_way_and_rerun_records_every_task_once_with_the_same
     assert f"({kept} reused)" in again.stdout, "only the missing tasks were computed"
     got, want = (json.loads((d / "results.json").read_text()) for d in (out, tmp_path / "whole"))
     assert len(list((out / "runs").glob("*.json"))) == 600 and len(got["runs"]) == 600
-    assert _without_times(got) == _without_times(want)
+    assert without_timing(got) == without_timing(want)
 
 
 def test_a_twin_sweep_places_the_box_at_each_drawn_pose(tmp_path):
