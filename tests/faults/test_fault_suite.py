@@ -142,3 +142,23 @@ def test_a_video_killed_in_mid_write_never_appears_under_its_final_name(specs, t
     reader = imageio_ffmpeg.read_frames(str(out / "rollout.mp4"))
     meta = next(reader)
     assert meta["size"] == (640, 480) and sum(1 for _ in reader) > 100, "a whole video: every frame decodes"
+
+
+def test_ctrl_c_to_a_pool_trial_stops_after_the_runs_in_flight_and_keeps_them(specs, tmp_path):
+    """Ctrl-C at a terminal signals the whole process group: the workers leave it to the driver, which stops
+    handing out runs, keeps the ones in flight and says how to resume."""
+    out = tmp_path / "out"
+    command = [sys.executable, ROOT / "scripts/trial.py", "--specs", *sorted(specs.glob("*.json")), "--sim",
+               "symbolic", "--agent", "dual", "--runs", 300, "--seed", 0, "--max-actions", 30, "--out", out,
+               "--workers", 2]  # fmt: skip
+    proc = subprocess.Popen(list(map(str, command)), stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and len(list(out.glob("runs/*.json"))) < 10:
+        time.sleep(0.02)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 130 and "--resume" in stderr and "Traceback" not in stderr, stderr
+    results = json.loads((out / "results.json").read_text())
+    assert 10 <= results["runs_done"] == len(list(out.glob("runs/*.json"))) < results["runs_planned"] == 900
+    resumed = python(*command[1:], "--resume")
+    assert resumed.returncode == 0 and json.loads((out / "results.json").read_text())["runs_done"] == 900
