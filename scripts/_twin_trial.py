@@ -4,6 +4,7 @@ perception, the agent, the primitives, physics — with a timeline and, optional
 from __future__ import annotations
 
 import hashlib
+import math
 import time
 from collections.abc import Callable
 from dataclasses import asdict
@@ -82,7 +83,7 @@ class TrueForceWatch:
         self._robot.wait(seconds)
         load_in_base = self._session.data.site_xmat[self._site].reshape(3, 3) @ self._session.ft.load()[:3]
         external = load_in_base - self._weight_in_base
-        magnitude = float(np.linalg.norm(external))
+        magnitude = math.sqrt(external @ external)  # np.linalg.norm, bit for bit, at a third of its cost
         if magnitude > self.peak:
             self.peak, self.peak_during = magnitude, self.doing()
 

@@ -8,7 +8,9 @@
 - symbolic environment: steps per second of ``PuzzleEnv.step`` with random actions;
 - twin: scene build + compile time; bare ``mj_step`` rate on the compiled paper scene (one step per
   call, as a Python user steps, and ``nstep`` in C) beside the twin's rate on the same model, with
-  their ratio; overview render time per 640x480 frame without and with shadows.
+  their ratio; overview render time per 640x480 frame without and with shadows;
+- twin trial: simulated/wall time of one oracle twin trial on a paper test box (ideal cell, no video), the
+  first in the process (renderer, scene and IK model built) and a second one (kept from the first).
 Single-threaded numpy is enforced for the agent figures (one core).
 """
 
@@ -121,6 +123,26 @@ def twin_figures(quick: bool) -> dict[str, float]:
     return out
 
 
+def twin_trial_figures(quick: bool) -> dict[str, float]:
+    """Simulated over wall time of oracle twin trials on the first paper test box, ideal cell: a first trial
+    in this process and, unless ``quick``, a second one with what the process kept from the first. Quick: one
+    try after the survey instead of the whole box."""
+    from _twin_trial import run_twin_trial
+
+    from models.generator import paper_family
+
+    spec = paper_family("test")[0]
+    out: dict[str, float] = {}
+    for label in ("first", "second")[: 1 if quick else 2]:
+        start = time.perf_counter()
+        record = run_twin_trial(spec, 0, "oracle", None, 1 if quick else 30, None)
+        wall = time.perf_counter() - start
+        out[f"{label}_sim_s"], out[f"{label}_wall_s"] = record["sim_time_s"], wall
+        out[f"{label}_sim_over_wall"] = record["sim_time_s"] / wall
+        out[f"{label}_actions"] = record["num_actions"]
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", required=True, help="output JSON file")
@@ -142,6 +164,16 @@ def main(argv: list[str] | None = None) -> int:
         f"twin {twin['twin_step_per_s']:,.0f}/s (x{twin['twin_over_bare_per_call']:.2f} per call, "
         f"x{twin['twin_over_bare_nstep']:.2f} nstep); overview render {twin['overview_render_ms_no_shadows']:.1f} ms "
         f"({twin['overview_render_ms_shadows']:.1f} ms with shadows)"
+    )
+    results["twin_trial"] = trial = twin_trial_figures(args.quick)
+    print(
+        "twin trial (oracle, ideal): "
+        + "; ".join(
+            f"{label} x{trial[f'{label}_sim_over_wall']:.1f} ({trial[f'{label}_sim_s']:.0f} s simulated in "
+            f"{trial[f'{label}_wall_s']:.2f} s, {trial[f'{label}_actions']} actions)"
+            for label in ("first", "second")
+            if f"{label}_sim_s" in trial
+        )
     )
     path = write_json(Path(args.out), results)
     print(f"-> {path}")

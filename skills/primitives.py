@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import collections
 import collections.abc
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -185,7 +186,7 @@ class Toggler:
         the safety limit."""
         self._force_window.append(self.robot.ft_rotation_in_base() @ self.robot.wrench()[:3])
         self.force_in_base = _median_rows(self._force_window)
-        magnitude = float(np.linalg.norm(self.force_in_base))
+        magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
         self.peak_force = max(self.peak_force, magnitude)
         if self.guard and magnitude > self.config.force_limit:
             raise ForceLimitExceeded(
@@ -351,7 +352,7 @@ class Toggler:
                     return ToggleResult("blocked", "latched: held until the grasp slipped", progress, max(forces),
                                         forces=forces)  # fmt: skip
                 raise
-            magnitude = float(np.linalg.norm(self.force_in_base))
+            magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
             if s > 1.0 and magnitude > c.overtravel_force:  # past the travel and pushing hard: stop here
                 end = max(1.0, min(progress, s))
             if (opposing > c.blocked_force or magnitude > c.blocked_magnitude) and progress < c.blocked_progress:

@@ -1,0 +1,53 @@
+"""A twin trial's record does not depend on what ran before it in the process: with the renderer, the compiled
+scene and the IK model kept from earlier trials (another spec's in between), a trial gives the record it gives
+in a fresh process — the same fingerprint of everything sensed, the same actions — apart from wall times."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+import world_fixtures  # noqa: E402, F401  (puts scripts/ on the path)
+from _twin_trial import run_twin_trial  # noqa: E402
+
+from models.generator import paper_family  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[2]
+MAX_ACTIONS = 1
+"""One try after the survey: every cached object (renderer, scene, IK) is used, in a few seconds."""
+
+
+def _without_wall_times(value):
+    if isinstance(value, dict):
+        return {k: _without_wall_times(v) for k, v in value.items() if k not in ("wall_time_s", "wall_time")}
+    if isinstance(value, list):
+        return [_without_wall_times(v) for v in value]
+    return value
+
+
+def _record(spec_index: int, seed: int, reality: str) -> dict:
+    spec = paper_family("test")[spec_index]
+    return _without_wall_times(run_twin_trial(spec, seed, "oracle", None, MAX_ACTIONS, None, reality=reality))
+
+
+def test_a_trial_after_others_in_the_process_gives_the_record_of_a_fresh_process():
+    first = _record(0, 1, "realistic")
+    _record(1, 0, "ideal")  # another spec in between: other cached scene and renderer resources
+    again = _record(0, 1, "realistic")
+    assert again == first
+    code = (
+        "import json, sys; sys.path.insert(0, 'tests/skills'); import test_trial_caches as t; "
+        "print(json.dumps(t._record(0, 1, 'realistic')))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, check=True, timeout=600,
+        env={**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")},
+    )  # fmt: skip
+    fresh = json.loads(out.stdout.strip().splitlines()[-1])
+    assert fresh == json.loads(json.dumps(first))
+    assert first["sensed_sha256"] and first["num_actions"] == MAX_ACTIONS
