@@ -16,6 +16,7 @@ searches' best paths. A search that ends within ``max_expansions`` is exact; one
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -70,6 +71,43 @@ def free_table(belief: Belief) -> np.ndarray:
     return np.clip(free, 0.0, 1.0, out=free)
 
 
+def open_free_rows(locker_probs: np.ndarray, rows: np.ndarray, goal: int, goal_state: int) -> np.ndarray:
+    """Rows ``rows`` of :func:`free_table` on the non-goal states only, ``(len(rows), 2^(N-1))``, indexed
+    by :func:`open_index` (the goal's bit removed): all the value iteration needs, as the goal states'
+    values are 1. ``locker_probs`` is ``(N, 2, N, 2)`` (``[c, x_c, m, x_m]``).
+
+    The same doubling as :func:`free_table` with the goal's bit fixed (its term is added in its turn),
+    so every sum runs over ``m`` in the same order: the entries equal the full table's bit for bit.
+    """
+    n = locker_probs.shape[0]
+    lockers = locker_probs[rows]
+    size = 1 << (n - 1)
+    held = np.zeros((len(rows), 2, size))
+    k = 1
+    for m in range(n):
+        if m == goal:  # fixed at 1 - goal_state in every non-goal state
+            held += lockers[:, :, m, 1 - goal_state, None]
+            continue
+        held[:, :, k : 2 * k] = held[:, :, :k] + lockers[:, :, m, 1, None]
+        held[:, :, :k] += lockers[:, :, m, 0, None]
+        k *= 2
+    free = np.empty((len(rows), size))
+    for i, c in enumerate(rows.tolist()):
+        if c == goal:
+            np.subtract(1.0, held[i, 1 - goal_state], out=free[i])
+            continue
+        j = c if c < goal else c - 1  # c's bit in the open index
+        out, by_own = free[i].reshape(-1, 2, 1 << j), held[i].reshape(2, -1, 2, 1 << j)
+        np.subtract(1.0, by_own[0, :, 0], out=out[:, 0])
+        np.subtract(1.0, by_own[1, :, 1], out=out[:, 1])
+    return np.clip(free, 0.0, 1.0, out=free)
+
+
+def open_index(x: int | np.ndarray, goal: int) -> int | np.ndarray:
+    """Index of non-goal state ``x`` among the non-goal states: ``x`` with the goal's bit removed."""
+    return (x & ((1 << goal) - 1)) | ((x >> (goal + 1)) << goal)
+
+
 def state_values(belief: Belief, goal: int, goal_state: int, gamma: float) -> np.ndarray:
     """``V(x)`` for all ``2^N`` states by value iteration to the exact fixed point."""
     return value_iteration(free_table(belief), goal, goal_state, gamma)
@@ -84,23 +122,81 @@ def value_iteration(free: np.ndarray, goal: int, goal_state: int, gamma: float) 
     """``V(x)`` for all ``2^N`` states from any table ``free`` (N, 2^N) of move probabilities (the
     belief's, or a learned precondition model's)."""
     n = free.shape[0]
-    size = 1 << n
-    index = np.arange(size)
+    index = np.arange(1 << n)
     is_goal = ((index >> goal) & 1) == goal_state
-    step = gamma * free  # (N, 2^N): gamma * P(c free | x)
-    values = is_goal.astype(np.float64)  # goal states stay 1: every step * V is below gamma < 1
-    for _ in range(size):  # converges far sooner: each sweep extends the best paths by one action or more
-        changed = False
-        for c in range(n):
-            # in place (Gauss-Seidel): values only grow and never pass the least fixed point, so this
-            # ends at the same fixed point, bit for bit, as updating all of them from the last sweep
-            candidate = step[c] * values.reshape(-1, 2, 1 << c)[:, ::-1, :].reshape(-1)  # gamma P V(x ^ c)
-            if not changed and np.any(candidate > values):
-                changed = True
+    values = np.ones(1 << n)  # goal states stay 1: every step * V is below gamma < 1
+    values[~is_goal] = open_value_iteration(gamma * free[:, ~is_goal], goal)  # ascending x: the open index
+    return values
+
+
+_FLIP_INDEX: dict[tuple[int, int], np.ndarray] = {}
+"""``arange(size) ^ (1 << j)`` per (size, j): the partner states of the low bits, gathered with ``take``."""
+GATHER_BITS = 5
+"""Bits below this are flipped by a gather (a strided view of runs of 1-16 floats is several times slower)."""
+
+
+def open_value_iteration(step: np.ndarray, goal: int) -> np.ndarray:
+    """``V`` on the non-goal states (open index) from ``step[c] = gamma * P(c free | x)`` on them.
+
+    ``V(x) = max(step[goal, x], max_(c != goal) step[c, x] * V(x ^ c))``: the goal toggle ends at a value
+    of 1, so it starts the iteration; the other toggles stay among non-goal states. Gauss-Seidel sweeps in
+    place: values only grow and never pass the least fixed point, so they end at the same fixed point, bit
+    for bit, as the Jacobi iteration over all ``2^N`` states (each value is the same product
+    ``step * V(next)`` of the same best path).
+    """
+    n = step.shape[0]
+    values = step[goal].copy()  # V >= the goal toggle's step * 1
+    size = values.size
+    candidate = np.empty(size)
+    previous = np.empty(size)
+    others = [c for c in range(n) if c != goal]
+    gather = size >= 1 << 10
+    for _ in range(size + 1):  # converges far sooner: each sweep extends the best paths by one action or more
+        previous[...] = values
+        for j, c in enumerate(others):
+            k = 1 << j
+            if gather and j < GATHER_BITS:
+                flip = _FLIP_INDEX.get((size, j))
+                if flip is None:
+                    flip = _FLIP_INDEX[(size, j)] = np.arange(size) ^ k
+                np.take(values, flip, out=candidate)
+                np.multiply(step[c], candidate, out=candidate)  # gamma P V(x ^ c)
+            else:
+                now, pair, out = values.reshape(-1, 2, k), step[c].reshape(-1, 2, k), candidate.reshape(-1, 2, k)
+                np.multiply(pair[:, 0], now[:, 1], out=out[:, 0])
+                np.multiply(pair[:, 1], now[:, 0], out=out[:, 1])
             np.maximum(values, candidate, out=values)
-        if not changed:
+        if np.array_equal(previous, values):
             break
     return values
+
+
+class _StepCache:
+    """One belief's ``gamma * P(c free | x)`` on the non-goal states, kept across decisions: a decision
+    changes one block of the belief, so only the changed components' rows are rebuilt (bit for bit what
+    a full rebuild gives: each row depends on its own component's blocks only)."""
+
+    def __init__(self) -> None:
+        self.key: tuple[int, int, float] | None = None
+        self.probs = np.empty(0)
+        self.step = np.empty(0)
+
+    def get(self, belief: Belief, goal: int, goal_state: int, gamma: float) -> np.ndarray:
+        n = belief.num_components
+        probs = belief.probs
+        if self.key != (goal, goal_state, gamma) or self.probs.shape != probs.shape:
+            rows = np.arange(n)
+            self.step = np.empty((n, 1 << (n - 1)))
+        else:
+            rows = np.flatnonzero(np.any((self.probs != probs).reshape(n, -1), axis=1))
+        if rows.size:
+            locker_probs = probs[:, :, 1:].reshape(n, 2, n, 2)
+            self.step[rows] = gamma * open_free_rows(locker_probs, rows, goal, goal_state)
+        self.key, self.probs = (goal, goal_state, gamma), probs.copy()
+        return self.step
+
+
+_STEP_CACHES: weakref.WeakKeyDictionary[Belief, _StepCache] = weakref.WeakKeyDictionary()
 
 
 def exploit_values(
@@ -117,9 +213,20 @@ def exploit_values(
 
 def _sweep_values(belief: Belief, states: np.ndarray, x: int, goal: int, goal_state: int, gamma: float) -> np.ndarray:
     n = belief.num_components
-    values = state_values(belief, goal, goal_state, gamma)
+    if n <= SMALL_N:
+        table = free_table(belief)
+        is_goal = ((np.arange(1 << n) >> goal) & 1) == goal_state
+        step = gamma * table[:, ~is_goal]
+    else:
+        cache = _STEP_CACHES.get(belief)
+        if cache is None:
+            cache = _STEP_CACHES[belief] = _StepCache()
+        step = cache.get(belief, goal, goal_state, gamma)
+    values = open_value_iteration(step, goal)
     free = np.array([belief.probability_free(states, c) for c in range(n)])
-    return gamma * free * values[[x ^ (1 << c) for c in range(n)]]
+    successors = [x ^ (1 << c) for c in range(n)]
+    after = np.array([1.0 if ((y >> goal) & 1) == goal_state else values[open_index(y, goal)] for y in successors])
+    return gamma * free * after
 
 
 def _best_first_values(belief: Belief, x: int, goal: int, goal_state: int, config: PlannerConfig) -> np.ndarray:
