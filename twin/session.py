@@ -187,6 +187,9 @@ class TwinSession:
                 m, handle_geoms, gripper_bodies, self.travel, r.physics.jam_probability, r.physics.jam_release_after
             )
         self._plain = self.ft.sample_steps == 0 and self.servos.immediate
+        self._dt = float(m.opt.timestep)  # [s] read every run: a model attribute costs a binding call
+        self._held_for: np.ndarray | None = None
+        self._held_now = np.zeros(len(spec.components), dtype=bool)
         self._robot: RobotInterface | None = None
         self.reset()
 
@@ -245,21 +248,24 @@ class TwinSession:
 
     def advance(self, seconds: float) -> None:
         """Advance by ``seconds`` of simulated time (rounded to whole steps) [s]."""
-        self.step(max(1, round(seconds / self.timestep)))
+        self.step(max(1, round(seconds / self._dt)))
 
-    def _steps(self, k: int) -> None:
-        """``k`` ``mj_step``, the sensors computed in the last one only: nothing can read them in between, and
-        the wrist F/T sensor's post-constraint pass was ~15 % of a step. (A step computes the sensors of the state
-        it starts from, so ``sensordata`` after it is what computing them at every step gives: bit for bit.)"""
+    def _steps(self, k: int, sense: bool = True) -> None:
+        """``k`` ``mj_step``, the sensors computed in the last one only (``sense``) or in none: nothing reads them
+        but an F/T sample and whoever reads the sensor after :meth:`step` returns, and the wrist F/T sensor's
+        post-constraint pass was ~15 % of a step. (A step computes the sensors of the state it starts from, so
+        ``sensordata`` after it is what computing them at every step gives: bit for bit.)"""
         m, d = self.model, self.data
-        if k > 1:
+        blind = k - 1 if sense else k
+        if blind:
             flags = m.opt.disableflags
             m.opt.disableflags = flags | mujoco.mjtDisableBit.mjDSBL_SENSOR
             try:
-                mujoco.mj_step(m, d, nstep=k - 1)
+                mujoco.mj_step(m, d, nstep=blind)
             finally:
                 m.opt.disableflags = flags
-        mujoco.mj_step(m, d)
+        if sense:
+            mujoco.mj_step(m, d)
 
     def _run(self, k: int) -> None:
         """``k`` physics steps, stopping at each F/T sample and queued command on the way."""
@@ -270,22 +276,30 @@ class TwinSession:
         while k > 0:
             j = k
             if every:
-                j = min(j, every - round(self.data.time / self.timestep) % every)
+                j = min(j, every - round(self.data.time / self._dt) % every)
             due = self.servos.steps_to_next()
             if due is not None:
                 j = min(j, due)
-            self._steps(j)
+            sampling = bool(every) and round(self.data.time / self._dt + j) % every == 0
+            self._steps(j, sense=sampling or j == k)  # a command falling due reads no sensor
             k -= j
             self.servos.apply_due()
-            if every and round(self.data.time / self.timestep) % every == 0:
+            if every and round(self.data.time / self._dt) % every == 0:
                 self.ft.sample()
+
+    def _held(self) -> np.ndarray:
+        """Which components the lock rules hold in the current states (recomputed only when a state changed:
+        ``states.states`` is a new array then)."""
+        if self._held_for is not self.states.states:
+            self._held_for, self._held_now = self.states.states, self.latches.held(self.states.states)
+        return self._held_now
 
     def _after_steps(self) -> None:
         d = self.data
         q = d.qpos[self.component_qpos]
         changed = self.states.update(q)
         if self.jams is not None:
-            changed |= self.jams.update(d, q, self.latches.held(self.states.states))
+            changed |= self.jams.update(d, q, self._held())
         if changed:
             self.latches.apply(d, self.states.states, self._jammed())  # rules change only when a state does
         counts = d.warning.number

@@ -1,6 +1,7 @@
 """What a process keeps across twin sessions changes nothing a session senses: a pooled renderer rebound to
 another session's model draws the pixels a new renderer draws, a cached scene gives a session its own model
-with the trajectory a fresh build gives, and sensing on the last physics step of a run only changes no bit."""
+with the trajectory a fresh build gives, and sensing only on the last physics step of a run (or before an F/T
+sample) changes no bit."""
 
 from __future__ import annotations
 
@@ -125,7 +126,7 @@ def test_a_cached_scene_gives_each_session_its_own_model_and_a_fresh_builds_traj
 def test_sensing_on_the_last_step_of_a_run_only_changes_no_bit(spec, reality):
     fast = TwinSession(spec, seed=3, reality=reality)
     every = TwinSession(spec, seed=3, reality=reality)
-    every._steps = lambda k: mujoco.mj_step(every.model, every.data, nstep=k)  # sensors at every step
+    every._steps = lambda k, sense=True: mujoco.mj_step(every.model, every.data, nstep=k)  # sensors at every step
     rng = np.random.default_rng(0)
     for _ in range(150):
         q = np.clip(fast.robot.joint_positions() + rng.normal(0, 0.02, 7), *fast.robot.joint_limits().T)
