@@ -81,7 +81,7 @@ class TrueForceWatch:
 
     def wait(self, seconds: float) -> None:
         self._robot.wait(seconds)
-        load_in_base = self._session.data.site_xmat[self._site].reshape(3, 3) @ self._session.ft.load()[:3]
+        load_in_base = self._session.data.site_xmat[self._site].reshape(3, 3) @ self._session.ft.load_force()
         external = load_in_base - self._weight_in_base
         magnitude = math.sqrt(external @ external)  # np.linalg.norm, bit for bit, at a third of its cost
         if magnitude > self.peak:

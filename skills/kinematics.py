@@ -96,7 +96,7 @@ class ArmKinematics:
 
     @property
     def joints(self) -> np.ndarray:
-        return self.configuration.q[self.arm_qpos].copy()
+        return self.configuration.data.qpos[self.arm_qpos]  # fancy indexing: a copy
 
     def tcp_pose(self) -> np.ndarray:
         """4x4 TCP pose in the base frame for the current IK joints."""
@@ -117,9 +117,17 @@ class ArmKinematics:
             velocity = self._qp.velocity(c.dt)
             if not np.isfinite(velocity).all():
                 raise IKFailure("IK returned non-finite joint velocities")
-            self.configuration.integrate_inplace(velocity, c.dt)
+            self._integrate(velocity, c.dt)
             position_error, orientation_error = self._errors()
         return self.joints, position_error, orientation_error
+
+    def _integrate(self, velocity: np.ndarray, dt: float) -> None:
+        """``configuration.integrate_inplace`` without its equality-constraint pass (no task here uses one):
+        the joints moved, their frames and Jacobian terms updated."""
+        m, d = self.model, self.configuration.data
+        mujoco.mj_integratePos(m, d.qpos, velocity, dt)
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
 
     def _errors(self) -> tuple[float, float]:
         """Position [m] and orientation [rad] error of the TCP from the target."""

@@ -193,6 +193,11 @@ class Toggler:
                 f"force limit: {magnitude:.0f} N > {self.config.force_limit:.0f} N while {self.phase}, motion stopped"
             )
 
+    def _clip(self, q: np.ndarray) -> np.ndarray:
+        """``q`` within the servo ranges [rad] (``np.clip`` for finite ``q``, without its dispatch layers)."""
+        low, high = self._joint_limits
+        return np.minimum(np.maximum(q, low), high)
+
     def _wait_tick(self) -> None:
         self.robot.wait(self.config.tick)
         self._sense()
@@ -200,7 +205,7 @@ class Toggler:
     # -- motion ------------------------------------------------------------------------------------
     def _tick(self, target: np.ndarray) -> tuple[float, float]:
         q, position_error, orientation_error = self.ik.step_towards(target, self.config.ik_iterations_per_tick)
-        self.robot.command_joint_positions(np.clip(q, *self._joint_limits))
+        self.robot.command_joint_positions(self._clip(q))
         self._wait_tick()
         return position_error, orientation_error
 
@@ -243,7 +248,7 @@ class Toggler:
         for k in range(1, ticks + 1):
             s = k / ticks
             s = s * s * (3 - 2 * s)
-            self.robot.command_joint_positions(np.clip((1 - s) * start + s * q_goal, *self._joint_limits))
+            self.robot.command_joint_positions(self._clip((1 - s) * start + s * q_goal))
             self._wait_tick()
 
     def _gripper(self, closure: float, duration: float) -> None:

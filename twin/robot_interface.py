@@ -100,8 +100,8 @@ class RobotInterface:
         if not np.isfinite(q).all():
             raise CommandError(f"joint targets must be finite, got {q}")
         low, high = self._low, self._high
-        outside = np.flatnonzero((q < low) | (q > high))
-        if outside.size:
+        if (q < low).any() or (q > high).any():
+            outside = np.flatnonzero((q < low) | (q > high))
             low, high = self._ctrl_range[:, 0], self._ctrl_range[:, 1]
             detail = ", ".join(f"joint{i + 1}={q[i]:.3f} not in [{low[i]:.3f}, {high[i]:.3f}]" for i in outside)
             raise CommandError(f"joint targets outside the servo ranges: {detail}")

@@ -65,6 +65,10 @@ class ForceTorqueSensor:
         d = self._data.sensordata
         return -np.concatenate([d[self._force], d[self._torque]])
 
+    def load_force(self) -> np.ndarray:
+        """``load()[:3]``, the true force [N], without assembling the torque: ground truth, not for skills."""
+        return -self._data.sensordata[self._force]
+
     def sample(self) -> None:
         """Record a sample of the load at the current time (the session calls it every :attr:`sample_steps`)."""
         self._history.append((float(self._data.time), self.load()))
