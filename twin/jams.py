@@ -66,15 +66,20 @@ class Jams:
         """Start and end tries at joint positions ``q`` given the components lock rules ``held``;
         True when :attr:`jammed` changed."""
         time = float(data.time)
-        self._last_contact[self.touched(data)] = time
+        if data.ncon:
+            self._last_contact[self.touched(data)] = time
         changed = False
-        starting = np.flatnonzero(~self._in_try & ~held & (np.abs(q - self._rest) > self._threshold))
+        # this runs every control tick: the common case (no try starts, none ends) is kept to a few array ops
+        moved = np.abs(q - self._rest) > self._threshold
+        starting = np.flatnonzero(~self._in_try & ~held & moved) if moved.any() else ()
         for c in starting:  # in component order: a deterministic sequence of draws
             self._in_try[c] = True
             self._last_contact[c] = time
             if self._rng.random() < self.probability:
                 self.jammed[c] = True
                 changed = True
+        if not self._in_try.any():
+            return changed
         ending = np.flatnonzero(self._in_try & (time - self._last_contact >= self.release_after))
         for c in ending:
             self._in_try[c] = False

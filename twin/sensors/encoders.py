@@ -54,7 +54,7 @@ class JointEncoders:
 
     def positions(self) -> np.ndarray:
         """Joint positions as the encoders read them now [rad]."""
-        q = self._data.qpos[self._arm_qpos].copy()
+        q = self._data.qpos[self._arm_qpos]  # fancy indexing: a copy
         if self._noise == 0:
             return q
         time = float(self._data.time)
@@ -84,7 +84,7 @@ class JointEncoders:
         a control tick asks for the TCP and the F/T orientation of the same reading)."""
         if self._nominal is None:
             self._nominal = mujoco.MjData(self._nominal_model)
-        if self._nominal_q is None or not np.array_equal(q, self._nominal_q):
+        if self._nominal_q is None or not (q == self._nominal_q).all():  # np.array_equal: 7 joints each
             self._nominal.qpos[self._arm_qpos] = q
             mujoco.mj_kinematics(self._nominal_model, self._nominal)
             self._nominal_q = q.copy()

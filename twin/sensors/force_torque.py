@@ -41,9 +41,11 @@ class ForceTorqueSensor:
         if config.torque_range is not None:
             limits[3:] = config.torque_range
         self._limits = limits if np.isfinite(limits).any() else None
+        self._low = None if self._limits is None else -self._limits
         resolution = np.array([config.force_resolution] * 3 + [config.torque_resolution] * 3)
         self._resolution = resolution if resolution.any() else None
-        self._step = np.where(resolution > 0, resolution, 1.0)  # quantisation step (1: an unquantised axis)
+        self._quantised = resolution > 0
+        self._step = np.where(self._quantised, resolution, 1.0)  # quantisation step (1: an unquantised axis)
 
     def reset(self, rng: np.random.Generator) -> None:
         """A new trial: bias and drift direction drawn from ``rng``, no tare, the load sampled now."""
@@ -86,10 +88,10 @@ class ForceTorqueSensor:
         value = self._delayed_load(time) + self.bias + self.drift_rate * time
         if self._noise is not None:
             value = value + self._rng.normal(0.0, self._noise)
-        if self._limits is not None:
-            value = np.clip(value, -self._limits, self._limits)  # the sensor's raw range, before any tare
+        if self._limits is not None:  # the sensor's raw range, before any tare (np.clip of a finite value)
+            value = np.minimum(np.maximum(value, self._low), self._limits)
         if self._resolution is not None:
-            value = np.where(self._resolution > 0, np.round(value / self._step) * self._step, value)
+            value = np.where(self._quantised, np.round(value / self._step) * self._step, value)
         return value
 
     def read(self, time: float) -> np.ndarray:
