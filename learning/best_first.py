@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from learning.belief import Belief, state_bits
+from learning.belief import Belief
 
 COST_TOLERANCE = 1e-12
 """A path within this [nats] of the best one counts as equal to it: without it, the many paths of
@@ -32,6 +32,11 @@ equal cost (toggle the same lockers in another order), whose sums differ only by
 all be expanded. A relative error of 1e-12 in V, far below the differences between distinct plans."""
 HEURISTIC_SHAVE = 1e-13
 """The heuristic is lowered by this [nats] so that rounding never lets it exceed a true cost."""
+
+
+def _clip_unit(values: np.ndarray) -> np.ndarray:
+    """``np.clip(values, 0, 1)`` in place, without its Python-level dispatch (same result: no NaN here)."""
+    return np.minimum(np.maximum(values, 0.0, out=values), 1.0, out=values)
 
 
 class BestFirstPlanner:
@@ -62,6 +67,15 @@ class BestFirstPlanner:
         best_free = 1.0 - lockers.min(axis=3).sum(axis=2)  # (N, 2)
         with np.errstate(divide="ignore"):
             self._cheapest_toggle = self.step - np.log(np.clip(best_free, 0.0, 1.0))
+        # per (bit of c, c), precomputed for expand: a - b == -(b - a) exactly, so the gains equal the
+        # per-state differences bit for bit
+        difference = self._goal_lockers[:, 0] - self._goal_lockers[:, 1]
+        self._gain_by_bit = np.stack([difference, -difference])
+        self._toggle_by_bit = np.ascontiguousarray(self._cheapest_toggle.T)
+        self._columns = np.arange(n)
+        self._shifts = np.arange(n, dtype=np.int64)
+        self._lockers_by_row = belief.locker_matrix()
+        self._flips = [1 << c for c in range(n)]
 
     def is_goal(self, x: int) -> bool:
         return ((x >> self.goal) & 1) == self.goal_state
@@ -72,26 +86,27 @@ class BestFirstPlanner:
         cached = self._cache.get(x)
         if cached is not None:
             return cached
-        n = self.num_components
-        columns = np.arange(n)
-        bits = state_bits(x, n)
+        n, columns = self.num_components, self._columns
+        bits = (x >> self._shifts) & 1
         rows = 2 * columns + bits
-        held = self.belief.locker_matrix()[rows[:, None], rows[None, :]].sum(axis=1)
-        free = np.clip(1.0 - held, 0.0, 1.0)
+        held = self._lockers_by_row[rows[:, None], rows].sum(axis=1)
+        free = _clip_unit(1.0 - held)
         # the relaxed problem seen from each successor x ^ c, as (successor, locker) matrices
-        gain = self._goal_lockers[columns, bits] - self._goal_lockers[columns, 1 - bits]
+        gain = self._gain_by_bit[bits, columns]  # what switching c frees of the goal: lockers[c, x_c] - [c, 1 - x_c]
         goal_free = 1.0 - held[self.goal] + gain  # the goal's free probability in x ^ c
-        gains = np.broadcast_to(gain, (n, n)).copy()
+        gains = np.empty((n, n))
+        gains[:] = gain
         gains[columns, columns] = -gain  # in x ^ c, switching c back undoes its gain
-        toggles = np.broadcast_to(self._cheapest_toggle[columns, bits], (n, n)).copy()
-        toggles[columns, columns] = self._cheapest_toggle[columns, 1 - bits]
+        toggles = np.empty((n, n))
+        toggles[:] = self._toggle_by_bit[bits, columns]
+        toggles[columns, columns] = self._toggle_by_bit[1 - bits, columns]
         useful = gains > 0.0
         best_gains = np.cumsum(-np.sort(-np.where(useful, gains, 0.0), axis=1), axis=1)
         cheapest = np.cumsum(np.sort(np.where(useful, toggles, np.inf), axis=1), axis=1)
         with np.errstate(divide="ignore"):
             costs = self.step - np.log(free)
-            now = -np.log(np.clip(goal_free, 0.0, 1.0))
-            later = cheapest - np.log(np.clip(goal_free[:, None] + best_gains, 0.0, 1.0))
+            later = cheapest - np.log(_clip_unit(goal_free[:, None] + best_gains))
+            now = -np.log(_clip_unit(goal_free))  # clipped in place: after its last use unclipped
         heuristic = np.maximum(self.step + np.minimum(now, later.min(axis=1)) - HEURISTIC_SHAVE, 0.0)
         cached = (costs.tolist(), heuristic.tolist())
         self._cache[x] = cached
@@ -104,14 +119,16 @@ class BestFirstPlanner:
             return 0.0
         if source in self.known:
             return self.known[source]
-        goal_bit, goal_value, known = 1 << self.goal, self.goal_state << self.goal, self.known
+        goal_bit, known = 1 << self.goal, self.known
         best, best_parent, best_end = math.inf, -1, -1
         cost = {source: 0.0}
         parent = {source: -1}
         frontier = [(0.0, -0.0, source)]  # (cost + heuristic, -cost: deepest first among equals, state)
         expanded = 0
+        flips, expand, known_tail, cost_of = self._flips, self.expand, known.get, cost.get
+        push, pop, inf = heapq.heappush, heapq.heappop, math.inf
         while frontier:
-            bound, negative_cost, x = heapq.heappop(frontier)
+            bound, negative_cost, x = pop(frontier)
             if bound >= best - COST_TOLERANCE:  # no open state can beat the best path: it is optimal
                 break
             g = -negative_cost
@@ -122,20 +139,21 @@ class BestFirstPlanner:
                 self.expansions += expanded
                 return best
             expanded += 1
-            costs, heuristic = self.expand(x)
-            for c, w in enumerate(costs):
-                y, g_y = x ^ (1 << c), g + w
+            costs, heuristic = expand(x)
+            for w, h, flip in zip(costs, heuristic, flips, strict=True):
+                g_y = g + w
                 if g_y >= best:  # also skips surely held components (w = inf)
                     continue
-                tail = 0.0 if (y & goal_bit) == goal_value else known.get(y)
+                y = x ^ flip
+                tail = 0.0 if flip == goal_bit else known_tail(y)  # x is not a goal state: y is iff c is the goal
                 if tail is not None:
                     if g_y + tail < best:
                         best, best_parent, best_end = g_y + tail, x, y
                     continue
-                if g_y < cost.get(y, math.inf):
+                if g_y < cost_of(y, inf):
                     cost[y] = g_y
                     parent[y] = x
-                    heapq.heappush(frontier, (g_y + heuristic[c], -g_y, y))
+                    push(frontier, (g_y + h, -g_y, y))
         self.expansions += expanded
         if best_end < 0:
             known[source] = math.inf

@@ -187,3 +187,20 @@ def test_a_search_stopped_by_its_budget_is_a_lower_bound_and_says_so():
     config = PlannerConfig(max_expansions=5)
     q = planner._best_first_values(belief, 0, n - 1, 1, config)
     assert np.all(q <= 0.9**n * (1.0 + 1e-12))
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(2, 6), st.integers(0, 2**32 - 1), st.floats(0.5, 0.99), st.booleans())
+def test_the_heuristic_never_exceeds_the_true_cost_to_go(n, seed, gamma, noisy):
+    rng = np.random.default_rng(seed)
+    belief = random_belief(rng, n, NOISY if noisy else EXACT)
+    goal, goal_state = int(rng.integers(n)), int(rng.integers(2))
+    search = BestFirstPlanner(belief, goal, goal_state, gamma)
+    for x in range(1 << n):
+        if search.is_goal(x):
+            continue
+        costs, heuristic = search.expand(x)
+        for c in range(n):
+            y = x ^ (1 << c)
+            if not search.is_goal(y):
+                assert heuristic[c] <= brute_force_cost(belief, y, goal, goal_state, gamma)
