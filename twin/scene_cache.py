@@ -18,8 +18,9 @@ import mujoco
 from models import PuzzleSpec
 from models.scene import Scene, SceneConfig, build_scene
 
-MAX_SCENES = 8
-"""Compiled scenes kept (a paper scene's model is ~3 MB)."""
+MAX_SCENES = 4
+"""Compiled scenes kept (a paper scene's model holds ~18 MB, its meshes' collision data mostly; under a profile
+that places boxes every trial is a new scene, so more would only hold memory)."""
 
 _cache: collections.OrderedDict[str, tuple[Scene, mujoco.MjModel]] = collections.OrderedDict()
 _lock = threading.Lock()
