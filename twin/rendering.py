@@ -16,9 +16,9 @@ on an OSMesa context (measured with mujoco 3.17.0). So when EGL fails, :class:`R
 :class:`~twin.errors.RenderingError` telling to start the process with ``MUJOCO_GL=osmesa``.
 
 Shadows are off unless asked for (:attr:`RenderConfig.shadows`): on the CPU they make a frame 3-4x
-slower (DESIGN.md) and ArUco detection does not need them. Without them the shadow map is allocated at
-1x1 instead of the model's 4096x4096: it is never drawn into, and its allocation was 40-120 ms of the
-~0.2 s a render context took to make on llvmpipe.
+slower (DESIGN.md) and ArUco detection does not need them. Without them the render context's shadow map is
+1x1 instead of the model's 4096x4096 (the model keeps its setting): it is never drawn into, and its
+allocation was 40-120 ms of the ~0.2 s a render context took to make on llvmpipe.
 
 A renderer can draw another model whose render resources are the same (:func:`render_resources_key`: the
 meshes, textures and materials a render context uploads, and the visual settings it copies) with
@@ -280,8 +280,15 @@ class Renderer:
 
         self._gl_context = _create_gl_context(self._backend, config.width, config.height)
         try:
-            # The smallest font scale: no text is drawn, and the font textures cost memory per context.
-            self._mjr_context = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_50)
+            # The smallest font scale: no text is drawn, and the font textures cost memory per context. The shadow
+            # map's size is read at creation only: set for it, then the model's own again (a renderer with shadows
+            # made later from the same model gets the model's map).
+            quality = model.vis.quality
+            shadowsize, quality.shadowsize = quality.shadowsize, _bound_visual(model, config)[2]
+            try:
+                self._mjr_context = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_50)
+            finally:
+                quality.shadowsize = shadowsize
             mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._mjr_context)
         except Exception as exc:  # mujoco.FatalError: "gladLoadGL error", "no OpenGL platform library"...
             self.close()
@@ -298,7 +305,7 @@ class Renderer:
         names = (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_CAMERA, i) for i in range(model.ncam))
         self._camera_ids = {name: i for i, name in enumerate(names) if name}
         global_ = model.vis.global_
-        global_.offwidth, global_.offheight, model.vis.quality.shadowsize = _bound_visual(model, config)
+        global_.offwidth, global_.offheight, _ = _bound_visual(model, config)
         self._scene = mujoco.MjvScene(model, maxgeom=config.max_geoms)
         self._scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = config.shadows
 

@@ -91,15 +91,18 @@ def test_two_open_sessions_never_share_a_renderer(spec):
         assert a.cameras._renderer is not b.cameras._renderer
 
 
-def test_the_small_shadow_map_changes_no_pixel_without_shadows(spec, monkeypatch):
+def test_the_small_shadow_map_changes_no_pixel_without_shadows_and_leaves_the_model_its_own(spec, monkeypatch):
     with TwinSession(spec) as session:
+        model_size = session.model.vis.quality.shadowsize
         with Renderer(session.model) as small:
-            assert session.model.vis.quality.shadowsize == 1
+            assert small._mjr_context.shadowSize == 1 and session.model.vis.quality.shadowsize == model_size
             image = small.render(session.data, "overview")
+        with Renderer(session.model, RenderConfig(shadows=True)) as shadows:  # made after: the model's map
+            assert shadows._mjr_context.shadowSize == model_size
         full = rendering_module._bound_visual
-        monkeypatch.setattr(rendering_module, "_bound_visual", lambda m, c: (*full(m, c)[:2], 4096))
+        monkeypatch.setattr(rendering_module, "_bound_visual", lambda m, c: (*full(m, c)[:2], model_size))
         with Renderer(session.model) as default:
-            assert session.model.vis.quality.shadowsize == 4096
+            assert default._mjr_context.shadowSize == model_size
             np.testing.assert_array_equal(default.render(session.data, "overview"), image)
 
 
