@@ -1,6 +1,6 @@
 """Speed figures, measured in one run on this machine (ratios matter more than absolutes here).
 
-    python scripts/bench.py --out FILE
+    python scripts/bench.py --out FILE [--quick] [--scale-trials T]
 
 - agent decision latency: median and 90th percentile milliseconds per dual-controller decision on
   random lock graphs of N = 5, 10, 16, 32 components (beliefs as they evolve during real episodes;
@@ -10,7 +10,10 @@
   call, as a Python user steps, and ``nstep`` in C) beside the twin's rate on the same model, with
   their ratio; overview render time per 640x480 frame without and with shadows;
 - twin trial: simulated/wall time of one oracle twin trial on a paper test box (ideal cell, no video), the
-  first in the process (renderer, scene and IK model built) and a second one (kept from the first).
+  first in the process (renderer, scene and IK model built) and a second one (kept from the first);
+- scale (``scripts/_bench_scale.py``): each executor's overhead per no-op task, and twin trials per hour of
+  the same T oracle trials on one worker, on a local pool (one worker per core) and on a local Ray cluster,
+  one after the other in this run, with each one's speed-up over one worker.
 Single-threaded numpy is enforced for the agent figures (one core).
 """
 
@@ -27,7 +30,7 @@ import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
-from _cli import versions, write_json  # noqa: E402
+from _cli import fail, versions, write_json  # noqa: E402
 
 from learning import DualAgent, PuzzleEnv, PuzzleEnvConfig, SymbolicWorld  # noqa: E402
 from models.generator import RandomGraphConfig, generate_random  # noqa: E402
@@ -147,7 +150,13 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", required=True, help="output JSON file")
     parser.add_argument("--quick", action="store_true", help="fewer episodes (CI smoke run)")
+    parser.add_argument(
+        "--scale-trials", type=int, default=None,
+        help="twin trials per executor for the scale figures (default 40; --quick 4; 0 skips them)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
+    if args.scale_trials is not None and args.scale_trials < 0:
+        fail(f"--scale-trials must be >= 0, got {args.scale_trials}")
     episodes = 1 if args.quick else 5
     results = {"command": "bench", "machine": platform.processor() or platform.machine(), "versions": versions()}
     results["decision_latency"] = {}
@@ -175,7 +184,20 @@ def main(argv: list[str] | None = None) -> int:
             if f"{label}_sim_s" in trial
         )
     )
-    path = write_json(Path(args.out), results)
+    path = write_json(Path(args.out), results)  # what is measured so far is kept if the scale part fails
+    trials = args.scale_trials if args.scale_trials is not None else (4 if args.quick else 40)
+    if trials:
+        from _bench_scale import overhead_ms, twin_throughput
+
+        results["executor_overhead_ms_per_noop_task"] = overhead = overhead_ms(50 if args.quick else 200)
+        print("per-task overhead on no-op tasks: " + ", ".join(f"{k} {v:.2f} ms" for k, v in overhead.items()))
+        results["twin_throughput"] = scale = twin_throughput(trials)
+        print(f"twin trials per hour ({trials} oracle trials, ideal, paper test boxes): " + "; ".join(
+            f"{k} {v['trials_per_hour']:.0f}" + (f" (x{v['speedup_over_one_worker']:.2f})" if "speedup_over_one_worker"
+                                                  in v else "")
+            for k, v in scale.items() if isinstance(v, dict)
+        ))  # fmt: skip
+        path = write_json(Path(args.out), results)
     print(f"-> {path}")
     return 0
 
