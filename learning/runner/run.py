@@ -27,6 +27,7 @@ class RunReport:
         failures: key -> error text (first line: ``Type: message``) of every task that raised.
         stopped: a stop request or an interrupt left tasks undone.
         wall_time_s: duration of the call [s].
+        planned: tasks in the list.
     """
 
     records: dict[str, dict[str, Any]] = field(default_factory=dict)
@@ -35,13 +36,12 @@ class RunReport:
     failures: dict[str, str] = field(default_factory=dict)
     stopped: bool = False
     wall_time_s: float = 0.0
+    planned: int = 0
 
     @property
     def missing(self) -> int:
         """Tasks with neither a record nor a failure (left undone by a stop)."""
         return self.planned - len(self.records) - len(self.failures)
-
-    planned: int = 0
 
 
 def run_tasks(
