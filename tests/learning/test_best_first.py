@@ -8,25 +8,14 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from random_beliefs import EXACT, NOISY, random_belief, random_problem
 
 import learning.planner as planner
-from learning.belief import Belief, BeliefConfig, hypothesis_count, state_bits
+from learning.belief import Belief, hypothesis_count, state_bits
 from learning.best_first import BestFirstPlanner
 from learning.dual_controller import DualControllerConfig, decide
 from learning.exploration import expected_information_gain, information_values
 from learning.planner import PlannerConfig, exploit_values, free_table, state_values, value_iteration
-
-EXACT = BeliefConfig(jam_probability=0.0, false_move_probability=0.0)
-NOISY = BeliefConfig(jam_probability=0.05, false_move_probability=0.02)
-
-
-def random_belief(rng: np.random.Generator, n: int, config: BeliefConfig = EXACT) -> Belief:
-    """Sparse random blocks: some hypotheses impossible, so some moves are surely held."""
-    shape = (n, 2, hypothesis_count(n))
-    probs = rng.random(shape) ** 3 * (rng.random(shape) < 0.7)
-    probs[:, :, 0] += rng.choice([0.0, 0.05, 0.5])
-    probs[:, :, 0] += 1e-9
-    return Belief(probs, config)
 
 
 def brute_force_cost(belief: Belief, source: int, goal: int, goal_state: int, gamma: float) -> float:
@@ -52,9 +41,7 @@ def brute_force_cost(belief: Belief, source: int, goal: int, goal_state: int, ga
 @settings(max_examples=40, deadline=None)
 @given(st.integers(2, 6), st.integers(0, 2**32 - 1), st.floats(0.5, 0.99))
 def test_a_star_cost_equals_the_brute_force_shortest_path(n, seed, gamma):
-    rng = np.random.default_rng(seed)
-    belief = random_belief(rng, n)
-    goal, goal_state = int(rng.integers(n)), int(rng.integers(2))
+    rng, belief, goal, goal_state = random_problem(seed, n, EXACT)
     search = BestFirstPlanner(belief, goal, goal_state, gamma)
     for source in rng.integers(0, 1 << n, size=4):
         expected = brute_force_cost(belief, int(source), goal, goal_state, gamma)
@@ -66,9 +53,7 @@ def test_a_star_cost_equals_the_brute_force_shortest_path(n, seed, gamma):
 @settings(max_examples=40, deadline=None)
 @given(st.integers(2, 9), st.integers(0, 2**32 - 1))
 def test_a_star_exploit_values_equal_value_iteration(n, seed):
-    rng = np.random.default_rng(seed)
-    belief = random_belief(rng, n, NOISY if seed % 2 else EXACT)
-    goal, goal_state = int(rng.integers(n)), int(rng.integers(2))
+    rng, belief, goal, goal_state = random_problem(seed, n, NOISY if seed % 2 else EXACT)
     values = state_values(belief, goal, goal_state, 0.9)
     search = BestFirstPlanner(belief, goal, goal_state, 0.9)
     for x in rng.integers(0, 1 << n, size=3):
@@ -192,9 +177,7 @@ def test_a_search_stopped_by_its_budget_is_a_lower_bound_and_says_so():
 @settings(max_examples=40, deadline=None)
 @given(st.integers(2, 6), st.integers(0, 2**32 - 1), st.floats(0.5, 0.99), st.booleans())
 def test_the_heuristic_never_exceeds_the_true_cost_to_go(n, seed, gamma, noisy):
-    rng = np.random.default_rng(seed)
-    belief = random_belief(rng, n, NOISY if noisy else EXACT)
-    goal, goal_state = int(rng.integers(n)), int(rng.integers(2))
+    rng, belief, goal, goal_state = random_problem(seed, n, NOISY if noisy else EXACT)
     search = BestFirstPlanner(belief, goal, goal_state, gamma)
     for x in range(1 << n):
         if search.is_goal(x):

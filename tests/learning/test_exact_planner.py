@@ -4,19 +4,11 @@ per-belief table of step probabilities kept across decisions, equal the full com
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from random_beliefs import NOISY, random_belief, random_problem
 
 import learning.planner as planner
-from learning.belief import Belief, BeliefConfig, hypothesis_count
+from learning.belief import Belief
 from learning.planner import exploit_values, free_table, open_free_rows, open_index, value_iteration
-
-NOISY = BeliefConfig(jam_probability=0.05, false_move_probability=0.02)
-
-
-def random_belief(rng: np.random.Generator, n: int, config: BeliefConfig = NOISY) -> Belief:
-    shape = (n, 2, hypothesis_count(n))
-    probs = rng.random(shape) ** 3 * (rng.random(shape) < 0.7)
-    probs[:, :, 0] += rng.choice([1e-9, 0.05, 0.5])
-    return Belief(probs, config)
 
 
 def jacobi_values(table: np.ndarray, goal: int, goal_state: int, gamma: float) -> np.ndarray:
@@ -36,9 +28,7 @@ def jacobi_values(table: np.ndarray, goal: int, goal_state: int, gamma: float) -
 @settings(max_examples=30, deadline=None)
 @given(st.integers(1, 13), st.integers(0, 2**32 - 1))
 def test_the_non_goal_rows_equal_the_full_tables_non_goal_columns_bit_for_bit(n, seed):
-    rng = np.random.default_rng(seed)
-    belief = random_belief(rng, n)
-    goal, goal_state = int(rng.integers(n)), int(rng.integers(2))
+    rng, belief, goal, goal_state = random_problem(seed, n, NOISY)
     index = np.arange(1 << n)
     open_states = index[((index >> goal) & 1) != goal_state]
     np.testing.assert_array_equal(open_index(open_states, goal), np.arange(open_states.size))
@@ -55,9 +45,7 @@ def test_the_non_goal_rows_equal_the_full_tables_non_goal_columns_bit_for_bit(n,
 @settings(max_examples=30, deadline=None)
 @given(st.integers(1, 12), st.integers(0, 2**32 - 1), st.floats(0.5, 0.99))
 def test_value_iteration_on_the_non_goal_states_equals_jacobi_sweeps_over_all_states(n, seed, gamma):
-    rng = np.random.default_rng(seed)
-    belief = random_belief(rng, n)
-    goal, goal_state = int(rng.integers(n)), int(rng.integers(2))
+    rng, belief, goal, goal_state = random_problem(seed, n, NOISY)
     table = free_table(belief)
     np.testing.assert_array_equal(
         value_iteration(table, goal, goal_state, gamma), jacobi_values(table, goal, goal_state, gamma)
@@ -67,7 +55,7 @@ def test_value_iteration_on_the_non_goal_states_equals_jacobi_sweeps_over_all_st
 def test_exploit_values_kept_across_belief_updates_equal_a_fresh_computation_bit_for_bit():
     rng = np.random.default_rng(3)
     n = 13
-    belief = random_belief(rng, n)
+    belief = random_belief(rng, n, NOISY)
     goal, goal_state = 4, 1
     for step in range(12):
         states = rng.integers(0, 2, n)
