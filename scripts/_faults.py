@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 from _cli import write_json
+from _trial_task import without_timing
 
 from learning.memory import MemoryStore
 
@@ -88,14 +89,6 @@ def _one_line_error(result: subprocess.CompletedProcess) -> bool:
     return result.returncode == 2 and len(errors) == 1 and "Traceback" not in result.stderr
 
 
-def _without_times(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {k: _without_times(v) for k, v in value.items() if "wall" not in k}
-    if isinstance(value, list):
-        return [_without_times(v) for v in value]
-    return value
-
-
 def _specs(out: Path) -> Path:
     specs = out / "specs"
     if not (specs / "paper-test-0.json").exists():
@@ -108,7 +101,7 @@ def _uninterrupted(directory: Path, base: list[Any]) -> Any:
     if not (directory / "results.json").exists():
         shutil.rmtree(directory, ignore_errors=True)
         _python(*base, "--out", directory).check_returncode()
-    return _without_times(json.loads((directory / "results.json").read_text()))
+    return without_timing(json.loads((directory / "results.json").read_text()))
 
 
 def _lost_and_duplicated(results_path: Path, planned: int) -> tuple[dict[str, Any], int, int]:
@@ -144,7 +137,7 @@ def killed_trial(out: Path, config: FaultsConfig) -> FaultRow:
         resumed += result.returncode == 0
         got, missing, twice = _lost_and_duplicated(target / "results.json", config.trial_runs)
         lost, duplicated = lost + missing, duplicated + twice
-        identical += _without_times(got) == whole
+        identical += without_timing(got) == whole
     return FaultRow(
         "trial.py killed (SIGKILL) and resumed",
         config.kills,
@@ -195,7 +188,7 @@ def killed_worker(out: Path, config: FaultsConfig) -> FaultRow:
         survived += proc.returncode == 0 and "Traceback" not in stderr
         got, missing, twice = _lost_and_duplicated(target / "results.json", config.worker_runs)
         lost, duplicated = lost + missing, duplicated + twice
-        identical += _without_times(got) == whole
+        identical += without_timing(got) == whole
     n = config.worker_kills
     return FaultRow(
         "a trial.py pool worker killed (SIGKILL)",
@@ -255,24 +248,12 @@ def concurrent_trainers(out: Path, config: FaultsConfig, trainers: int) -> Fault
     memory = out / "concurrent" / f"{trainers}" / "memory.sqlite"
     shutil.rmtree(memory.parent, ignore_errors=True)
     memory.parent.mkdir(parents=True)
+    command = [sys.executable, str(SCRIPTS / "train.py"), "--specs", *map(str, specs), "--episodes",
+               str(config.trainer_episodes), "--memory", str(memory)]  # fmt: skip
     procs = [
         subprocess.Popen(
-            [
-                sys.executable,
-                str(SCRIPTS / "train.py"),
-                "--specs",
-                *map(str, specs),
-                "--episodes",
-                str(config.trainer_episodes),
-                "--memory",
-                str(memory),
-                "--seed",
-                str(100 * k),
-            ],
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.PIPE,
-            text=True,
-        )  # fmt: skip
+            [*command, "--seed", str(100 * k)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
+        )
         for k in range(trainers)
     ]
     errors = [p.communicate(timeout=1800)[1] for p in procs]

@@ -10,8 +10,8 @@ outcome agreement drops below 99 %.
 Calibrations and trials are tasks of ``learning.runner`` (``--workers K`` processes, default one per
 core, or ``--ray``). Nothing is lost: each calibration and each trial is written to ``DIR/calibrations/``
 and ``DIR/trials/`` as soon as it is made (atomically), and the same command resumes after an
-interruption, reusing them. The summary (``DIR/reality.json``, ``.md``, ``.png``) is rewritten after every
-trial, a profile's point appearing once all its trials are in.
+interruption, reusing them. The summary (``DIR/reality.json``, ``.md``, ``.png``) is rewritten every few
+seconds as trials end and at the end, a profile's point appearing once all its trials are in.
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ from typing import Any
 
 from _calibration_run import calibrate_cell
 from _cli import write_json
+from _run_store import Periodic
 from _trial_task import trial_task
 from trial import twin_figures
 
@@ -134,25 +135,24 @@ def run_sweep(
                 runs = [found[t.key] for t in trials if by_profile[t.key] == name and t.key in found]
                 if len(runs) == len(specs) * config.placements:  # a profile's point once all its trials are in
                     per_profile[name] = _figures(runs, config.max_actions, done.records[name]["figures"])
+            shown = [{"series": s, "level": lv, "profile": p.name, **per_profile[p.name]}
+                     for s, lv, p in points if p.name in per_profile]  # fmt: skip
             return {
-                "config": dataclasses.asdict(config), "memory": str(memory_path),
-                "points": [{"series": s, "level": lv, "profile": p.name, **per_profile[p.name]}
-                           for s, lv, p in points if p.name in per_profile],
-                "force_noise_threshold_n": None, "wall_time_s": time.perf_counter() - start,
+                "config": dataclasses.asdict(config), "memory": str(memory_path), "points": shown,
+                "force_noise_threshold_n": force_noise_threshold(shown), "wall_time_s": time.perf_counter() - start,
             }  # fmt: skip
+
+        report_now = Periodic(lambda: write_report(summary(), out))  # its plot alone takes ~0.3 s
 
         def keep(task: Task, record: dict[str, Any]) -> None:
             found[task.key] = record
-            result = summary()
-            result["force_noise_threshold_n"] = force_noise_threshold(result["points"])
-            write_report(result, out)
+            report_now()
 
         report = run_tasks(trials, RecordStore(out / "trials"), executor, on_record=keep, desc="reality sweep",
                            postfix=lambda r: f"solved {sum(x['solved'] for x in r.values())}/{len(r)}")  # fmt: skip
         _raise_failures(report)
     found.update(report.records)
     result = summary()
-    result["force_noise_threshold_n"] = force_noise_threshold(result["points"])
     write_report(result, out)
     return result
 

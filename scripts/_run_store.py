@@ -2,7 +2,8 @@
 
 Layout of ``DIR``: ``config.json`` (the experiment's resolved arguments, written first), ``runs/KEY.json``
 (one record per finished run, each written atomically the moment the run ends) and ``results.json``
-(the summary, rewritten from the records after every run, with ``runs_done`` of ``runs_planned``).
+(the summary, rewritten from the records every few seconds and at the end, with ``runs_done`` of
+``runs_planned``).
 A crash, a kill or Ctrl-C keeps every finished run; ``--resume`` continues a directory of the same
 configuration, skipping what is there; ``--force`` empties one that holds anything else. Without either,
 a directory holding results is refused, so no directory ever describes one experiment and holds
@@ -15,6 +16,8 @@ from __future__ import annotations
 import json
 import shutil
 import sys
+import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -77,3 +80,21 @@ class RunStore:
 
     def write_results(self, results: dict[str, Any]) -> Path:
         return write_json(self.out / "results.json", results)
+
+
+class Periodic:
+    """Calls ``write()`` at most once every ``period_s`` [s] of wall time when asked (the first time at once).
+
+    A summary rewritten from every record after every task grows quadratic in the tasks (the records are already
+    on disk, each the moment it ended): this rewrites it a few times a minute, and the caller writes it once more
+    at the end."""
+
+    def __init__(self, write: Callable[[], object], period_s: float = 5.0) -> None:
+        self._write, self._period = write, period_s
+        self._next = 0.0
+
+    def __call__(self) -> None:
+        now = time.monotonic()
+        if now >= self._next:
+            self._next = now + self._period
+            self._write()

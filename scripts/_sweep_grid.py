@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import glob
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -157,10 +157,10 @@ def grid(sweep: dict[str, Any], base: Path) -> tuple[list[Task], dict[str, Cell]
     realities, calibrations = {}, {}
     if twin:
         from models.calibration import CellCalibration
-        from twin.reality import load_profile
+        from twin.reality import PRESETS, load_profile
 
         for name in profiles:
-            realities[name] = load_profile(name if name in ("ideal", "realistic", "harsh") else base / name)
+            realities[name] = load_profile(name if name in PRESETS else base / name)
             file = sweep.get("calibrations", {}).get(name)
             calibrations[name] = CellCalibration.load(base / file) if file else None
     tasks, cells = [], {}
@@ -172,8 +172,6 @@ def grid(sweep: dict[str, Any], base: Path) -> tuple[list[Task], dict[str, Cell]
                 for profile in profiles:
                     reality = realities.get(profile)
                     if pose is not None and reality is not None:
-                        from dataclasses import replace
-
                         reality = replace(reality, placement=None)  # the sweep placed the box
                     calibration = calibrations.get(profile)
                     if calibration is not None:

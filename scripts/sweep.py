@@ -19,12 +19,13 @@ from typing import Any
 
 from _cli import fail
 from _interrupt import StopRequests
-from _run_store import RunStore
+from _run_store import Periodic, RunStore
 from _sweep_grid import Cell, SweepError, grid, load_sweep
 
 from learning import LearningError, summarise
 from learning.runner import RunnerError, make_executor, run_tasks
 from models import ModelsError
+from twin.errors import TwinError
 
 
 def cell_summaries(records: dict[str, dict], cells: dict[str, Cell], max_actions: int) -> list[dict[str, Any]]:
@@ -103,12 +104,8 @@ def main(argv: list[str] | None = None) -> int:
         sweep = load_sweep(path)
         tasks, cells = grid(sweep, path.resolve().parent)
         executor = make_executor(args.workers, args.ray)
-    except (SweepError, ModelsError, LearningError, OSError) as err:
+    except (SweepError, ModelsError, LearningError, TwinError, OSError) as err:  # a calibration's is a ModelsError
         fail(f"{path}: {err}" if not str(err).startswith(("sweep", "cannot read")) else str(err))
-    except Exception as err:  # a profile's or calibration's own error types (twin), one line each
-        if type(err).__name__ not in ("ProfileError", "CalibrationError"):
-            raise
-        fail(f"{path}: {err}")
     out = Path(args.out)
     store = RunStore(out, {"command": "sweep", "sweep": sweep, "sweep_file": str(path)}, args.resume, args.force)
     keys = [t.key for t in tasks]
@@ -121,9 +118,11 @@ def main(argv: list[str] | None = None) -> int:
                        cells=cell_summaries(found, cells, sweep["max_actions"]))  # fmt: skip
         return summary
 
+    rewrite = Periodic(lambda: store.write_results(results()))
+
     def keep(task, record) -> None:
         found[task.key] = record
-        store.write_results(results())
+        rewrite()
 
     try:
         with StopRequests("trial") as stop, executor:

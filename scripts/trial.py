@@ -25,9 +25,10 @@ A run that raises is named with its key and the others go on (exit 1; ``--resume
 Run ``r`` on every spec uses seed ``S + r`` for the world (component order, faults) and the agent.
 ``DIR/config.json`` records the resolved arguments and package versions, so the result can be re-run.
 Each run's record is written to ``DIR/runs/`` the moment it ends and ``results.json`` is rewritten
-from the records (``runs_done`` of ``runs_planned``): a crash, a kill or Ctrl-C (SIGINT or SIGTERM: stop
-after the current run; twice: at once) keeps every finished run, and ``--resume`` continues them. A
-directory that holds results is refused unless ``--resume`` (same arguments) or ``--force`` (start over).
+from the records every few seconds and at the end (``runs_done`` of ``runs_planned``): a crash, a kill
+or Ctrl-C (SIGINT or SIGTERM: stop after the current run; twice: at once) keeps every finished run, and
+``--resume`` continues them. A directory that holds results is refused unless ``--resume`` (same arguments)
+or ``--force`` (start over).
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ from pathlib import Path
 import _trial_task
 from _cli import fail
 from _interrupt import StopRequests
-from _run_store import RunStore
+from _run_store import Periodic, RunStore
 from tqdm import tqdm
 
 from learning import AGENT_NAMES, LearningError, make_agent, summarise
@@ -195,6 +196,8 @@ def main(argv: list[str] | None = None) -> int:
         make_agent(args.agent, specs[0], memory, args.checkpoint)
     except LearningError as err:
         fail(str(err))
+    if memory is not None:
+        memory.close()  # each run opens it where it runs
 
     out = Path(args.out)
     not_results = ("out", "resume", "force", "workers", "ray")  # where and how it runs changes no record
@@ -209,9 +212,11 @@ def main(argv: list[str] | None = None) -> int:
     found: dict[str, dict] = {}
     keys = [t.key for t in tasks]
 
+    summary = Periodic(lambda: store.write_results(_results([found[k] for k in keys if k in found], args, len(tasks))))
+
     def keep(task, record) -> None:
         found[task.key] = record
-        store.write_results(_results([found[k] for k in keys if k in found], args, len(tasks)))
+        summary()
 
     try:
         with StopRequests("run") as stop, executor:

@@ -6,6 +6,9 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from _trial_task import without_timing  # noqa: E402  (a results object less its wall-clock fields)
 
 
 def run(*args):
@@ -166,15 +169,6 @@ def test_twin_trial_refuses_a_calibration_made_for_another_cell(tmp_path):
 # -- nothing lost: records written as runs end, resume, interrupts ---------------------------------------
 
 
-def _without_times(value):
-    """A results object with its wall-clock fields removed (the only part a rerun may change)."""
-    if isinstance(value, dict):
-        return {k: _without_times(v) for k, v in value.items() if "wall" not in k}
-    if isinstance(value, list):
-        return [_without_times(v) for v in value]
-    return value
-
-
 def _symbolic_trial(specs, out, runs, *extra):
     return [
         sys.executable, ROOT / "scripts/trial.py", "--specs", *sorted(specs.glob("*.json")), "--sim", "symbolic",
@@ -215,7 +209,7 @@ def test_a_killed_trial_resumes_with_no_run_lost_or_duplicated(tmp_path):
         assert resumed.returncode == 0
         got, want = (json.loads((d / "results.json").read_text()) for d in (out, whole))
         assert len(got["runs"]) == 180 and got["runs_done"] == got["runs_planned"] == 180
-        assert _without_times(got) == _without_times(want)
+        assert without_timing(got) == without_timing(want)
         assert not list(out.rglob("*.tmp")), "the resumed run removed the killed run's half-written file"
 
 
@@ -286,7 +280,7 @@ def test_a_twin_trial_gives_the_same_records_in_process_in_the_pool_on_ray_and_r
         results[name] = json.loads((tmp_path / name / "results.json").read_text())
     runs = results["inline"]["runs"]
     assert runs[0]["sensed_sha256"] != runs[1]["sensed_sha256"], "two seeds sensed two different worlds"
-    assert _without_times(results["inline"]) == _without_times(results["pool"]) == _without_times(results["ray"])
+    assert without_timing(results["inline"]) == without_timing(results["pool"]) == without_timing(results["ray"])
     # Resuming on another executor reuses every record: nothing is recomputed (the wall times stay the same).
     again = run(*common, "--out", tmp_path / "pool", "--resume", "--workers", 1)
     assert again.returncode == 0, again.stderr

@@ -13,6 +13,7 @@ from pathlib import Path
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 import world_fixtures  # noqa: E402, F401  (puts scripts/ on the path)
+from _trial_task import without_timing  # noqa: E402
 from _twin_trial import run_twin_trial  # noqa: E402
 
 from models.generator import paper_family  # noqa: E402
@@ -22,17 +23,9 @@ MAX_ACTIONS = 1
 """One try after the survey: every cached object (renderer, scene, IK) is used, in a few seconds."""
 
 
-def _without_wall_times(value):
-    if isinstance(value, dict):
-        return {k: _without_wall_times(v) for k, v in value.items() if k not in ("wall_time_s", "wall_time")}
-    if isinstance(value, list):
-        return [_without_wall_times(v) for v in value]
-    return value
-
-
 def _record(spec_index: int, seed: int, reality: str) -> dict:
     spec = paper_family("test")[spec_index]
-    return _without_wall_times(run_twin_trial(spec, seed, "oracle", None, MAX_ACTIONS, None, reality=reality))
+    return without_timing(run_twin_trial(spec, seed, "oracle", None, MAX_ACTIONS, None, reality=reality))
 
 
 def test_a_trial_after_others_in_the_process_gives_the_record_of_a_fresh_process():
