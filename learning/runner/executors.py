@@ -8,6 +8,7 @@ after the tasks in flight. Workers live as long as the executor: what a task fun
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import sys
@@ -38,7 +39,6 @@ class Completion:
     task: Task
     ok: bool
     payload: Any
-    attempts: int = 1
 
 
 class Executor(Protocol):
@@ -70,10 +70,22 @@ class InlineExecutor:
             yield Completion(task, ok, payload)
 
 
+@contextlib.contextmanager
+def _sigint_blocked() -> Iterator[None]:
+    """SIGINT held back in this thread for the duration (delivered after, not lost). A worker spawned meanwhile
+    inherits the blocked signal through fork and exec, so a Ctrl-C to the process group never interrupts its
+    start-up (its imports can take seconds): the driver alone decides what Ctrl-C does."""
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
 def _worker_init(parent: int) -> None:
     """Leave Ctrl-C to the driver (it stops after the tasks in flight) and exit if the driver dies
     (a SIGKILLed driver must not leave workers computing records nobody will write)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # and it stays blocked (see _sigint_blocked)
 
     def watch() -> None:
         while os.getppid() == parent:
@@ -163,7 +175,7 @@ class PoolExecutor:
                             dead.append(task)
                             continue
                         restarts_at_last_completion = self.restarts
-                        yield Completion(task, ok, payload, deaths.get(task.key, 0) + 1)
+                        yield Completion(task, ok, payload)
                     if not dead:
                         continue
                 for future, task in list(in_flight.items()):  # the rest died with the pool, or just finished
@@ -172,14 +184,14 @@ class PoolExecutor:
                     except BrokenProcessPool:
                         dead.append(task)
                         continue
-                    yield Completion(task, ok, payload, deaths.get(task.key, 0) + 1)
+                    yield Completion(task, ok, payload)
                 in_flight.clear()
                 if len(dead) == 1:  # the only task lost with the pool: count it against this task
                     task = dead[0]
                     deaths[task.key] = deaths.get(task.key, 0) + 1
                     if deaths[task.key] >= self.max_attempts:
                         message = f"WorkerDied: its worker died on each of {deaths[task.key]} attempts"
-                        yield Completion(task, False, message, deaths[task.key])
+                        yield Completion(task, False, message)
                     else:
                         suspects.appendleft(task)
                 else:
@@ -199,7 +211,8 @@ class PoolExecutor:
         """Hand the next task of ``queue`` to the pool (left in ``queue`` if the pool is broken)."""
         assert self._pool is not None
         task = queue[0]
-        future = self._pool.submit(execute, task.function, dict(task.settings), task.context)
+        with _sigint_blocked():  # a submit may spawn a worker (the pool starts them on demand)
+            future = self._pool.submit(execute, task.function, dict(task.settings), task.context)
         in_flight[future] = queue.popleft()
 
     def _restart(self, to_go: int) -> None:
