@@ -1,0 +1,307 @@
+"""Pushing a door: a finger pad against the back of its handle, along the door's arc (and the pads' edges on
+its plate to shut it) — the geometry, its configuration and the motions.
+
+A door's handle moves along its own post as the door swings (the post stands on the plate, the plate turns
+about the hinge), so fingers that pinch the post lift the door by friction alone: with a weak grip (10 N,
+pad mu 0.25: the harsh profile) the pads slid up off the post in 12 of 60 trials. Pushed instead, the post's
+back face (the side away from the hinge) takes the pad's normal force, whose lever about the hinge is the
+contact's height above it: no friction needed, whatever the grip.
+
+All vectors are in the robot base frame [m]. The *door frame* here has its origin on the hinge axis below
+the handle, ``e_x`` from the hinge towards the handle (horizontal when closed), ``e_z = axis x e_x`` (up
+when closed); opening turns ``e_x`` towards ``e_z`` by the door angle.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from models.kinds import HANDLE_HEIGHT, HANDLE_SIZE
+from skills.errors import IKFailure
+from skills.joint_model import GRASP_DEPTH, JointModel, cross
+from skills.kinematics import top_down
+from skills.toggle_result import ToggleResult
+
+PUSHED_IN_VAIN = "latched: pushed without progress"
+
+
+@dataclass(frozen=True)
+class DoorPushConfig:
+    """How a door is pushed (geometry of the xArm gripper's pads, forces, times)."""
+
+    pad_offset: float = 0.021
+    """Inner face of a finger pad from the TCP, along the closing axis, at ``pregrasp_closure`` [m] (the
+    xArm gripper's pads are 4 mm thick, 42 mm apart there)."""
+    gap: float = 0.006
+    """Clearance between the pad and the handle's back face at the end of the descent [m]: the perceived
+    handle may be a few mm off; less and the pad could land on the post."""
+    approach_time: float = 0.5
+    """Time over which the pad closes the gap and presses on [s]: jumped onto the face at once, the impact
+    read 31 N, past ``blocked_force``, on a free door."""
+    depth: float = 0.003
+    """How far past the back face the pad's target is pressed, along the whole push [m]: the preload that
+    keeps the pad on the face."""
+    contact_force: float = 3.0
+    """Normal force on the handle's back face that means the pad is pressing on it [N] (10 sigma of the harsh
+    F/T noise; a light free door may turn before it is felt: then no slide test is needed)."""
+    slide_turn: float = math.radians(7.0)
+    """Turn of the pad since it first pressed after which a face that turned less than half as much means
+    the pad is sliding along a latched handle [rad] (a jammed door: the pad slid ~12 deg and over the post)."""
+    pad_half_width: float = 0.015
+    """Half the width of a finger pad along the gripper's x (perpendicular to closing) [m]: its edge pushes a
+    door closed."""
+    close_x: float = 0.075
+    """Where on the plate, from the hinge, the pad edges push a door closed [m]: the pads reach back 30 mm
+    from there, straddling the handle (64-76 mm); the longer the lever, the softer a door held open feels
+    (at 45 mm a jammed door put 170 N on the wrist before the guard could stop the arm)."""
+    close_time: float = 4.0
+    """Time of a closing push [s] (~30 mm/s at the pads)."""
+    end_force: float = 20.0
+    """Force magnitude at which a door pushed most of the way closed is taken to lie on the lid and the push
+    stops there [N] (pressed on by a TCP a few mm off, the lid put 80-130 N on the wrist)."""
+    height: float = 0.020
+    """Height of the pushed point above the door's plate when the push begins [m]: low on the 35 mm post, so
+    a pad that slides up a latched door's face (``lead``, plus the TCP's few mm of bias) stays on it."""
+    climb: float = 0.008
+    """How far the pad climbs the handle's face over the first ``climb_time`` of the push [m]. Sliding up
+    the face, its friction lifts the door; held still by friction on a face that must rise as the door turns,
+    it pulls the door shut with a lever (~76 mm) that outweighs the push's (~15 mm) once mu > 0.2: at the
+    realistic pad mu of 0.16-0.24, free doors locked at 30-50 N."""
+    climb_time: float = 1.0
+    """Time over which the pad climbs [s] (whether or not the door turns: a lock would hold the pad still)."""
+    lead: float = 0.010
+    """As the pinch's ``lead``, for a push [m]: the pad slides along a latched face by about this much, not
+    over it."""
+    overtravel: float = 0.06
+    """As the pinch's ``door_overtravel``, for a push (fraction of the travel): a pushed door follows the pad."""
+    blocked_force: float = 30.0
+    """Normal force on a handle's back face that, with little progress, means a latch [N] (a free door
+    under the harsh profile's damping and friction took up to 13 N)."""
+
+
+@dataclass(frozen=True)
+class DoorPush:
+    """A door as a pusher sees it: the hinge and the contact point on the back face of its handle."""
+
+    origin: np.ndarray
+    """The point of the hinge axis below the handle [m]."""
+    axis: np.ndarray
+    """Unit hinge axis: turning about it by a positive angle opens the door."""
+    e_x: np.ndarray
+    """Unit vector from the hinge towards the handle, door closed (horizontal)."""
+    e_z: np.ndarray
+    """``axis x e_x``: the door's normal, door closed (up)."""
+    contact: np.ndarray
+    """The pushed point of the handle's back face in door coordinates ``(x, z)`` [m]."""
+    travel: float
+    """The door's travel [rad]."""
+    plate_top: float
+    """Height of the plate's top face above the hinge axis, in door coordinates [m]."""
+
+    @classmethod
+    def of(cls, jm: JointModel, height: float) -> DoorPush:
+        """The push geometry of door joint model ``jm``, pushed ``height`` above its plate [m]."""
+        r = jm.grasp_point - jm.origin
+        r_perp = r - np.dot(r, jm.axis) * jm.axis
+        along = r_perp - r_perp[2] * np.array([0.0, 0.0, 1.0])  # the closed plate lies level: e_x is horizontal
+        e_x = along / np.linalg.norm(along)
+        e_z = cross(jm.axis, e_x)
+        origin = jm.origin + np.dot(r, jm.axis) * jm.axis
+        plate_top = np.dot(r_perp, e_z) - (HANDLE_HEIGHT - GRASP_DEPTH)  # the grasp point is on the post
+        contact = np.array([np.dot(r_perp, e_x) + HANDLE_SIZE / 2, plate_top + height])
+        return cls(origin, jm.axis.copy(), e_x, e_z, contact, jm.travel, plate_top)
+
+    def point_at(self, angle: float, door_xz: np.ndarray) -> np.ndarray:
+        """Where door point ``door_xz`` (door coordinates) is with the door open by ``angle`` [rad] [m]."""
+        c, s = math.cos(angle), math.sin(angle)
+        x, z = door_xz
+        return self.origin + (x * c - z * s) * self.e_x + (x * s + z * c) * self.e_z
+
+    def face_normal(self, angle: float) -> np.ndarray:
+        """Outward normal of the handle's back face with the door open by ``angle`` [rad]."""
+        return math.cos(angle) * self.e_x + math.sin(angle) * self.e_z
+
+    def motion_direction(self, angle: float) -> np.ndarray:
+        """Unit direction in which the contact point moves as the door opens, at ``angle`` [rad]."""
+        p = self.point_at(angle, self.contact) - self.origin
+        tangent = cross(self.axis, p)
+        return tangent / math.sqrt(tangent @ tangent)
+
+    def turn_of(self, point: np.ndarray) -> float:
+        """Angle of ``point`` about the hinge, from ``e_x`` towards ``e_z`` [rad]."""
+        d = point - self.origin
+        return math.atan2(float(d @ self.e_z), float(d @ self.e_x))
+
+    def angle_from_contact(self, point: np.ndarray) -> float:
+        """The door angle [rad] at which the handle's back face passes through ``point`` (a pad edge resting
+        on it): the smaller root of ``a cos t + b sin t = x_face``. A pad that slides along a face that does
+        not turn (a latched door) measures no angle, however far it slides."""
+        d = point - self.origin
+        a, b = float(d @ self.e_x), float(d @ self.e_z)
+        radius = math.hypot(a, b)
+        if radius <= 1e-9:
+            return 0.0
+        return math.atan2(b, a) - math.acos(max(-1.0, min(1.0, self.contact[0] / radius)))
+
+
+class DoorPushing:
+    """The door pushes of :class:`skills.primitives.Toggler` (a mixin: it moves through the toggler's own
+    ticks, force guard and retreat, and reads ``config.push``)."""
+
+    def _push_door_open(self, jm: JointModel) -> ToggleResult:
+        """Open a door by pushing the back face of its handle with the inner face of a finger pad (see
+        :mod:`skills.door_push`): descend behind the handle, then swing the pad along the door's arc,
+        ``depth`` into the face, measuring the door's angle from where the pad rests on the face (the
+        command runs at most ``lead`` ahead of it, so on a latched door the pad slides a few mm up the
+        face and presses, never over the post)."""
+        c = self.config
+        p = c.push
+        door = DoorPush.of(jm, p.height)
+        yaw = float(np.arctan2(door.e_x[1], door.e_x[0]) + np.pi / 2)  # the gripper's y axis (closing) = e_x
+
+        def tcp_for(pad_edge: np.ndarray) -> np.ndarray:
+            return top_down(pad_edge - p.pad_offset * door.e_x, yaw)
+
+        self._descend_to(tcp_for(door.point_at(0.0, door.contact + np.array([p.gap, 0.0]))))
+        self.phase = "actuating"
+        result = self._swing_door(door, tcp_for)
+        self.phase = "retreating"
+        self._let_go_and_retreat()
+        self.phase = "moving"
+        return result
+
+    def _push_door_closed(self, jm: JointModel) -> ToggleResult:
+        """Close a door by pushing its plate down with the edges of both finger pads, the fingers straddling
+        the handle (they close along the hinge): the pads' outer edge (``pad_half_width`` along the
+        gripper's x = the door's ``e_x``) rests on the plate's top face ``close_x`` from the hinge and
+        follows it down its arc. Closing, the pad moves into the face, not along it: a door held open
+        presses back at once, and no friction is needed to carry a free one."""
+        c = self.config
+        p = c.push
+        door = DoorPush.of(jm, p.height)
+        yaw = self.grasp_yaw(jm)  # fingers along the hinge: the gripper's x is the door's e_x
+        on_plate = np.array([p.close_x, door.plate_top - p.depth])
+
+        def tcp_for(edge: np.ndarray) -> np.ndarray:
+            return top_down(edge - p.pad_half_width * door.e_x, yaw)
+
+        self._descend_to(tcp_for(door.point_at(door.travel, on_plate + np.array([0.0, p.depth + p.gap]))))
+
+        self.phase = "actuating"
+        lead = p.lead / (door.travel * p.close_x)
+        end = 1.0
+        ticks = round(p.close_time / c.tick)
+        forces: list[float] = []
+        progress = 0.0
+        edge = lambda: self.robot.tcp_pose_in_base()[:3, 3] + p.pad_half_width * door.e_x  # noqa: E731
+        self.ik.set_joints(self.robot.joint_positions())
+        turn_at_start = door.turn_of(edge())
+        result = None
+        for k in range(1, ticks + 1 + round(2 * c.settle_time / c.tick)):
+            u = min(1.0, k / ticks)
+            s = min(end * u * u * (3 - 2 * u), max(progress, 0.0) + lead)  # slow onto the lid
+            self._tick(tcp_for(door.point_at((1.0 - s) * door.travel, on_plate)))
+            progress = self.progress = (turn_at_start - door.turn_of(edge())) / door.travel
+            angle = (1.0 - max(progress, 0.0)) * door.travel
+            forces.append(float(self.force_in_base @ door.motion_direction(angle)))  # opposing a closing motion
+            magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
+            if progress >= c.moved_fraction and magnitude > p.end_force:  # the plate is on the lid: stop
+                end = min(end, max(progress, c.moved_fraction))
+            if progress < c.blocked_progress and (forces[-1] > c.blocked_force or magnitude > c.blocked_magnitude):
+                result = ToggleResult("blocked", PUSHED_IN_VAIN, progress, max(forces),
+                                      forces=forces)  # fmt: skip
+                break
+        if result is None:
+            peak = max(forces)
+            if progress >= c.moved_fraction:
+                result = ToggleResult("moved", "", progress, peak, forces=forces)
+            elif progress < c.blocked_progress and peak >= c.push_force:
+                result = ToggleResult("blocked", PUSHED_IN_VAIN, progress, peak, forces=forces)
+            else:
+                result = ToggleResult("failed", f"IncompleteTravel: only {progress:.0%} of the travel covered",
+                                      progress, peak, forces=forces)  # fmt: skip
+        self.phase = "retreating"
+        self._let_go_and_retreat()
+        self.phase = "moving"
+        return result
+
+    def _pad_edge(self, door: DoorPush) -> np.ndarray:
+        """The pushing pad's lower inner edge where the robot measures it [m]."""
+        return self.robot.tcp_pose_in_base()[:3, 3] + self.config.push.pad_offset * door.e_x
+
+    def _swing_door(self, door: DoorPush, tcp_for) -> ToggleResult:
+        """Swing the pad along the door's arc up to the end stop; decide moved, blocked or failed.
+
+        Progress is the pad's own turn about the hinge since the swing began (well conditioned: a pad on a
+        turning face turns with it). On a latched door the pad turns too, sliding up the face, until it
+        slips over the post; what tells the two apart is the face: the angle at which the handle's back
+        face passes through the pad (:meth:`DoorPush.angle_from_contact`) follows the pad's turn on a door
+        that turns and stays put while the pad slides along a face that does not. Its offset (1 mm of
+        perception error is ~3 deg here) cancels in its change since the pad first pressed on the face."""
+        c = self.config
+        p = c.push
+        x = door.contact[0] - p.depth
+
+        def pressed(k: int) -> np.ndarray:  # the pad's point on the door at tick k: climbing the face at first
+            return np.array([x, door.contact[1] + p.climb * min(k * c.tick / p.climb_time, 1.0)])
+
+        def climb_turn(k: int) -> float:  # what the climb alone adds to the pad's turn about the hinge [rad]
+            return math.atan2(pressed(k)[1], x) - math.atan2(door.contact[1], x)
+
+        lead = p.lead / (door.travel * float(np.hypot(*door.contact)))
+        end = 1.0 + p.overtravel
+        ticks = round(c.actuate_time / c.tick)
+        forces: list[float] = []
+        progress = 0.0
+        pressed_at: tuple[float, float] | None = None  # (progress, face angle) when the pad first pressed
+        self.ik.set_joints(self.robot.joint_positions())
+        turn_at_start = door.turn_of(self._pad_edge(door))
+        for k in range(1, ticks + 1 + round(2 * c.settle_time / c.tick)):
+            s = min(end * min(1.0, k / ticks), max(progress, 0.0) + lead)
+            closing_in = max(0.0, 1.0 - k * c.tick / p.approach_time) * (p.gap + p.depth)
+            self._tick(tcp_for(door.point_at(s * door.travel, pressed(k) + np.array([closing_in, 0.0]))))
+            pad_edge = self._pad_edge(door)
+            progress = self.progress = (door.turn_of(pad_edge) - turn_at_start - climb_turn(k)) / door.travel
+            angle = max(progress, 0.0) * door.travel
+            normal = float(self.force_in_base @ door.face_normal(angle))
+            forces.append(float(-self.force_in_base @ door.motion_direction(angle)))
+            magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
+            if s > 1.0 and magnitude > c.overtravel_force:  # in the end stop: stop here
+                end = max(1.0, min(progress, s))
+            face = door.angle_from_contact(pad_edge) / door.travel
+            if pressed_at is None and normal > p.contact_force:
+                pressed_at = (progress, face)
+            slid = pressed_at is not None and progress - pressed_at[0] >= p.slide_turn / door.travel
+            if slid and face - pressed_at[1] < 0.5 * (progress - pressed_at[0]):
+                self._back_off(door, angle)
+                return ToggleResult("blocked", "latched: the pad slid along its handle", progress, max(forces),
+                                    forces=forces)  # fmt: skip
+            if progress < c.blocked_progress and (normal > p.blocked_force or magnitude > c.blocked_magnitude):
+                self._back_off(door, angle)
+                return ToggleResult("blocked", PUSHED_IN_VAIN, progress, max(forces), forces=forces)
+        self._back_off(door, max(progress, 0.0) * door.travel)
+        peak = max(forces)
+        if progress >= c.moved_fraction:
+            return ToggleResult("moved", "", progress, peak, forces=forces)
+        return ToggleResult(
+            "failed", f"IncompleteTravel: only {progress:.0%} of the travel covered", progress, peak, forces=forces
+        )
+
+    def _back_off(self, door: DoorPush, angle: float) -> None:
+        """Take the pad off the handle's face (along its normal) before lifting: pressed on, it would drag
+        the handle up with it."""
+        c = self.config
+        p = c.push
+        away = self.robot.tcp_pose_in_base()
+        away[:3, 3] += p.gap * door.face_normal(angle)
+        self.ik.set_joints(self.robot.joint_positions())
+        try:
+            self.move_to(away, c.release_time)
+        except IKFailure:
+            pass  # lifting next
+
+
+__all__ = ["DoorPush", "DoorPushConfig", "DoorPushing", "PUSHED_IN_VAIN"]

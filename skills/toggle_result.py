@@ -1,0 +1,24 @@
+"""What a toggle did, as the robot sensed it."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from models.try_outcome import Outcome
+
+
+@dataclass
+class ToggleResult:
+    """What a toggle did, as the robot sensed it."""
+
+    outcome: Outcome
+    reason: str = ""
+    progress: float = 0.0
+    """Measured fraction of the travel the grasp point covered (towards the other state)."""
+    peak_opposing_force: float = 0.0
+    """Largest force opposing the motion while actuating [N]."""
+    sim_time: float = 0.0
+    wall_time: float = 0.0
+    forces: list[float] = field(default_factory=list)
+    peak_force: float = 0.0
+    """Largest filtered force magnitude over the whole try [N] (what the safety limit watches)."""
