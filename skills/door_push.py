@@ -196,15 +196,15 @@ class DoorPushing:
         ticks = round(p.close_time / c.tick)
         forces: list[float] = []
         progress = 0.0
-        edge = lambda: self.robot.tcp_pose_in_base()[:3, 3] + p.pad_half_width * door.e_x  # noqa: E731
         self.ik.set_joints(self.robot.joint_positions())
-        turn_at_start = door.turn_of(edge())
+        turn_at_start = door.turn_of(self._pad_edge(door, p.pad_half_width))
         result = None
         for k in range(1, ticks + 1 + round(2 * c.settle_time / c.tick)):
             u = min(1.0, k / ticks)
             s = min(end * u * u * (3 - 2 * u), max(progress, 0.0) + lead)  # slow onto the lid
             self._tick(tcp_for(door.point_at((1.0 - s) * door.travel, on_plate)))
-            progress = self.progress = (turn_at_start - door.turn_of(edge())) / door.travel
+            turn = door.turn_of(self._pad_edge(door, p.pad_half_width))
+            progress = self.progress = (turn_at_start - turn) / door.travel
             angle = (1.0 - max(progress, 0.0)) * door.travel
             forces.append(float(self.force_in_base @ door.motion_direction(angle)))  # opposing a closing motion
             magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
@@ -215,22 +215,15 @@ class DoorPushing:
                                       forces=forces)  # fmt: skip
                 break
         if result is None:
-            peak = max(forces)
-            if progress >= c.moved_fraction:
-                result = ToggleResult("moved", "", progress, peak, forces=forces)
-            elif progress < c.blocked_progress and peak >= c.push_force:
-                result = ToggleResult("blocked", PUSHED_IN_VAIN, progress, peak, forces=forces)
-            else:
-                result = ToggleResult("failed", f"IncompleteTravel: only {progress:.0%} of the travel covered",
-                                      progress, peak, forces=forces)  # fmt: skip
+            result = self._verdict(progress, forces, PUSHED_IN_VAIN)
         self.phase = "retreating"
         self._let_go_and_retreat()
         self.phase = "moving"
         return result
 
-    def _pad_edge(self, door: DoorPush) -> np.ndarray:
-        """The pushing pad's lower inner edge where the robot measures it [m]."""
-        return self.robot.tcp_pose_in_base()[:3, 3] + self.config.push.pad_offset * door.e_x
+    def _pad_edge(self, door: DoorPush, offset: float) -> np.ndarray:
+        """The pushing pad edge, ``offset`` from the TCP along the door's ``e_x``, where the robot measures it [m]."""
+        return self.robot.tcp_pose_in_base()[:3, 3] + offset * door.e_x
 
     def _swing_door(self, door: DoorPush, tcp_for) -> ToggleResult:
         """Swing the pad along the door's arc up to the end stop; decide moved, blocked or failed.
@@ -258,12 +251,12 @@ class DoorPushing:
         progress = 0.0
         pressed_at: tuple[float, float] | None = None  # (progress, face angle) when the pad first pressed
         self.ik.set_joints(self.robot.joint_positions())
-        turn_at_start = door.turn_of(self._pad_edge(door))
+        turn_at_start = door.turn_of(self._pad_edge(door, p.pad_offset))
         for k in range(1, ticks + 1 + round(2 * c.settle_time / c.tick)):
             s = min(end * min(1.0, k / ticks), max(progress, 0.0) + lead)
             closing_in = max(0.0, 1.0 - k * c.tick / p.approach_time) * (p.gap + p.depth)
             self._tick(tcp_for(door.point_at(s * door.travel, pressed(k) + np.array([closing_in, 0.0]))))
-            pad_edge = self._pad_edge(door)
+            pad_edge = self._pad_edge(door, p.pad_offset)
             progress = self.progress = (door.turn_of(pad_edge) - turn_at_start - climb_turn(k)) / door.travel
             angle = max(progress, 0.0) * door.travel
             normal = float(self.force_in_base @ door.face_normal(angle))
@@ -283,12 +276,7 @@ class DoorPushing:
                 self._back_off(door, angle)
                 return ToggleResult("blocked", PUSHED_IN_VAIN, progress, max(forces), forces=forces)
         self._back_off(door, max(progress, 0.0) * door.travel)
-        peak = max(forces)
-        if progress >= c.moved_fraction:
-            return ToggleResult("moved", "", progress, peak, forces=forces)
-        return ToggleResult(
-            "failed", f"IncompleteTravel: only {progress:.0%} of the travel covered", progress, peak, forces=forces
-        )
+        return self._verdict(progress, forces)  # a latch was decided on the way: short of it, no evidence
 
     def _back_off(self, door: DoorPush, angle: float) -> None:
         """Take the pad off the handle's face (along its normal) before lifting: pressed on, it would drag

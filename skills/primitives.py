@@ -129,6 +129,8 @@ class PrimitiveConfig:
     (:data:`PADS_LOST_HOLD`): a pinched post moves the door by pad friction alone, which a weak grip does not
     give. Not first: with grippy pads (mu above ~0.2) the pad's friction on the pushed face can lock the push
     (realistic profile, pushing first: 98.3 % solved in 5.57 actions against 100 % in 5.18)."""
+    relieve_load: float = 3.0
+    """Filtered force above which a stopped arm backs off along it before letting go [N]."""
     relieve_distance: float = 0.005
     """How far the arm backs off along the load after a force stop, before letting go [m]."""
     push: DoorPushConfig = field(default_factory=DoorPushConfig)
@@ -389,13 +391,21 @@ class Toggler(DoorPushing):
             progress = self.progress = self._progress(jm, sign, begin)
             self._tick(self._pose_along(jm, begin + sign * min(end, max(progress, 0.0) + lead), at_grasp, begin))
             self._check_grip(progress)
-        progress = self._progress(jm, sign, begin)
+        result = self._verdict(self._progress(jm, sign, begin), forces, "latched: pulled without progress")
+        if result.outcome == "blocked":
+            self.move_to(at_grasp, 0.5)
+        return result
+
+    def _verdict(self, progress: float, forces: list[float], latched: str | None = None) -> ToggleResult:
+        """How a motion that ran its course ended: ``moved`` past ``moved_fraction`` of the travel; ``blocked``
+        (reason ``latched``, when given) short of ``blocked_progress`` after at least ``push_force`` against
+        the motion (``forces`` [N], one per tick); else ``failed``."""
+        c = self.config
         peak = max(forces)
         if progress >= c.moved_fraction:
             return ToggleResult("moved", "", progress, peak, forces=forces)
-        if progress < c.blocked_progress and peak >= c.push_force:
-            self.move_to(at_grasp, 0.5)
-            return ToggleResult("blocked", "latched: pulled without progress", progress, peak, forces=forces)
+        if latched is not None and progress < c.blocked_progress and peak >= c.push_force:
+            return ToggleResult("blocked", latched, progress, peak, forces=forces)
         return ToggleResult(
             "failed", f"IncompleteTravel: only {progress:.0%} of the travel covered", progress, peak, forces=forces
         )
@@ -435,7 +445,7 @@ class Toggler(DoorPushing):
         load = math.sqrt(self.force_in_base @ self.force_in_base)
         self.guard = False
         try:
-            if load > c.push.contact_force:
+            if load > c.relieve_load:
                 away = self.robot.tcp_pose_in_base()
                 away[:3, 3] += c.relieve_distance * self.force_in_base / load
                 self.ik.set_joints(self.robot.joint_positions())
