@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.kinds import HANDLE_HEIGHT, HANDLE_SIZE
+from models.kinds import HANDLE_HEIGHT, HANDLE_MARGIN, HANDLE_SIZE
 from skills.errors import IKFailure
 from skills.joint_model import GRASP_DEPTH, JointModel, cross
 from skills.kinematics import top_down
@@ -77,6 +77,24 @@ class DoorPushConfig:
     over it."""
     overtravel: float = 0.06
     """As the pinch's ``door_overtravel``, for a push (fraction of the travel): a pushed door follows the pad."""
+    start_margin: float = 0.035
+    """How far behind a door's seen angle a push after a pinch that lost its hold starts (fraction of the
+    travel, 3 deg): a door let go part-way open falls back ~1 deg while the arm comes round. Behind the
+    handle's true angle the pad sits higher on the post (~1.7 mm per deg, 15 mm of post above it); ahead of
+    it, lower, towards the plate, and the other finger onto the raised handle."""
+    top_up: bool = True
+    """Push on to the end stop a door a pinch opened without feeling the stop (:meth:`DoorPushing._top_up_door`)."""
+    top_up_from: float = math.radians(50.0)
+    """Lowest door angle a top-up push (:meth:`DoorPushing._top_up_door`) is placed for [rad]: a pinch that
+    carried its fingers past ``moved_fraction`` left the door above it (the handle lags the fingers by up to a
+    quarter of their turn)."""
+    top_up_height: float = 0.055
+    """Height of the TCP above the hinge line during a top-up push [m]: the plate's underside is there at 50
+    deg only 9 mm short of its free edge, and the pads pass 15 mm above a neighbouring handle's top."""
+    top_up_clearance: float = 0.010
+    """Clearance between the pads' edge and the plate's top corner at ``top_up_from`` as the pads descend [m]."""
+    top_up_time: float = 3.0
+    """Time of the top-up push, from outside the plate's reach to its end stop (~20 mm/s) [s]."""
     blocked_force: float = 30.0
     """Normal force on a handle's back face that, with little progress, means a latch [N] (a free door
     under the harsh profile's damping and friction took up to 13 N)."""
@@ -151,12 +169,15 @@ class DoorPushing:
     """The door pushes of :class:`skills.primitives.Toggler` (a mixin: it moves through the toggler's own
     ticks, force guard and retreat, and reads ``config.push``)."""
 
-    def _push_door_open(self, jm: JointModel) -> ToggleResult:
+    def _push_door_open(self, jm: JointModel, start: float = 0.0) -> ToggleResult:
         """Open a door by pushing the back face of its handle with the inner face of a finger pad (see
         :mod:`skills.door_push`): descend behind the handle, then swing the pad along the door's arc,
         ``depth`` into the face, measuring the door's angle from where the pad rests on the face (the
         command runs at most ``lead`` ahead of it, so on a latched door the pad slides a few mm up the
-        face and presses, never over the post)."""
+        face and presses, never over the post). ``start`` is the fraction of the travel at which the door
+        stands (a pinch that slipped part-way left it there): the pad descends behind the handle there
+        (descending behind the closed pose of a door left at 43 deg, it landed on the raised post at
+        60-100 N)."""
         c = self.config
         p = c.push
         door = DoorPush.of(jm, p.height)
@@ -165,20 +186,21 @@ class DoorPushing:
         def tcp_for(pad_edge: np.ndarray) -> np.ndarray:
             return top_down(pad_edge - p.pad_offset * door.e_x, yaw)
 
-        self._descend_to(tcp_for(door.point_at(0.0, door.contact + np.array([p.gap, 0.0]))))
+        self._descend_to(tcp_for(door.point_at(start * door.travel, door.contact + np.array([p.gap, 0.0]))))
         self.phase = "actuating"
-        result = self._swing_door(door, tcp_for)
+        result = self._swing_door(door, tcp_for, start)
         self.phase = "retreating"
         self._let_go_and_retreat()
         self.phase = "moving"
         return result
 
-    def _push_door_closed(self, jm: JointModel) -> ToggleResult:
+    def _push_door_closed(self, jm: JointModel, start: float = 0.0) -> ToggleResult:
         """Close a door by pushing its plate down with the edges of both finger pads, the fingers straddling
         the handle (they close along the hinge): the pads' outer edge (``pad_half_width`` along the
         gripper's x = the door's ``e_x``) rests on the plate's top face ``close_x`` from the hinge and
         follows it down its arc. Closing, the pad moves into the face, not along it: a door held open
-        presses back at once, and no friction is needed to carry a free one."""
+        presses back at once, and no friction is needed to carry a free one. ``start`` is the fraction of
+        the closing travel already covered (by a pinch that slipped part-way)."""
         c = self.config
         p = c.push
         door = DoorPush.of(jm, p.height)
@@ -188,7 +210,8 @@ class DoorPushing:
         def tcp_for(edge: np.ndarray) -> np.ndarray:
             return top_down(edge - p.pad_half_width * door.e_x, yaw)
 
-        self._descend_to(tcp_for(door.point_at(door.travel, on_plate + np.array([0.0, p.depth + p.gap]))))
+        above_plate = on_plate + np.array([0.0, p.depth + p.gap])
+        self._descend_to(tcp_for(door.point_at((1.0 - start) * door.travel, above_plate)))
 
         self.phase = "actuating"
         lead = p.lead / (door.travel * p.close_x)
@@ -201,10 +224,10 @@ class DoorPushing:
         result = None
         for k in range(1, ticks + 1 + round(2 * c.settle_time / c.tick)):
             u = min(1.0, k / ticks)
-            s = min(end * u * u * (3 - 2 * u), max(progress, 0.0) + lead)  # slow onto the lid
+            s = min(start + (end - start) * u * u * (3 - 2 * u), max(progress, start) + lead)  # slow onto the lid
             self._tick(tcp_for(door.point_at((1.0 - s) * door.travel, on_plate)))
             turn = door.turn_of(self._pad_edge(door, p.pad_half_width))
-            progress = self.progress = (turn_at_start - turn) / door.travel
+            progress = self.progress = start + (turn_at_start - turn) / door.travel
             angle = (1.0 - max(progress, 0.0)) * door.travel
             forces.append(float(self.force_in_base @ door.motion_direction(angle)))  # opposing a closing motion
             magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
@@ -221,19 +244,77 @@ class DoorPushing:
         self.phase = "moving"
         return result
 
+    def _top_up_door(self, jm: JointModel) -> ToggleResult:
+        """Push a door the pinch opened on to its end stop, under its plate: a handle that lags the fingers
+        leaves the door short of the stop (78 deg under the harsh grip), and a door short of it sinks back
+        under its own weight (to 66 deg within 45 s) over its neighbour's handle, onto which the next
+        descent then lands (100-130 N). Where the door stands is not known (above ~50 deg its handle hides
+        its marker), so the pads, fingers along the hinge, descend beside the plate outside its reach at any
+        angle above ``top_up_from``, ``top_up_height`` above the hinge, and their inner edge moves in towards
+        the hinge: it meets the plate's underside wherever the door stands and turns it up into its end stop.
+        ``moved`` once the edge passed where the underside is at ``moved_fraction`` of the travel (a free door
+        turns under less than 1 N: meeting the plate is not felt, so this cannot tell a door that was not
+        there)."""
+        c = self.config
+        p = c.push
+        door = DoorPush.of(jm, p.height)
+        yaw = self.grasp_yaw(jm)  # fingers along the hinge: the gripper's x is the door's e_x
+        h = p.top_up_height
+        free_edge = door.contact[0] + HANDLE_MARGIN - HANDLE_SIZE / 2  # the plate's far edge from the hinge
+        x_start = free_edge * math.cos(p.top_up_from) + p.top_up_clearance
+        x_end = h / math.tan(door.travel) - p.depth  # where the underside meets the pads' height at the stop
+        x_moved = h / math.tan(c.moved_fraction * door.travel)
+
+        def tcp_for(edge_x: float) -> np.ndarray:  # the TCP with the pads' inner edge at edge_x from the hinge
+            return top_down(door.origin + (edge_x + p.pad_half_width) * door.e_x + h * door.e_z, yaw)
+
+        self._descend_to(tcp_for(x_start))
+        self.phase = "actuating"
+        ticks = round(p.top_up_time / c.tick)
+        forces: list[float] = []
+        edge_x = x_start
+        self.ik.set_joints(self.robot.joint_positions())
+        for k in range(1, ticks + round(c.settle_time / c.tick) + 1):
+            u = min(k / ticks, 1.0)
+            self._tick(tcp_for(x_start + (x_end - x_start) * u * u * (3 - 2 * u)))
+            edge_x = float((self.robot.tcp_pose_in_base()[:3, 3] - door.origin) @ door.e_x) - p.pad_half_width
+            forces.append(float(-self.force_in_base @ door.e_x))
+            magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
+            if magnitude > p.end_force and edge_x <= x_moved:  # the door is in its end stop
+                break
+            if magnitude > c.blocked_magnitude:
+                break
+        progress = math.atan2(h, max(edge_x, 1e-6)) / door.travel  # the underside's angle where the edge is
+        result = self._verdict(progress, forces)
+        away = self.robot.tcp_pose_in_base()
+        away[:3, 3] += p.gap * door.e_x  # off the plate before lifting
+        self.ik.set_joints(self.robot.joint_positions())
+        try:
+            self.move_to(away, c.release_time)
+        except IKFailure:
+            pass
+        self.phase = "retreating"
+        self._let_go_and_retreat()
+        self.phase = "moving"
+        return result
+
     def _pad_edge(self, door: DoorPush, offset: float) -> np.ndarray:
         """The pushing pad edge, ``offset`` from the TCP along the door's ``e_x``, where the robot measures it [m]."""
         return self.robot.tcp_pose_in_base()[:3, 3] + offset * door.e_x
 
-    def _swing_door(self, door: DoorPush, tcp_for) -> ToggleResult:
-        """Swing the pad along the door's arc up to the end stop; decide moved, blocked or failed.
+    def _swing_door(self, door: DoorPush, tcp_for, start: float = 0.0) -> ToggleResult:
+        """Swing the pad along the door's arc from ``start`` (fraction of the travel) up to the end stop;
+        decide moved, blocked or failed.
 
         Progress is the pad's own turn about the hinge since the swing began (well conditioned: a pad on a
         turning face turns with it). On a latched door the pad turns too, sliding up the face, until it
         slips over the post; what tells the two apart is the face: the angle at which the handle's back
         face passes through the pad (:meth:`DoorPush.angle_from_contact`) follows the pad's turn on a door
         that turns and stays put while the pad slides along a face that does not. Its offset (1 mm of
-        perception error is ~3 deg here) cancels in its change since the pad first pressed on the face."""
+        perception error is ~3 deg here) cancels in its change since the pad first pressed on the face.
+        A swing is only as far as the pad last pressed on the face: past it the pad is in the air (over the
+        post of a latched door, within the slide test's turn; or past a door that was not where it was
+        placed)."""
         c = self.config
         p = c.push
         x = door.contact[0] - p.depth
@@ -250,14 +331,15 @@ class DoorPushing:
         forces: list[float] = []
         progress = 0.0
         pressed_at: tuple[float, float] | None = None  # (progress, face angle) when the pad first pressed
+        last_pressed, last_face = start, 0.0  # progress and face angle when the pad last pressed on the face
         self.ik.set_joints(self.robot.joint_positions())
         turn_at_start = door.turn_of(self._pad_edge(door, p.pad_offset))
         for k in range(1, ticks + 1 + round(2 * c.settle_time / c.tick)):
-            s = min(end * min(1.0, k / ticks), max(progress, 0.0) + lead)
+            s = min(start + (end - start) * min(1.0, k / ticks), max(progress, start) + lead)
             closing_in = max(0.0, 1.0 - k * c.tick / p.approach_time) * (p.gap + p.depth)
             self._tick(tcp_for(door.point_at(s * door.travel, pressed(k) + np.array([closing_in, 0.0]))))
             pad_edge = self._pad_edge(door, p.pad_offset)
-            progress = self.progress = (door.turn_of(pad_edge) - turn_at_start - climb_turn(k)) / door.travel
+            progress = self.progress = start + (door.turn_of(pad_edge) - turn_at_start - climb_turn(k)) / door.travel
             angle = max(progress, 0.0) * door.travel
             normal = float(self.force_in_base @ door.face_normal(angle))
             forces.append(float(-self.force_in_base @ door.motion_direction(angle)))
@@ -265,17 +347,29 @@ class DoorPushing:
             if s > 1.0 and magnitude > c.overtravel_force:  # in the end stop: stop here
                 end = max(1.0, min(progress, s))
             face = door.angle_from_contact(pad_edge) / door.travel
-            if pressed_at is None and normal > p.contact_force:
-                pressed_at = (progress, face)
+            if normal > p.contact_force:
+                last_pressed, last_face = progress, face
+                if pressed_at is None:
+                    pressed_at = (progress, face)
             slid = pressed_at is not None and progress - pressed_at[0] >= p.slide_turn / door.travel
             if slid and face - pressed_at[1] < 0.5 * (progress - pressed_at[0]):
                 self._back_off(door, angle)
+                if start >= c.blocked_progress:  # a door held part-way open is stuck, not latched: no evidence
+                    return ToggleResult("failed", f"Jammed: the door held at {start:.0%} of its travel",
+                                        progress, max(forces), forces=forces)  # fmt: skip
                 return ToggleResult("blocked", "latched: the pad slid along its handle", progress, max(forces),
                                     forces=forces)  # fmt: skip
             if progress < c.blocked_progress and (normal > p.blocked_force or magnitude > c.blocked_magnitude):
                 self._back_off(door, angle)
                 return ToggleResult("blocked", PUSHED_IN_VAIN, progress, max(forces), forces=forces)
         self._back_off(door, max(progress, 0.0) * door.travel)
+        if last_pressed < c.moved_fraction:
+            # the pad lost the face before the door was open: it went over the post (a latched door, inside the
+            # slide test's 7 deg: it read "moved" with the door shut) or the door is elsewhere. How far the door
+            # went is how far its face turned while pressed.
+            turned = last_face - pressed_at[1] if pressed_at is not None else 0.0
+            at = (pressed_at[0] if pressed_at is not None else start) + turned
+            return self._verdict(at, forces, PUSHED_IN_VAIN if start < c.blocked_progress else None)
         return self._verdict(progress, forces)  # a latch was decided on the way: short of it, no evidence
 
     def _back_off(self, door: DoorPush, angle: float) -> None:

@@ -50,6 +50,16 @@ class JointModel:
         rotated = r * np.cos(amount) + cross(k, r) * np.sin(amount) + k * np.dot(k, r) * (1 - np.cos(amount))
         return self.origin + rotated
 
+    def fraction_between(self, before: np.ndarray, after: np.ndarray) -> float:
+        """Fraction of the travel (signed: positive opens) that carries a point of the part from ``before``
+        to ``after`` [m]: the displacement along a slide's axis, the turn about a hinge's axis."""
+        if self.joint == "slide":
+            return float(np.dot(after - before, self.axis) / self.travel)
+        a, b = before - self.origin, after - self.origin
+        a -= np.dot(a, self.axis) * self.axis
+        b -= np.dot(b, self.axis) * self.axis
+        return float(np.arctan2(np.dot(self.axis, cross(a, b)), np.dot(a, b)) / self.travel)
+
     def motion_direction(self, fraction: float) -> np.ndarray:
         """Unit direction in which the grasp point moves when opening, at ``fraction`` of the travel."""
         if self.joint == "slide":

@@ -40,7 +40,7 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from skills.door_push import DoorPushConfig, DoorPushing
 from skills.errors import ForceLimitExceeded, GraspFailure, IKFailure, SlipDetected
-from skills.joint_model import JointModel, cross
+from skills.joint_model import JointModel
 from skills.kinematics import ArmKinematics, top_down
 from skills.toggle_result import ToggleResult
 
@@ -102,10 +102,16 @@ class PrimitiveConfig:
     """Force magnitude (any direction) that, with little progress, also means a latch [N]: a latched wheel
     or a part pulled along a slightly wrong direction loads the grasp sideways more than along the path."""
     door_overtravel: float = 0.15
-    """How far past the far end of a door's travel the grasp point is driven (fraction of the travel): a
-    handle pivoting between the pads lags the fingers by up to ~15 mm along an 85 deg door arc, which left
-    doors at ~74 deg, leaning over their neighbours' handles; the joint's end stop takes the rest. Past the
-    travel, a filtered force above ``overtravel_force`` stops the over-travel where the handle is."""
+    """How far past the far end of a door's travel the grasp point is driven (fraction of the travel), at half
+    the pace of the arc: a handle pivoting between the pads lags the fingers by up to ~15 mm along an 85 deg
+    door arc, which left doors at ~74 deg, leaning over their neighbours' handles; the joint's end stop takes
+    the rest. Past the travel, a filtered force above ``overtravel_force`` stops the over-travel where the
+    handle is. (Under the harsh grip the lag is a fifth of the fingers' turn, fingers at 98 deg leaving a
+    door at 78: more over-travel met the end stop with 70 N jolts; a top-up push finishes those doors.)"""
+    end_stop_force: float = 20.0
+    """Filtered force magnitude past the travel that tells a pinched door has reached its end stop [N] (a
+    lagging handle pressed into it loads the grasp with 20-30 N, one that follows closely 47 N; weak pads
+    dragging a door still short of it, 12-15 N): a door not felt there is pushed on (``push.top_up``)."""
     overtravel_force: float = 40.0
     """Filtered force magnitude that ends a door's over-travel [N]: a lagging handle pulled into its end stop
     loads the grasp with 20-30 N; a handle that follows the fingers closely is pushed towards the safety
@@ -181,6 +187,8 @@ class Toggler(DoorPushing):
         """Largest filtered force magnitude since the last :meth:`reset_force_watch` [N]."""
         self.guard = True
         """Stop motions at ``force_limit`` (off only while withdrawing from a stop)."""
+        self.felt_end_stop = False
+        """Whether the last pinch of a door felt it reach its end stop (past the travel, ``overtravel_force``)."""
 
     # -- force -------------------------------------------------------------------------------------
     def reset_force_watch(self) -> None:
@@ -285,20 +293,70 @@ class Toggler(DoorPushing):
         direction = jm.axis if jm.kind == "door" else jm.motion_direction(0.0)
         return float(np.arctan2(direction[1], direction[0]) + np.pi / 2)
 
-    def toggle(self, jm: JointModel, opening: bool = True) -> ToggleResult:
-        """Try to move the component of joint model ``jm`` to its other state (see the module docstring)."""
+    def toggle(
+        self,
+        jm: JointModel,
+        opening: bool = True,
+        where_is: collections.abc.Callable[[], float | None] | None = None,
+        door_at: float | None = None,
+        push: bool = False,
+    ) -> ToggleResult:
+        """Try to move the component of joint model ``jm`` to its other state (see the module docstring).
+        ``where_is`` looks at the part and tells the fraction of its travel at which it stands now (0 closed,
+        1 open; None if not seen): a door the pinch could not hold is pushed from there. ``door_at``: where a
+        door was just seen to stand; one part-way (past ``blocked_progress`` of the motion) is pushed from
+        there at once, as its handle is not where a pinch would descend. ``push``: push a door without
+        pinching it first (from ``door_at``, else from its start)."""
         wall = time.perf_counter()
         start_time = self.robot.time
         self.reset_force_watch()
-        result = self._attempt(lambda: self._toggle(jm, 1.0 if opening else -1.0))
-        if jm.kind == "door" and self.config.door_push and result.reason.startswith(PADS_LOST_HOLD):
-            # the pads could not hold the handle: push the door instead, in the same try
-            push = self._push_door_open if opening else self._push_door_closed
-            result = self._attempt(lambda: push(jm))
+        c = self.config
+        pushable = jm.kind == "door" and c.door_push
+        covered = None if door_at is None else (door_at if opening else 1.0 - door_at)
+        if pushable and (push or (covered is not None and covered >= c.blocked_progress)):
+            result = self._push(jm, opening, 0.0 if covered is None else covered)
+        else:
+            self.felt_end_stop = False
+            result = self._attempt(lambda: self._toggle(jm, 1.0 if opening else -1.0))
+            if pushable and opening and result.outcome == "moved" and not self.felt_end_stop and c.push.top_up:
+                self._attempt(lambda: self._top_up_door(jm))  # best effort: the pinch's verdict stands
+            if pushable and result.reason.startswith(PADS_LOST_HOLD):
+                # the pads could not hold the handle: push the door instead, in the same try, from where it stands
+                covered = self._push_start(result, opening, where_is)
+                if covered is not None:
+                    result = self._push(jm, opening, covered)
+                elif result.progress < c.moved_fraction:  # (past it, the world looks whether it moved)
+                    result.reason += "; the door stands part-way where it cannot be seen: not pushed"
         result.peak_force = self.peak_force  # over the whole try, withdrawal included
         result.sim_time = self.robot.time - start_time
         result.wall_time = time.perf_counter() - wall
         return result
+
+    def _push(self, jm: JointModel, opening: bool, covered: float) -> ToggleResult:
+        """Push door ``jm`` open or shut from where it stands, ``covered`` (fraction of this motion's travel),
+        beginning ``push.start_margin`` behind it: a door let go part-way falls back ~1 deg while the arm
+        comes round, and behind the handle the pad only sits higher on the post (~1.7 mm per deg)."""
+        c = self.config
+        start = min(max(covered - c.push.start_margin, 0.0), c.moved_fraction)
+        push = self._push_door_open if opening else self._push_door_closed
+        return self._attempt(lambda: push(jm, start))
+
+    def _push_start(
+        self, pinch: ToggleResult, opening: bool, where_is: collections.abc.Callable[[], float | None] | None
+    ) -> float | None:
+        """Fraction of the motion's travel a door has covered after a pinch lost its hold, as seen by
+        ``where_is``: the pinch's own progress is the fingers', and a handle sliding in weak pads lags them (a
+        door at 43 deg after fingers at 68 deg), so a push placed from it met the raised post at 60-100 N, or
+        swung through the air; a grasp that closed on nothing may be a door left part-way by an earlier try.
+        Not seen: a pinch short of ``blocked_progress`` left the door near its start (0); a closing push
+        descends onto the plate from above and meets it on the way down (0); an opening push of a door opened
+        part-way (above ~50 deg its handle hides its marker from above) has nowhere safe to start (None)."""
+        seen = where_is() if where_is is not None else None
+        if seen is not None:
+            return seen if opening else 1.0 - seen
+        if pinch.progress < self.config.blocked_progress or not opening:
+            return 0.0
+        return None
 
     def _attempt(self, motion: collections.abc.Callable[[], ToggleResult]) -> ToggleResult:
         """Run one toggle motion; a typed failure ends it ``failed`` with its reason, the arm withdrawn."""
@@ -357,11 +415,15 @@ class Toggler(DoorPushing):
             * np.linalg.norm((jm.grasp_point - jm.origin) - np.dot(jm.grasp_point - jm.origin, jm.axis) * jm.axis)
         )
         lead = c.lead / path_length  # as a fraction of the travel
-        end = 1.0 + (c.door_overtravel if jm.kind == "door" and sign > 0 else 0.0)
+        opening_door = jm.kind == "door" and sign > 0
+        pace = (1.0 + (c.door_overtravel if opening_door else 0.0)) / ticks  # travel per tick
+        end = 1.0 + (c.door_overtravel if opening_door else 0.0)
         progress_at_peak = 0.0
+        in_end_stop = False  # felt the door reach its end stop: open, whatever the pads do next
         self.ik.set_joints(self.robot.joint_positions())
-        for k in range(1, ticks + 1):
-            s = min(end * (k / ticks), max(progress, 0.0) + lead)
+        for k in range(1, ticks + math.ceil(2 * (end - 1.0) / pace - 1e-9) + 1):
+            paced = pace * k if pace * k <= 1.0 else 1.0 + 0.5 * (pace * k - 1.0)  # past the travel at half pace
+            s = min(end, paced, max(progress, 0.0) + lead)
             fraction = begin + sign * s
             target = self._pose_along(jm, fraction, at_grasp, begin)
             self._tick(target)
@@ -378,8 +440,12 @@ class Toggler(DoorPushing):
                     # the part held while pulled until the pads slid off its handle: a latch, not a slip
                     return ToggleResult("blocked", SLIPPED_OFF, progress, max(forces),
                                         forces=forces)  # fmt: skip
+                if in_end_stop:  # the pads slid off a post pressed into its end stop: the door is open
+                    self.felt_end_stop = True
+                    return ToggleResult("moved", "", progress, max(forces), forces=forces)
                 raise
             magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
+            in_end_stop = in_end_stop or (s > 1.0 and magnitude > c.end_stop_force)
             if s > 1.0 and magnitude > c.overtravel_force:  # past the travel and pushing hard: stop here
                 end = max(1.0, min(progress, s))
             if (opposing > c.blocked_force or magnitude > c.blocked_magnitude) and progress < c.blocked_progress:
@@ -390,7 +456,13 @@ class Toggler(DoorPushing):
         for _ in range(round(2 * c.settle_time / c.tick)):  # let the part catch up with the end target
             progress = self.progress = self._progress(jm, sign, begin)
             self._tick(self._pose_along(jm, begin + sign * min(end, max(progress, 0.0) + lead), at_grasp, begin))
-            self._check_grip(progress)
+            try:
+                self._check_grip(progress)
+            except SlipDetected:
+                if not in_end_stop:
+                    raise
+                break
+        self.felt_end_stop = in_end_stop
         result = self._verdict(self._progress(jm, sign, begin), forces, "latched: pulled without progress")
         if result.outcome == "blocked":
             self.move_to(at_grasp, 0.5)
@@ -426,15 +498,7 @@ class Toggler(DoorPushing):
 
     def _progress(self, jm: JointModel, sign: float, begin: float) -> float:
         """Measured fraction of the travel covered towards the other state, from the TCP position."""
-        p = self.robot.tcp_pose_in_base()[:3, 3]
-        p0 = jm.grasp_point_at(begin)
-        if jm.joint == "slide":
-            return float(sign * np.dot(p - p0, jm.axis) / jm.travel)
-        a, b = p0 - jm.origin, p - jm.origin
-        a -= np.dot(a, jm.axis) * jm.axis
-        b -= np.dot(b, jm.axis) * jm.axis
-        angle = np.arctan2(np.dot(jm.axis, cross(a, b)), np.dot(a, b))
-        return float(sign * angle / jm.travel)
+        return sign * jm.fraction_between(jm.grasp_point_at(begin), self.robot.tcp_pose_in_base()[:3, 3])
 
     def withdraw(self) -> None:
         """After a stop: back off along the load, open the gripper, move up and go to rest with the force

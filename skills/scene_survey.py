@@ -104,13 +104,13 @@ class SceneSurvey:
     def overview(self) -> list[MarkerDetection]:
         return self.look(OVERVIEW_CAMERA)
 
-    def _wrist_from_above(self, point: np.ndarray, height: float) -> bool:
+    def _wrist_from_above(self, point: np.ndarray, height: float, yaws=(0.0, np.pi / 2, -np.pi / 2, np.pi)) -> bool:
         """Put the wrist camera ``height`` above ``point`` looking down, arriving through the toggler's
-        transit waypoint high above the workspace, the camera turned so the TCP stays at least
-        ``MIN_REACH`` from the base axis; False if the arm cannot, or if the force limit stopped it (it
-        then withdraws)."""
+        transit waypoint high above the workspace, the camera turned (the first of ``yaws`` [rad] that works)
+        so the TCP stays at least ``MIN_REACH`` from the base axis; False if the arm cannot, or if the force
+        limit stopped it (it then withdraws)."""
         T_tcp_camera = self.calibration.camera(WRIST_CAMERA).T_tcp_camera
-        for yaw in (0.0, np.pi / 2, -np.pi / 2, np.pi):
+        for yaw in yaws:
             target = top_down(np.zeros(3), yaw)
             target[:3, 3] = np.asarray(point, float) + (0.0, 0.0, height) - target[:3, :3] @ T_tcp_camera[:3, 3]
             if np.hypot(*target[:2, 3]) < MIN_REACH:
@@ -133,9 +133,25 @@ class SceneSurvey:
         self.toggler.go_rest()
         return found
 
-    def _measure_from_above(self, marker: int, xy: np.ndarray, height: float | None) -> MarkerDetection | None:
+    def close_up_turning(self, marker: int, xy: np.ndarray, height: float | None = None) -> MarkerDetection | None:
+        """As :meth:`close_up` from above ``xy``, turning the camera to the next yaw while the marker is not
+        seen: looking at a point beside the marker, the marker is off the image's centre, where the gripper's
+        own fingers may hide it (they fill one side of the wrist image)."""
+        found = None
+        for yaw in (0.0, np.pi / 2, -np.pi / 2, np.pi):
+            found = self._measure_from_above(marker, xy, height, yaws=(yaw,))
+            if found is not None:
+                break
+        self.toggler.go_rest()
+        return found
+
+    def _measure_from_above(
+        self, marker: int, xy: np.ndarray, height: float | None, yaws=(0.0, np.pi / 2, -np.pi / 2, np.pi)
+    ) -> MarkerDetection | None:
         z = height if height is not None else self.config.table_height
-        self.last_close_up_reached = self._wrist_from_above(np.array([xy[0], xy[1], z]), self.config.close_up_height)
+        self.last_close_up_reached = self._wrist_from_above(
+            np.array([xy[0], xy[1], z]), self.config.close_up_height, yaws
+        )
         if not self.last_close_up_reached:
             return None
         seen = [d for d in self.look(WRIST_CAMERA) if d.marker_id == marker]

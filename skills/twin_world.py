@@ -44,6 +44,8 @@ MOVED_DISTANCE = 0.01
 """A re-observed marker this far from its closed pose has moved [m]..."""
 MOVED_ANGLE = math.radians(20)
 """... or turned this much [rad]."""
+DOOR_STAYED = "SlipDetected: the door stayed shut"
+"""Reason of a try whose fingers went the whole way while the door's marker stayed at its closed pose."""
 
 
 @dataclass(frozen=True)
@@ -55,6 +57,11 @@ class WorldConfig:
     remeasure_limit: float = 0.02
     """A close-up measurement this far from the pose in use replaces it only for a closed component
     whose marker did not move [m]: farther means the part moved (or another marker was read)."""
+    door_look_offset: float = 0.10
+    """How far towards its hinge from a door's closed marker the wrist camera looks down from, to see where
+    the door stands [m]: from straight above, a door raised 40 deg shows its marker behind its own handle
+    (not detected); from 10 cm over (~22 deg off the vertical at the close-up height), face on to a
+    half-open door and clear of the handle."""
     survey: SurveyConfig = field(default_factory=SurveyConfig)
 
 
@@ -127,9 +134,12 @@ class TwinWorld:
         peak = 0.0
         sim_time = wall_time = 0.0
         attempts = 0
+        door_at = None
         for attempt in range(1 + self.config.max_retries):
             attempts = attempt + 1
-            result: ToggleResult = self.toggler.toggle(self.joint_models[marker], opening=opening)
+            result: ToggleResult = self.toggler.toggle(
+                self.joint_models[marker], opening, where_is=lambda: self._fraction_open(marker), door_at=door_at
+            )
             peak, sim_time, wall_time = (
                 max(peak, result.peak_force),
                 sim_time + result.sim_time,
@@ -137,14 +147,28 @@ class TwinWorld:
             )
             if result.outcome == "failed" and result.progress >= self.toggler.config.moved_fraction:
                 # stopped (force limit, slip) after carrying the handle most of the way: look before retrying
-                if self._overview_verdict(marker, opening).moved:
+                # (a door's marker must be seen where an open door's is: one the pads let go part-way hides
+                # it behind its own raised handle, as an open one shows it edge-on)
+                if self._overview_verdict(
+                    marker, opening, unseen_moved=kind_of(self.marker_map, marker) != "door"
+                ).moved:
                     result.outcome, result.reason = "moved", ""
             if result.outcome != "failed":
                 break
             reasons.append(result.reason)
-            if attempt < self.config.max_retries and opening:  # only a closed part shows its closed pose
-                self._remeasure(marker)
+            if attempt < self.config.max_retries and self.joint_models[marker].kind == "door":
+                door_at = self._fraction_open(marker)  # a failed try may leave a door part-way: see where
+            if attempt < self.config.max_retries and opening and (door_at is None or abs(door_at) < 0.05):
+                self._remeasure(marker)  # only a closed part shows its closed pose
         outcome = self._sensed_outcome(result, marker, opening)
+        if self._door_stayed_shut(outcome, marker, opening):
+            # the fingers went the whole way and the door stayed: weak pads slid along its post (a latch,
+            # or a door heavier than they hold). A push tells which: it turns a free door, a latch holds it.
+            result = self.toggler.toggle(self.joint_models[marker], opening, push=True)
+            attempts += 1
+            peak, sim_time = max(peak, result.peak_force), sim_time + result.sim_time
+            wall_time += result.wall_time
+            outcome = self._sensed_outcome(result, marker, opening)
         if outcome.moved:
             self.states[index] ^= 1
         if outcome.outcome == "failed" and len(reasons) > self.config.max_retries:
@@ -157,6 +181,34 @@ class TwinWorld:
             )
         )  # fmt: skip
         return outcome
+
+    def _door_stayed_shut(self, outcome: TryResult, marker: int, opening: bool) -> bool:
+        """Whether a pinch that carried its fingers the whole way left a door seen shut (its marker where
+        it was): the signature of pads sliding along the post of a door they could not turn."""
+        return (
+            opening
+            and self.toggler.config.door_push
+            and kind_of(self.marker_map, marker) == "door"
+            and outcome.outcome == "failed"
+            and outcome.reason.startswith(DOOR_STAYED)
+        )
+
+    def _fraction_open(self, marker: int) -> float | None:
+        """Fraction of its travel at which ``marker``'s part stands now (0 closed, 1 open), from its marker
+        measured close up (the wrist camera above its closed pose: a door's marker turns with it, trusted up to
+        ``max_view_angle_deg``); None if not seen."""
+        jm = self.joint_models[marker]
+        closed = np.array([*self.closed_poses[marker][:2], self.lid_height])
+        look_at = closed
+        if jm.joint == "hinge" and abs(jm.axis[2]) < 0.5:  # a door: from over its hinge side (see WorldConfig)
+            out = closed - jm.origin
+            out -= np.dot(out, jm.axis) * jm.axis
+            out[2] = 0.0
+            look_at = closed - self.config.door_look_offset * out / np.linalg.norm(out)
+        seen = self.survey.close_up_turning(marker, look_at, self.lid_height)
+        if seen is None:
+            return None
+        return jm.fraction_between(closed, seen.T_base_marker[:3, 3])
 
     def _remeasure(self, marker: int) -> None:
         """Measure ``marker`` again close up and use it if it is still near its closed pose."""
@@ -173,19 +225,19 @@ class TwinWorld:
             return TryResult(result.outcome, result.reason)
         return self._overview_verdict(marker, opening)
 
-    def _overview_verdict(self, marker: int, opening: bool) -> TryResult:
+    def _overview_verdict(self, marker: int, opening: bool, unseen_moved: bool = True) -> TryResult:
         """Whether the overview agrees that ``marker``'s part moved (``moved``) or shows it where it was
-        (``failed``: slipped); ``moved`` when the overview has no trusted view of it."""
+        (``failed``: slipped); when the overview has no trusted view of it, ``moved`` if ``unseen_moved``."""
         if marker not in self.seen_by_overview:
-            return self._close_up_verdict(marker, opening)
-        seen = [d.planar_pose for d in self.survey.overview() if d.marker_id == marker]
+            return self._close_up_verdict(marker, opening, unseen_moved)
+        seen = [d.T_base_marker for d in self.survey.overview() if d.marker_id == marker]
         if not seen:
             # a door standing open shows its marker edge-on: it left its closed pose; anything else
             # hidden (the arm?) leaves the primitive's verdict standing
-            return TryResult("moved")
+            return TryResult("moved") if unseen_moved else TryResult("failed", "SlipDetected: the part was not seen")
         return self._verdict(seen[0], marker, opening)
 
-    def _close_up_verdict(self, marker: int, opening: bool) -> TryResult:
+    def _close_up_verdict(self, marker: int, opening: bool, unseen_moved: bool = True) -> TryResult:
         """As :meth:`_overview_verdict` for a marker the overview does not see well, from the wrist camera
         straight above the marker's closed pose: a weakly held handle can slide out of the pads while the
         fingers travel the whole path with hardly any force (a latched door at a 10 N grip), and only a
@@ -194,13 +246,30 @@ class TwinWorld:
         verdict standing."""
         seen = self.survey.close_up(marker, self.closed_poses[marker], self.lid_height)
         if seen is None:
-            if opening or not self.survey.last_close_up_reached:
+            if (opening and unseen_moved) or not self.survey.last_close_up_reached:
                 return TryResult("moved")
             return TryResult("failed", "SlipDetected: the handle moved but the part is not back at its closed pose")
-        return self._verdict(seen.planar_pose, marker, opening)
+        return self._verdict(seen.T_base_marker, marker, opening)
 
-    def _verdict(self, pose: np.ndarray, marker: int, opening: bool) -> TryResult:
-        delta = pose - self.closed_poses[marker]
+    def _verdict(self, T_base_marker: np.ndarray, marker: int, opening: bool) -> TryResult:
+        """``moved`` if the marker seen at ``T_base_marker`` is where the part's other state puts it: a door's
+        by the fraction of its travel it turned (a door let go part-way has left its closed pose too), any
+        other part's by having left its closed pose (``MOVED_DISTANCE``, ``MOVED_ANGLE``) or not."""
+        closed = self.closed_poses[marker]
+        if kind_of(self.marker_map, marker) == "door":
+            at = self.joint_models[marker].fraction_between(
+                np.array([*closed[:2], self.lid_height]), T_base_marker[:3, 3]
+            )
+            c = self.toggler.config
+            if (at >= c.moved_fraction) if opening else (at <= 1.0 - c.moved_fraction):
+                return TryResult("moved")
+            if opening and at < c.blocked_progress:
+                return TryResult("failed", f"{DOOR_STAYED} ({at:.0%} of its travel)")
+            return TryResult("failed", f"SlipDetected: the door stands at {at:.0%} of its travel")
+        delta = np.array(
+            [T_base_marker[0, 3], T_base_marker[1, 3], math.atan2(T_base_marker[1, 0], T_base_marker[0, 0])]
+        )
+        delta -= closed
         turn = abs((delta[2] + math.pi) % (2 * math.pi) - math.pi)
         away = bool(np.linalg.norm(delta[:2]) > MOVED_DISTANCE or turn > MOVED_ANGLE)
         if away == opening:

@@ -54,3 +54,25 @@ def test_points_turn_rigidly_about_the_hinge():
         assert door.turn_of(moved) - door.turn_of(door.point_at(0.0, p)) == pytest.approx(angle)
         tangent = door.motion_direction(angle)
         assert tangent @ door.face_normal(angle) < 0  # opening, the back face runs away from a pad behind it
+
+
+@pytest.mark.parametrize("kind", ["door", "slide", "wheel"])
+def test_how_far_a_part_stands_open_is_read_back_from_any_point_it_carries(kind):
+    """``JointModel.fraction_between``: what a look at a door's marker tells of where the door stands (its
+    marker is not on the handle, and it rises as the door turns), exact for every kind and any point off the
+    axis."""
+    T = np.eye(4)
+    T[:3, :3] = [[math.cos(0.7), -math.sin(0.7), 0], [math.sin(0.7), math.cos(0.7), 0], [0, 0, 1]]
+    T[:3, 3] = (0.45, -0.1, 0.08)
+    jm = joint_model(kind, T)
+    marker = T[:3, 3] + (0.02, 0.01, 0.0)  # off a wheel's axis (its marker is on it)
+    for fraction in (0.0, 0.2, 0.5, 1.0):
+        amount = fraction * jm.travel
+        if jm.joint == "slide":
+            carried = marker + amount * jm.axis
+        else:  # Rodrigues about the hinge
+            r, k = marker - jm.origin, jm.axis
+            carried = jm.origin + r * math.cos(amount) + np.cross(k, r) * math.sin(amount)
+            carried += k * (k @ r) * (1 - math.cos(amount))
+        assert jm.fraction_between(marker, carried) == pytest.approx(fraction, abs=1e-9)
+        assert jm.fraction_between(carried, marker) == pytest.approx(-fraction, abs=1e-9)

@@ -56,7 +56,7 @@ def test_a_free_slide_then_the_door_it_released_are_opened(chain):
     door = toggler.toggle(models["door-1"])
     assert door.outcome == "moved", door.reason
     assert session.component_states()[1] == 1
-    assert 5.0 < door.sim_time < 16.0  # a slow descent and a return to rest through the transit waypoint
+    assert 5.0 < door.sim_time < 18.0  # a slow descent, the over-travel into the end stop, a return through the transit
 
 
 def test_a_free_wheel_is_turned_open():
