@@ -300,20 +300,24 @@ class Toggler(DoorPushing):
         where_is: collections.abc.Callable[[], float | None] | None = None,
         door_at: float | None = None,
         push: bool = False,
+        raised: bool = False,
     ) -> ToggleResult:
         """Try to move the component of joint model ``jm`` to its other state (see the module docstring).
         ``where_is`` looks at the part and tells the fraction of its travel at which it stands now (0 closed,
         1 open; None if not seen): a door the pinch could not hold is pushed from there. ``door_at``: where a
         door was just seen to stand; one part-way (past ``blocked_progress`` of the motion) is pushed from
         there at once, as its handle is not where a pinch would descend. ``push``: push a door without
-        pinching it first (from ``door_at``, else from its start)."""
+        pinching it first (from ``door_at``, else from its start). ``raised``: a door stands raised where no
+        look sees it (above ~50 deg its handle hides its marker): pushed on up under its plate."""
         wall = time.perf_counter()
         start_time = self.robot.time
         self.reset_force_watch()
         c = self.config
         pushable = jm.kind == "door" and c.door_push
         covered = None if door_at is None else (door_at if opening else 1.0 - door_at)
-        if pushable and (push or (covered is not None and covered >= c.blocked_progress)):
+        if pushable and opening and raised:
+            result = self._attempt(lambda: self._top_up_door(jm))
+        elif pushable and (push or (covered is not None and covered >= c.blocked_progress)):
             result = self._push(jm, opening, 0.0 if covered is None else covered)
         else:
             self.felt_end_stop = False

@@ -102,6 +102,9 @@ class TwinWorld:
     names: dict[int, str] | None = None
     """Evaluation only: marker id -> the spec's component name, for result files."""
     log: list[ActionLog] = field(default_factory=list)
+    unsettled: set[int] = field(default_factory=set)
+    """Markers of doors a failed try left possibly part-way where no look could see them: looked at before
+    they are tried again."""
 
     def __post_init__(self) -> None:
         self.detector = MarkerDetector()
@@ -135,10 +138,19 @@ class TwinWorld:
         sim_time = wall_time = 0.0
         attempts = 0
         door_at = None
+        raised = False  # a door left part-way where no look sees it
+        if marker in self.unsettled and opening:  # a door an earlier try left part-way: where is it now?
+            door_at = self._fraction_open(marker)
+            raised = door_at is None
+        self.unsettled.discard(marker)
         for attempt in range(1 + self.config.max_retries):
             attempts = attempt + 1
             result: ToggleResult = self.toggler.toggle(
-                self.joint_models[marker], opening, where_is=lambda: self._fraction_open(marker), door_at=door_at
+                self.joint_models[marker],
+                opening,
+                where_is=lambda: self._fraction_open(marker),
+                door_at=door_at,
+                raised=raised,
             )
             peak, sim_time, wall_time = (
                 max(peak, result.peak_force),
@@ -158,8 +170,18 @@ class TwinWorld:
             reasons.append(result.reason)
             if attempt < self.config.max_retries and self.joint_models[marker].kind == "door":
                 door_at = self._fraction_open(marker)  # a failed try may leave a door part-way: see where
-            if attempt < self.config.max_retries and opening and (door_at is None or abs(door_at) < 0.05):
+                # part-way and unseen: a pinch would descend onto it (195 N); it is pushed up under its plate
+                raised = door_at is None and result.progress >= self.toggler.config.blocked_progress
+            if (
+                attempt < self.config.max_retries
+                and opening
+                and not raised
+                and (door_at is None or abs(door_at) < 0.05)
+            ):
                 self._remeasure(marker)  # only a closed part shows its closed pose
+        if result.outcome == "failed" and kind_of(self.marker_map, marker) == "door" and opening:
+            if result.progress >= self.toggler.config.blocked_progress:
+                self.unsettled.add(marker)  # the next try of it looks first
         outcome = self._sensed_outcome(result, marker, opening)
         if self._door_stayed_shut(outcome, marker, opening):
             # the fingers went the whole way and the door stayed: weak pads slid along its post (a latch,
