@@ -280,22 +280,14 @@ class DoorPushing:
         for k in range(1, ticks + round(c.settle_time / c.tick) + 1):
             u = min(k / ticks, 1.0)
             self._tick(tcp_for(x_start + (x_end - x_start) * u * u * (3 - 2 * u)))
-            edge_x = float((self.robot.tcp_pose_in_base()[:3, 3] - door.origin) @ door.e_x) - p.pad_half_width
+            edge_x = float((self._pad_edge(door, -p.pad_half_width) - door.origin) @ door.e_x)
             forces.append(float(-self.force_in_base @ door.e_x))
             magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
-            if magnitude > p.end_force and edge_x <= x_near_stop:  # the door is in its end stop
-                break
-            if magnitude > c.blocked_magnitude:
-                break
+            if magnitude > c.blocked_magnitude or (magnitude > p.end_force and edge_x <= x_near_stop):
+                break  # held, or in its end stop
         progress = math.atan2(h, max(edge_x, 1e-6)) / door.travel  # the underside's angle where the edge is
         result = self._verdict(progress, forces)
-        away = self.robot.tcp_pose_in_base()
-        away[:3, 3] += p.gap * door.e_x  # off the plate before lifting
-        self.ik.set_joints(self.robot.joint_positions())
-        try:
-            self.move_to(away, c.release_time)
-        except IKFailure:
-            pass
+        self._back_off(door, 0.0)  # off the plate (along e_x) before lifting
         self.phase = "retreating"
         self._let_go_and_retreat()
         self.phase = "moving"

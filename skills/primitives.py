@@ -187,8 +187,6 @@ class Toggler(DoorPushing):
         """Largest filtered force magnitude since the last :meth:`reset_force_watch` [N]."""
         self.guard = True
         """Stop motions at ``force_limit`` (off only while withdrawing from a stop)."""
-        self.felt_end_stop = False
-        """Whether the last pinch of a door felt it reach its end stop (past the travel, ``overtravel_force``)."""
 
     # -- force -------------------------------------------------------------------------------------
     def reset_force_watch(self) -> None:
@@ -320,9 +318,8 @@ class Toggler(DoorPushing):
         elif pushable and (push or (covered is not None and covered >= c.blocked_progress)):
             result = self._push(jm, opening, 0.0 if covered is None else covered)
         else:
-            self.felt_end_stop = False
             result = self._attempt(lambda: self._toggle(jm, 1.0 if opening else -1.0))
-            if pushable and opening and result.outcome == "moved" and not self.felt_end_stop and c.push.top_up:
+            if pushable and opening and result.outcome == "moved" and not result.end_stop_felt and c.push.top_up:
                 self._attempt(lambda: self._top_up_door(jm))  # best effort: the pinch's verdict stands
             if pushable and result.reason.startswith(PADS_LOST_HOLD):
                 # the pads could not hold the handle: push the door instead, in the same try, from where it stands
@@ -419,9 +416,8 @@ class Toggler(DoorPushing):
             * np.linalg.norm((jm.grasp_point - jm.origin) - np.dot(jm.grasp_point - jm.origin, jm.axis) * jm.axis)
         )
         lead = c.lead / path_length  # as a fraction of the travel
-        opening_door = jm.kind == "door" and sign > 0
-        pace = (1.0 + (c.door_overtravel if opening_door else 0.0)) / ticks  # travel per tick
-        end = 1.0 + (c.door_overtravel if opening_door else 0.0)
+        end = 1.0 + (c.door_overtravel if jm.kind == "door" and sign > 0 else 0.0)
+        pace = end / ticks  # travel per tick up to the travel's end
         progress_at_peak = 0.0
         in_end_stop = False  # felt the door reach its end stop: open, whatever the pads do next
         self.ik.set_joints(self.robot.joint_positions())
@@ -445,8 +441,7 @@ class Toggler(DoorPushing):
                     return ToggleResult("blocked", SLIPPED_OFF, progress, max(forces),
                                         forces=forces)  # fmt: skip
                 if in_end_stop:  # the pads slid off a post pressed into its end stop: the door is open
-                    self.felt_end_stop = True
-                    return ToggleResult("moved", "", progress, max(forces), forces=forces)
+                    return ToggleResult("moved", "", progress, max(forces), forces=forces, end_stop_felt=True)
                 raise
             magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
             in_end_stop = in_end_stop or (s > 1.0 and magnitude > c.end_stop_force)
@@ -466,8 +461,8 @@ class Toggler(DoorPushing):
                 if not in_end_stop:
                     raise
                 break
-        self.felt_end_stop = in_end_stop
         result = self._verdict(self._progress(jm, sign, begin), forces, "latched: pulled without progress")
+        result.end_stop_felt = in_end_stop
         if result.outcome == "blocked":
             self.move_to(at_grasp, 0.5)
         return result

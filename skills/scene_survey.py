@@ -19,6 +19,7 @@ capture; the arm holds still while capturing.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,6 +34,8 @@ from skills.primitives import Toggler
 
 OVERVIEW_CAMERA = "overview"
 WRIST_CAMERA = "xarm7/gripper/wrist_camera"
+CAMERA_YAWS = (0.0, math.pi / 2, -math.pi / 2, math.pi)
+"""Yaws the wrist camera is turned to, in order, looking down from above a point [rad]."""
 
 
 @dataclass(frozen=True)
@@ -104,7 +107,7 @@ class SceneSurvey:
     def overview(self) -> list[MarkerDetection]:
         return self.look(OVERVIEW_CAMERA)
 
-    def _wrist_from_above(self, point: np.ndarray, height: float, yaws=(0.0, np.pi / 2, -np.pi / 2, np.pi)) -> bool:
+    def _wrist_from_above(self, point: np.ndarray, height: float, yaws: tuple[float, ...] = CAMERA_YAWS) -> bool:
         """Put the wrist camera ``height`` above ``point`` looking down, arriving through the toggler's
         transit waypoint high above the workspace, the camera turned (the first of ``yaws`` [rad] that works)
         so the TCP stays at least ``MIN_REACH`` from the base axis; False if the arm cannot, or if the force
@@ -138,7 +141,7 @@ class SceneSurvey:
         seen: looking at a point beside the marker, the marker is off the image's centre, where the gripper's
         own fingers may hide it (they fill one side of the wrist image)."""
         found = None
-        for yaw in (0.0, np.pi / 2, -np.pi / 2, np.pi):
+        for yaw in CAMERA_YAWS:
             found = self._measure_from_above(marker, xy, height, yaws=(yaw,))
             if found is not None:
                 break
@@ -146,7 +149,7 @@ class SceneSurvey:
         return found
 
     def _measure_from_above(
-        self, marker: int, xy: np.ndarray, height: float | None, yaws=(0.0, np.pi / 2, -np.pi / 2, np.pi)
+        self, marker: int, xy: np.ndarray, height: float | None, yaws: tuple[float, ...] = CAMERA_YAWS
     ) -> MarkerDetection | None:
         z = height if height is not None else self.config.table_height
         self.last_close_up_reached = self._wrist_from_above(

@@ -22,3 +22,5 @@ class ToggleResult:
     forces: list[float] = field(default_factory=list)
     peak_force: float = 0.0
     """Largest filtered force magnitude over the whole try [N] (what the safety limit watches)."""
+    end_stop_felt: bool = False
+    """A door's pinch felt the door reach its end stop (past the travel, ``end_stop_force``)."""

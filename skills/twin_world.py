@@ -36,7 +36,7 @@ from models import ComponentObservation, SceneObservation, TryResult
 from models.calibration import CellCalibration
 from models.robot import Robot
 from skills.joint_model import JointModel, joint_model
-from skills.perception import MarkerDetector, kind_of, lid_height, upright_pose
+from skills.perception import MarkerDetection, MarkerDetector, kind_of, lid_height, upright_pose
 from skills.primitives import Toggler, ToggleResult
 from skills.scene_survey import SceneSurvey, SurveyConfig
 
@@ -137,6 +137,7 @@ class TwinWorld:
         peak = 0.0
         sim_time = wall_time = 0.0
         attempts = 0
+        is_door = kind_of(self.marker_map, marker) == "door"
         door_at = None
         raised = False  # a door left part-way where no look sees it
         if marker in self.unsettled and opening:  # a door an earlier try left part-way: where is it now?
@@ -161,14 +162,12 @@ class TwinWorld:
                 # stopped (force limit, slip) after carrying the handle most of the way: look before retrying
                 # (a door's marker must be seen where an open door's is: one the pads let go part-way hides
                 # it behind its own raised handle, as an open one shows it edge-on)
-                if self._overview_verdict(
-                    marker, opening, unseen_moved=kind_of(self.marker_map, marker) != "door"
-                ).moved:
+                if self._overview_verdict(marker, opening, unseen_moved=not is_door).moved:
                     result.outcome, result.reason = "moved", ""
             if result.outcome != "failed":
                 break
             reasons.append(result.reason)
-            if attempt < self.config.max_retries and self.joint_models[marker].kind == "door":
+            if attempt < self.config.max_retries and is_door:
                 door_at = self._fraction_open(marker)  # a failed try may leave a door part-way: see where
                 # part-way and unseen: a pinch would descend onto it (195 N); it is pushed up under its plate
                 raised = door_at is None and result.progress >= self.toggler.config.blocked_progress
@@ -179,11 +178,15 @@ class TwinWorld:
                 and (door_at is None or abs(door_at) < 0.05)
             ):
                 self._remeasure(marker)  # only a closed part shows its closed pose
-        if result.outcome == "failed" and kind_of(self.marker_map, marker) == "door" and opening:
-            if result.progress >= self.toggler.config.blocked_progress:
-                self.unsettled.add(marker)  # the next try of it looks first
+        if (
+            is_door
+            and opening
+            and result.outcome == "failed"
+            and result.progress >= self.toggler.config.blocked_progress
+        ):
+            self.unsettled.add(marker)  # the next try of it looks first
         outcome = self._sensed_outcome(result, marker, opening)
-        if self._door_stayed_shut(outcome, marker, opening):
+        if self._door_stayed_shut(outcome):
             # the fingers went the whole way and the door stayed: weak pads slid along its post (a latch,
             # or a door heavier than they hold). A push tells which: it turns a free door, a latch holds it.
             result = self.toggler.toggle(self.joint_models[marker], opening, push=True)
@@ -204,25 +207,19 @@ class TwinWorld:
         )  # fmt: skip
         return outcome
 
-    def _door_stayed_shut(self, outcome: TryResult, marker: int, opening: bool) -> bool:
+    def _door_stayed_shut(self, outcome: TryResult) -> bool:
         """Whether a pinch that carried its fingers the whole way left a door seen shut (its marker where
         it was): the signature of pads sliding along the post of a door they could not turn."""
-        return (
-            opening
-            and self.toggler.config.door_push
-            and kind_of(self.marker_map, marker) == "door"
-            and outcome.outcome == "failed"
-            and outcome.reason.startswith(DOOR_STAYED)
-        )
+        return self.toggler.config.door_push and outcome.reason.startswith(DOOR_STAYED)  # (doors, opening only)
 
     def _fraction_open(self, marker: int) -> float | None:
         """Fraction of its travel at which ``marker``'s part stands now (0 closed, 1 open), from its marker
         measured close up (the wrist camera above its closed pose: a door's marker turns with it, trusted up to
         ``max_view_angle_deg``); None if not seen."""
         jm = self.joint_models[marker]
-        closed = np.array([*self.closed_poses[marker][:2], self.lid_height])
+        closed = self._closed_point(marker)
         look_at = closed
-        if jm.joint == "hinge" and abs(jm.axis[2]) < 0.5:  # a door: from over its hinge side (see WorldConfig)
+        if jm.kind == "door":  # from over its hinge side (see WorldConfig.door_look_offset)
             out = closed - jm.origin
             out -= np.dot(out, jm.axis) * jm.axis
             out[2] = 0.0
@@ -231,6 +228,10 @@ class TwinWorld:
         if seen is None:
             return None
         return jm.fraction_between(closed, seen.T_base_marker[:3, 3])
+
+    def _closed_point(self, marker: int) -> np.ndarray:
+        """Where ``marker``'s centre is with its part closed, in the base frame [m]."""
+        return np.array([*self.closed_poses[marker][:2], self.lid_height])
 
     def _remeasure(self, marker: int) -> None:
         """Measure ``marker`` again close up and use it if it is still near its closed pose."""
@@ -252,7 +253,7 @@ class TwinWorld:
         (``failed``: slipped); when the overview has no trusted view of it, ``moved`` if ``unseen_moved``."""
         if marker not in self.seen_by_overview:
             return self._close_up_verdict(marker, opening, unseen_moved)
-        seen = [d.T_base_marker for d in self.survey.overview() if d.marker_id == marker]
+        seen = [d for d in self.survey.overview() if d.marker_id == marker]
         if not seen:
             # a door standing open shows its marker edge-on: it left its closed pose; anything else
             # hidden (the arm?) leaves the primitive's verdict standing
@@ -271,27 +272,21 @@ class TwinWorld:
             if (opening and unseen_moved) or not self.survey.last_close_up_reached:
                 return TryResult("moved")
             return TryResult("failed", "SlipDetected: the handle moved but the part is not back at its closed pose")
-        return self._verdict(seen.T_base_marker, marker, opening)
+        return self._verdict(seen, marker, opening)
 
-    def _verdict(self, T_base_marker: np.ndarray, marker: int, opening: bool) -> TryResult:
-        """``moved`` if the marker seen at ``T_base_marker`` is where the part's other state puts it: a door's
-        by the fraction of its travel it turned (a door let go part-way has left its closed pose too), any
-        other part's by having left its closed pose (``MOVED_DISTANCE``, ``MOVED_ANGLE``) or not."""
-        closed = self.closed_poses[marker]
+    def _verdict(self, seen: MarkerDetection, marker: int, opening: bool) -> TryResult:
+        """``moved`` if the marker ``seen`` is where the part's other state puts it: a door's by the fraction
+        of its travel it turned (a door let go part-way has left its closed pose too), any other part's by
+        having left its closed pose (``MOVED_DISTANCE``, ``MOVED_ANGLE``) or not."""
         if kind_of(self.marker_map, marker) == "door":
-            at = self.joint_models[marker].fraction_between(
-                np.array([*closed[:2], self.lid_height]), T_base_marker[:3, 3]
-            )
+            at = self.joint_models[marker].fraction_between(self._closed_point(marker), seen.T_base_marker[:3, 3])
             c = self.toggler.config
             if (at >= c.moved_fraction) if opening else (at <= 1.0 - c.moved_fraction):
                 return TryResult("moved")
             if opening and at < c.blocked_progress:
                 return TryResult("failed", f"{DOOR_STAYED} ({at:.0%} of its travel)")
             return TryResult("failed", f"SlipDetected: the door stands at {at:.0%} of its travel")
-        delta = np.array(
-            [T_base_marker[0, 3], T_base_marker[1, 3], math.atan2(T_base_marker[1, 0], T_base_marker[0, 0])]
-        )
-        delta -= closed
+        delta = seen.planar_pose - self.closed_poses[marker]
         turn = abs((delta[2] + math.pi) % (2 * math.pi) - math.pi)
         away = bool(np.linalg.norm(delta[:2]) > MOVED_DISTANCE or turn > MOVED_ANGLE)
         if away == opening:
