@@ -59,6 +59,15 @@ class DoorPushConfig:
     (at 45 mm a jammed door put 170 N on the wrist before the guard could stop the arm)."""
     close_time: float = 4.0
     """Time of a closing push [s] (~30 mm/s at the pads)."""
+    search_down_to: float = math.radians(50.0)
+    """Lowest angle at which a door believed open may stand [rad]: short of its stop it sinks under its own
+    weight (66 deg within 45 s), and a latch holds it wherever it was when engaged. Until the pads have pressed
+    on the plate or passed this angle, a closing push moves at ``search_speed``."""
+    search_speed: float = 0.015
+    """Speed of the pads along the arc while they search for the plate of a door that may stand below its stop
+    [m/s]: a harsh door latched open at 71.5 deg, met at the schedule's ~40 mm/s, put 99 N on the wrist before
+    the late reading passed ``blocked_force``; its progress, counted from where the pads began rather than
+    where they first pressed, had also passed ``blocked_progress``, so no latch was read."""
     end_force: float = 20.0
     """Force magnitude at which a door pushed most of the way closed is taken to lie on the lid and the push
     stops there [N] (pressed on by a TCP a few mm off, the lid put 80-130 N on the wrist)."""
@@ -82,6 +91,11 @@ class DoorPushConfig:
     travel, 3 deg): a door let go part-way open falls back ~1 deg while the arm comes round. Behind the
     handle's true angle the pad sits higher on the post (~1.7 mm per deg, 15 mm of post above it); ahead of
     it, lower, towards the plate, and the other finger onto the raised handle."""
+    close_by_push: bool = True
+    """Shut a door by pushing its plate down (:meth:`DoorPushing._push_door_closed`), not by pinching its
+    handle: pinched shut, the handle pivots ~85 deg between the pads against their torsional friction, and
+    under the harsh grip it lagged the fingers by 7 deg, the wrist force rising to 33 N and then released
+    in a stick-slip jolt of 70 N. Pushed, the pads move into the plate and need no friction."""
     top_up: bool = True
     """Push on to the end stop a door a pinch opened without feeling the stop (:meth:`DoorPushing._top_up_door`)."""
     top_up_from: float = math.radians(50.0)
@@ -91,13 +105,23 @@ class DoorPushConfig:
     top_up_height: float = 0.055
     """Height of the TCP above the hinge line during a top-up push [m]: the plate's underside is there at 50
     deg only 9 mm short of its free edge, and the pads pass 15 mm above a neighbouring handle's top."""
+    top_up_low: float = 0.045
+    """Height above the hinge line the pads dive to as they move in, once their outer edge is over the door's
+    own footprint (``top_up_dive`` in from where they descended) [m]: at ``top_up_height`` a door at 49 deg
+    has its plate's free edge 6 mm above the pads' lower edge, which then pressed on the edge's end face, along
+    the plate into the hinge (90 N); 10 mm lower they meet the edge side-on and turn the door up."""
+    top_up_dive: float = 0.015
+    """How far in from where they descended the pads reach ``top_up_low`` [m]: their 30 mm are then inside
+    the door's closed footprint (81 mm from the hinge), clear of any neighbour."""
     top_up_clearance: float = 0.010
     """Clearance between the pads' edge and the plate's top corner at ``top_up_from`` as the pads descend [m]."""
     top_up_near_stop: float = math.radians(3.0)
     """How close to its end stop the underside must be before ``end_force`` ends a top-up push [rad]: a damped
     door pushed at 20 mm/s presses back with 20 N long before (it stopped a harsh door at 75 deg)."""
-    top_up_time: float = 3.0
-    """Time of the top-up push, from outside the plate's reach to its end stop (~20 mm/s) [s]."""
+    top_up_time: float = 4.5
+    """Time of the top-up push, from outside the plate's reach to its end stop (~15 mm/s) [s]: at the pads'
+    ``top_up_low`` a damped door turns ~1.5 times as fast for the same pad speed as at ``top_up_height``, and
+    presses back over a shorter lever (3 s: 61-66 N on harsh doors)."""
     blocked_force: float = 30.0
     """Normal force on a handle's back face that, with little progress, means a latch [N] (a free door
     under the harsh profile's damping and friction took up to 13 N)."""
@@ -220,23 +244,42 @@ class DoorPushing:
         lead = p.lead / (door.travel * p.close_x)
         end = 1.0
         ticks = round(p.close_time / c.tick)
+        search_step = p.search_speed * c.tick / (door.travel * p.close_x)  # per tick, as a fraction of the travel
+        search_end = 1.0 - p.search_down_to / door.travel
+
+        def scheduled(k: float) -> float:  # where the pads are sent at (schedule) tick k: slow onto the lid
+            u = min(1.0, k / ticks)
+            return start + (end - start) * u * u * (3 - 2 * u)
+
         forces: list[float] = []
         progress = 0.0
+        pressed_from: float | None = None  # the progress at which the pads first pressed on the plate
         self.ik.set_joints(self.robot.joint_positions())
         turn_at_start = door.turn_of(self._pad_edge(door, p.pad_half_width))
         result = None
-        for k in range(1, ticks + 1 + round(2 * c.settle_time / c.tick)):
-            u = min(1.0, k / ticks)
-            s = min(start + (end - start) * u * u * (3 - 2 * u), max(progress, start) + lead)  # slow onto the lid
-            self._tick(tcp_for(door.point_at((1.0 - s) * door.travel, on_plate)))
+        k = 0
+        schedule = 0.0  # the schedule's clock [ticks]: slowed while the pads search for the plate
+        while schedule < ticks + round(2 * c.settle_time / c.tick):
+            k += 1
+            step = 1.0
+            if pressed_from is None and scheduled(schedule) < search_end:
+                nominal = scheduled(schedule + 1.0) - scheduled(schedule)
+                step = min(1.0, search_step / nominal) if nominal > 0 else 1.0
+            schedule += step
+            s = min(scheduled(schedule), max(progress, start) + lead)
+            closing_in = max(0.0, 1.0 - k * c.tick / p.approach_time) * (p.gap + p.depth)  # onto the plate gently
+            self._tick(tcp_for(door.point_at((1.0 - s) * door.travel, on_plate + np.array([0.0, closing_in]))))
             turn = door.turn_of(self._pad_edge(door, p.pad_half_width))
             progress = self.progress = start + (turn_at_start - turn) / door.travel
             angle = (1.0 - max(progress, 0.0)) * door.travel
             forces.append(float(self.force_in_base @ door.motion_direction(angle)))  # opposing a closing motion
             magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
+            if pressed_from is None and forces[-1] > p.contact_force:
+                pressed_from = progress
             if progress >= c.moved_fraction and magnitude > p.end_force:  # the plate is on the lid: stop
                 end = min(end, max(progress, c.moved_fraction))
-            if progress < c.blocked_progress and (forces[-1] > c.blocked_force or magnitude > c.blocked_magnitude):
+            pushed = progress - (start if pressed_from is None else max(pressed_from, start))
+            if pushed < c.blocked_progress and (forces[-1] > c.blocked_force or magnitude > c.blocked_magnitude):
                 result = ToggleResult("blocked", PUSHED_IN_VAIN, progress, max(forces),
                                       forces=forces)  # fmt: skip
                 break
@@ -254,24 +297,31 @@ class DoorPushing:
         descent then lands (100-130 N). Where the door stands is not known (above ~50 deg its handle hides
         its marker), so the pads, fingers along the hinge, descend beside the plate outside its reach at any
         angle above ``top_up_from``, ``top_up_height`` above the hinge, and their inner edge moves in towards
-        the hinge: it meets the plate's underside wherever the door stands and turns it up into its end stop.
-        ``moved`` once the edge passed where the underside is at ``moved_fraction`` of the travel (a free door
-        turns under less than 1 N: meeting the plate is not felt, so this cannot tell a door that was not
-        there)."""
+        the hinge, diving to ``top_up_low`` once over the door's own footprint: it meets the plate's underside
+        wherever the door stands and turns it up into its end stop. ``moved`` once the edge passed where the
+        underside is at ``moved_fraction`` of the travel (a free door turns under less than 1 N: meeting the
+        plate is not felt, so this cannot tell a door that was not there)."""
         c = self.config
         p = c.push
         door = DoorPush.of(jm, p.height)
         yaw = self.grasp_yaw(jm)  # fingers along the hinge: the gripper's x is the door's e_x
-        h = p.top_up_height
         free_edge = door.contact[0] + HANDLE_MARGIN - HANDLE_SIZE / 2  # the plate's far edge from the hinge
         x_start = free_edge * math.cos(p.top_up_from) + p.top_up_clearance
-        x_end = h / math.tan(door.travel) - p.depth  # where the underside meets the pads' height at the stop
-        x_near_stop = h / math.tan(door.travel - p.top_up_near_stop)
+        x_end = p.top_up_low / math.tan(door.travel) - p.depth  # where the underside meets the pads at the stop
+        x_near_stop = p.top_up_low / math.tan(door.travel - p.top_up_near_stop)
+
+        def height_at(edge_x: float) -> float:  # the pads' height above the hinge line with their edge at edge_x
+            dive = min(max((x_start - edge_x) / p.top_up_dive, 0.0), 1.0)
+            return p.top_up_height + (p.top_up_low - p.top_up_height) * dive
 
         def tcp_for(edge_x: float) -> np.ndarray:  # the TCP with the pads' inner edge at edge_x from the hinge
-            return top_down(door.origin + (edge_x + p.pad_half_width) * door.e_x + h * door.e_z, yaw)
+            return top_down(door.origin + (edge_x + p.pad_half_width) * door.e_x + height_at(edge_x) * door.e_z, yaw)
 
-        self._descend_to(tcp_for(x_start))
+        cautious, self.cautious = self.cautious, True  # beside a door standing at an unknown angle
+        try:
+            self._descend_to(tcp_for(x_start))
+        finally:
+            self.cautious = cautious
         self.phase = "actuating"
         ticks = round(p.top_up_time / c.tick)
         forces: list[float] = []
@@ -285,7 +335,7 @@ class DoorPushing:
             magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
             if magnitude > c.blocked_magnitude or (magnitude > p.end_force and edge_x <= x_near_stop):
                 break  # held, or in its end stop
-        progress = math.atan2(h, max(edge_x, 1e-6)) / door.travel  # the underside's angle where the edge is
+        progress = math.atan2(height_at(edge_x), max(edge_x, 1e-6)) / door.travel  # the underside's angle there
         result = self._verdict(progress, forces)
         self._back_off(door, 0.0)  # off the plate (along e_x) before lifting
         self.phase = "retreating"

@@ -68,6 +68,14 @@ class PrimitiveConfig:
     """Time of the 8 cm descent onto a handle [s]: slow enough (peak 6 cm/s) that a part standing in
     the way (a door left leaning over its neighbour) is met softly and the force guard stops the arm
     near its limit; at 1 s the impact put up to 270 N of true force on the wrist."""
+    cautious_descend_time: float = 5.0
+    """Time of the descent beside a door that may stand open over it (``toggle(cautious=True)``) [s]: met at
+    the 6 cm/s peak of a normal descent, a flap's edge put 80 N on the wrist at the first touch; at a third of
+    that speed 20-25 N (harsh profile)."""
+    cautious_contact_force: float = 15.0
+    """Filtered force that stops a cautious descent [N]: nothing should touch the fingers on the way down, and
+    the servos keep pushing into what they met by ~1 N per 10 ms tick while the 30 ms late, filtered reading
+    catches up."""
     close_time: float = 0.6
     close_speed: float = 0.4
     """Rate at which the gripper's commanded closure ramps up while closing on a handle [1/s]: the
@@ -155,6 +163,11 @@ class PrimitiveConfig:
                 "need 0 < blocked_force < blocked_magnitude < force_limit [N], got "
                 f"{self.blocked_force}, {self.blocked_magnitude}, {self.force_limit}"
             )
+        if not 0.0 < self.cautious_contact_force < self.force_limit:
+            raise ValueError(
+                "need 0 < cautious_contact_force < force_limit [N], got "
+                f"{self.cautious_contact_force}, {self.force_limit}"
+            )
 
 
 def _median_rows(rows: collections.abc.Sequence[np.ndarray]) -> np.ndarray:
@@ -187,6 +200,10 @@ class Toggler(DoorPushing):
         """Largest filtered force magnitude since the last :meth:`reset_force_watch` [N]."""
         self.guard = True
         """Stop motions at ``force_limit`` (off only while withdrawing from a stop)."""
+        self.limit = self.config.force_limit
+        """The force guard's threshold now [N]: ``force_limit``, or ``cautious_contact_force`` in a cautious descent."""
+        self.cautious = False
+        """Whether the toggle in progress descends cautiously (``toggle(cautious=True)``)."""
 
     # -- force -------------------------------------------------------------------------------------
     def reset_force_watch(self) -> None:
@@ -201,9 +218,9 @@ class Toggler(DoorPushing):
         self.force_in_base = _median_rows(self._force_window)
         magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
         self.peak_force = max(self.peak_force, magnitude)
-        if self.guard and magnitude > self.config.force_limit:
+        if self.guard and magnitude > self.limit:
             raise ForceLimitExceeded(
-                f"force limit: {magnitude:.0f} N > {self.config.force_limit:.0f} N while {self.phase}, motion stopped"
+                f"force limit: {magnitude:.0f} N > {self.limit:.0f} N while {self.phase}, motion stopped"
             )
 
     def _clip(self, q: np.ndarray) -> np.ndarray:
@@ -299,6 +316,7 @@ class Toggler(DoorPushing):
         door_at: float | None = None,
         push: bool = False,
         raised: bool = False,
+        cautious: bool = False,
     ) -> ToggleResult:
         """Try to move the component of joint model ``jm`` to its other state (see the module docstring).
         ``where_is`` looks at the part and tells the fraction of its travel at which it stands now (0 closed,
@@ -306,8 +324,11 @@ class Toggler(DoorPushing):
         door was just seen to stand; one part-way (past ``blocked_progress`` of the motion) is pushed from
         there at once, as its handle is not where a pinch would descend. ``push``: push a door without
         pinching it first (from ``door_at``, else from its start). ``raised``: a door stands raised where no
-        look sees it (above ~50 deg its handle hides its marker): pushed on up under its plate."""
+        look sees it (above ~50 deg its handle hides its marker): pushed on up under its plate. ``cautious``: a
+        door may stand open over the part (:mod:`skills.door_clearance`): every descent of the try is made at
+        ``cautious_descend_time`` and stopped at ``cautious_contact_force``."""
         wall = time.perf_counter()
+        self.cautious = cautious
         start_time = self.robot.time
         self.reset_force_watch()
         c = self.config
@@ -315,8 +336,8 @@ class Toggler(DoorPushing):
         covered = None if door_at is None else (door_at if opening else 1.0 - door_at)
         if pushable and opening and raised:
             result = self._attempt(lambda: self._top_up_door(jm))
-        elif pushable and (push or (covered is not None and covered >= c.blocked_progress)):
-            result = self._push(jm, opening, 0.0 if covered is None else covered)
+        elif pushable and (push or (not opening and c.push.close_by_push) or (covered or 0.0) >= c.blocked_progress):
+            result = self._push_on(jm, opening, 0.0 if covered is None else covered, where_is)
         else:
             result = self._attempt(lambda: self._toggle(jm, 1.0 if opening else -1.0))
             if pushable and opening and result.outcome == "moved" and not result.end_stop_felt and c.push.top_up:
@@ -325,12 +346,35 @@ class Toggler(DoorPushing):
                 # the pads could not hold the handle: push the door instead, in the same try, from where it stands
                 covered = self._push_start(result, opening, where_is)
                 if covered is not None:
-                    result = self._push(jm, opening, covered)
+                    result = self._push_on(jm, opening, covered, where_is)
                 elif result.progress < c.moved_fraction:  # (past it, the world looks whether it moved)
                     result.reason += "; the door stands part-way where it cannot be seen: not pushed"
         result.peak_force = self.peak_force  # over the whole try, withdrawal included
         result.sim_time = self.robot.time - start_time
         result.wall_time = time.perf_counter() - wall
+        return result
+
+    def _push_on(
+        self,
+        jm: JointModel,
+        opening: bool,
+        covered: float,
+        where_is: collections.abc.Callable[[], float | None] | None = None,
+    ) -> ToggleResult:
+        """:meth:`_push`, and an opening push that lost the handle's face short of the travel (``IncompleteTravel``:
+        under the harsh profile's perception error the pad drifted off a post at 62 deg) followed by a top-up
+        under the plate (:meth:`DoorPushing._top_up_door`) if ``where_is`` does not see the door (above ~50 deg
+        its handle hides its marker), whose verdict then stands (the world checks a ``moved`` against the
+        marker). A door seen lower is left to a retry's push from where it stands: under a plate that low
+        the top-up's pads pass over it and read "moved"."""
+        result = self._push(jm, opening, covered)
+        if opening and self.config.push.top_up and result.reason.startswith("IncompleteTravel"):
+            if where_is is not None and where_is() is not None:
+                return result
+            topped = self._attempt(lambda: self._top_up_door(jm))
+            if topped.outcome == "moved":
+                return topped
+            result.reason += f"; pushed on under its plate: {topped.reason}"
         return result
 
     def _push(self, jm: JointModel, opening: bool, covered: float) -> ToggleResult:
@@ -381,7 +425,14 @@ class Toggler(DoorPushing):
         self.robot.tare()  # fingers open, arm still: the load of the gripper alone
         self._force_window.clear()  # older samples were taken with another zero
         self.phase = "descending"
-        self.move_to(target, c.descend_time)
+        if not self.cautious:
+            self.move_to(target, c.descend_time)
+            return
+        self.limit = c.cautious_contact_force
+        try:
+            self.move_to(target, c.cautious_descend_time)
+        finally:
+            self.limit = c.force_limit
 
     def _toggle(self, jm: JointModel, sign: float) -> ToggleResult:
         c = self.config

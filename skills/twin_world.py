@@ -35,6 +35,7 @@ import numpy as np
 from models import ComponentObservation, SceneObservation, TryResult
 from models.calibration import CellCalibration
 from models.robot import Robot
+from skills.door_clearance import near_open_door
 from skills.joint_model import JointModel, joint_model
 from skills.perception import MarkerDetection, MarkerDetector, kind_of, lid_height, upright_pose
 from skills.primitives import Toggler, ToggleResult
@@ -44,6 +45,8 @@ MOVED_DISTANCE = 0.01
 """A re-observed marker this far from its closed pose has moved [m]..."""
 MOVED_ANGLE = math.radians(20)
 """... or turned this much [rad]."""
+STOPPED_DESCENDING = "while descending, motion stopped"
+"""End of the reason of a try the force guard stopped on the way down onto the handle."""
 DOOR_STAYED = "SlipDetected: the door stayed shut"
 """Reason of a try whose fingers went the whole way while the door's marker stayed at its closed pose."""
 
@@ -62,6 +65,14 @@ class WorldConfig:
     the door stands [m]: from straight above, a door raised 40 deg shows its marker behind its own handle
     (not detected); from 10 cm over (~22 deg off the vertical at the close-up height), face on to a
     half-open door and clear of the handle."""
+    open_door_from: float = 0.6
+    """Lowest fraction of its travel at which a door believed open may stand (opened past ``moved_fraction``,
+    0.75, it may sink back a few degrees under its own weight) [-]; one a failed try left part-way may stand
+    anywhere above ``blocked_progress``."""
+    door_clearance: float = 0.045
+    """A grasp point this close to where an open door may overhang (:mod:`skills.door_clearance`) is descended
+    onto cautiously [m]: the fingers, 42 mm apart and 30 mm wide, reach ~30 mm from it, and the door's pose
+    is known to ~5 mm."""
     survey: SurveyConfig = field(default_factory=SurveyConfig)
 
 
@@ -144,6 +155,7 @@ class TwinWorld:
             door_at = self._fraction_open(marker)
             raised = door_at is None
         self.unsettled.discard(marker)
+        overhanging = self._doors_overhanging(marker, opening)
         for attempt in range(1 + self.config.max_retries):
             attempts = attempt + 1
             result: ToggleResult = self.toggler.toggle(
@@ -152,6 +164,7 @@ class TwinWorld:
                 where_is=lambda: self._fraction_open(marker),
                 door_at=door_at,
                 raised=raised,
+                cautious=bool(overhanging),
             )
             peak, sim_time, wall_time = (
                 max(peak, result.peak_force),
@@ -167,6 +180,13 @@ class TwinWorld:
             if result.outcome != "failed":
                 break
             reasons.append(result.reason)
+            if attempt < self.config.max_retries and overhanging and result.reason.endswith(STOPPED_DESCENDING):
+                # the fingers met something on the way down beside a door that may stand short of its stop,
+                # leaning over this part: push that door up into its stop, then descend again
+                for door in overhanging:
+                    topped = self.toggler.toggle(self.joint_models[door], True, raised=True)
+                    peak, sim_time = max(peak, topped.peak_force), sim_time + topped.sim_time
+                    wall_time += topped.wall_time
             if attempt < self.config.max_retries and is_door:
                 door_at = self._fraction_open(marker)  # a failed try may leave a door part-way: see where
                 # part-way and unseen: a pinch would descend onto it (195 N); it is pushed up under its plate
@@ -206,6 +226,26 @@ class TwinWorld:
             )
         )  # fmt: skip
         return outcome
+
+    def _doors_overhanging(self, marker: int, opening: bool) -> list[int]:
+        """The other doors that may stand open (believed open, or left part-way by a failed try) over where
+        ``marker``'s part is grasped (:mod:`skills.door_clearance`): its descents are then made slowly and
+        stopped at a light touch."""
+        jm = self.joint_models[marker]
+        grasp = jm.grasp_point_at(0.0 if opening else 1.0)
+        doors = []
+        for other, state in zip(self.markers, self.states, strict=True):
+            if other == marker or kind_of(self.marker_map, other) != "door":
+                continue
+            if other in self.unsettled:
+                lowest = self.toggler.config.blocked_progress
+            elif state == 1:
+                lowest = self.config.open_door_from
+            else:
+                continue
+            if near_open_door(self.joint_models[other], lowest, grasp, self.config.door_clearance):
+                doors.append(other)
+        return doors
 
     def _door_stayed_shut(self, outcome: TryResult) -> bool:
         """Whether a pinch that carried its fingers the whole way left a door seen shut (its marker where
@@ -268,6 +308,13 @@ class TwinWorld:
         stands edge-on), a closed one did not come back; the arm out of reach leaves the primitive's
         verdict standing."""
         seen = self.survey.close_up(marker, self.closed_poses[marker], self.lid_height)
+        is_door = kind_of(self.marker_map, marker) == "door"
+        if seen is None and opening and is_door and self.survey.last_close_up_reached:
+            # from straight above, a door raised 20-50 deg shows its marker tilted and offset (often not read):
+            # from over its hinge side a door short of ~50 deg is seen, one standing open is not
+            at = self._fraction_open(marker)
+            if at is not None:
+                return self._door_verdict(at, opening)
         if seen is None:
             if (opening and unseen_moved) or not self.survey.last_close_up_reached:
                 return TryResult("moved")
@@ -280,18 +327,22 @@ class TwinWorld:
         having left its closed pose (``MOVED_DISTANCE``, ``MOVED_ANGLE``) or not."""
         if kind_of(self.marker_map, marker) == "door":
             at = self.joint_models[marker].fraction_between(self._closed_point(marker), seen.T_base_marker[:3, 3])
-            c = self.toggler.config
-            if (at >= c.moved_fraction) if opening else (at <= 1.0 - c.moved_fraction):
-                return TryResult("moved")
-            if opening and at < c.blocked_progress:
-                return TryResult("failed", f"{DOOR_STAYED} ({at:.0%} of its travel)")
-            return TryResult("failed", f"SlipDetected: the door stands at {at:.0%} of its travel")
+            return self._door_verdict(at, opening)
         delta = seen.planar_pose - self.closed_poses[marker]
         turn = abs((delta[2] + math.pi) % (2 * math.pi) - math.pi)
         away = bool(np.linalg.norm(delta[:2]) > MOVED_DISTANCE or turn > MOVED_ANGLE)
         if away == opening:
             return TryResult("moved")
         return TryResult("failed", "SlipDetected: the handle moved but the marker did not")
+
+    def _door_verdict(self, at: float, opening: bool) -> TryResult:
+        """Whether a door seen at fraction ``at`` of its travel reached its other state."""
+        c = self.toggler.config
+        if (at >= c.moved_fraction) if opening else (at <= 1.0 - c.moved_fraction):
+            return TryResult("moved")
+        if opening and at < c.blocked_progress:
+            return TryResult("failed", f"{DOOR_STAYED} ({at:.0%} of its travel)")
+        return TryResult("failed", f"SlipDetected: the door stands at {at:.0%} of its travel")
 
     def ground_truth_name(self, index: int) -> str:
         """For logs: the spec name of component ``index`` when given, else its marker id."""

@@ -3,14 +3,15 @@
 A *try* starts when a component that no lock rule holds leaves its rest position (by more than
 :data:`START_FRACTION` of its travel). At that moment, with probability ``p`` (one draw per try), the
 component jams: its latch constraint holds it where it stands, exactly as a lock would, so the robot
-feels it blocked. The try ends once the gripper has touched none of the component's handle for
-``release_after`` seconds: a jam is then released and the component's rest position becomes wherever
-it now is. All draws come from one generator, in the order tries start, so a session stays a pure
-function of its seed and commands.
+feels it blocked. The try ends once the gripper has touched none of the component (its handle, or its
+plate that a push presses on) for ``release_after`` seconds: a jam is then released and the component's
+rest position becomes wherever it now is. All draws come from one generator, in the order tries start,
+so a session stays a pure function of its seed and commands.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import mujoco
@@ -26,19 +27,20 @@ class Jams:
     def __init__(
         self,
         model: mujoco.MjModel,
-        handle_geoms: np.ndarray,
+        part_geoms: Sequence[Sequence[int]],
         gripper_bodies: np.ndarray,
         travel: np.ndarray,
         probability: float,
         release_after: float,
     ) -> None:
         self._geom_component = np.full(model.ngeom, -1, dtype=np.int64)
-        self._geom_component[handle_geoms] = np.arange(len(handle_geoms))
+        for c, geoms in enumerate(part_geoms):  # (keyed on the handle alone, a door pushed shut by its plate
+            self._geom_component[np.asarray(geoms, dtype=np.int64)] = c  # drew a new jam every 0.5 s of the push)
         self._gripper_geom = np.isin(model.geom_bodyid, gripper_bodies)
         self._threshold = START_FRACTION * np.abs(travel)
         self.probability = probability
         self.release_after = release_after
-        n = len(handle_geoms)
+        n = len(part_geoms)
         self.jammed = np.zeros(n, dtype=bool)
         self._in_try = np.zeros(n, dtype=bool)
         self._rest = np.zeros(n)
@@ -52,7 +54,7 @@ class Jams:
         self._last_contact[:] = 0.0
 
     def touched(self, data: mujoco.MjData) -> np.ndarray:
-        """Which components' handles the gripper touches now."""
+        """Which components the gripper touches now."""
         touched = np.zeros(len(self.jammed), dtype=bool)
         if data.ncon:
             geoms = data.contact.geom[: data.ncon]

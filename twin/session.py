@@ -183,8 +183,9 @@ class TwinSession:
         self.jams: Jams | None = None
         if r.physics.jam_probability > 0:
             gripper_bodies = subtree_bodies(m, gripper_body)
+            part_geoms = [np.flatnonzero(m.geom_bodyid == m.body(c.body).id) for c in component_names]
             self.jams = Jams(
-                m, handle_geoms, gripper_bodies, self.travel, r.physics.jam_probability, r.physics.jam_release_after
+                m, part_geoms, gripper_bodies, self.travel, r.physics.jam_probability, r.physics.jam_release_after
             )
         self._plain = self.ft.sample_steps == 0 and self.servos.immediate
         self._dt = float(m.opt.timestep)  # [s] read every run: a model attribute costs a binding call

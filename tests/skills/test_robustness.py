@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from world_fixtures import twin_world
+from world_fixtures import TrueForceWatch, twin_world
 
 from learning import OracleAgent, run_episode
 from models import Goal, Robot
@@ -19,7 +19,7 @@ from skills import MarkerDetector, joint_model, lid_height, select_markers, upri
 from skills.primitives import PrimitiveConfig, Toggler
 from skills.twin_world import TwinWorld
 from twin.nominal_calibration import nominal_calibration
-from twin.reality import PhysicsReality, RealityProfile
+from twin.reality import ArmReality, ForceTorqueReality, PhysicsReality, RealityProfile
 from twin.session import TwinSession
 
 
@@ -62,6 +62,27 @@ def test_a_toggle_with_the_wrong_kind_is_stopped_below_the_force_limit():
         result = Toggler(session.robot).toggle(jm)
         assert result.outcome in ("blocked", "failed")
         assert max(result.forces, default=0.0) < limit + 5.0
+
+
+def test_a_cautious_descent_meets_a_part_in_its_way_at_a_light_touch():
+    """A pad landing on the top of a handle post (the fingers 23 mm off along their closing axis): at the normal
+    pace the guard stops the descent at the 60 N limit, the true force past it; a cautious descent (beside a
+    door that may stand open) stops at ``cautious_contact_force`` with the true force well under half that."""
+    spec = generate_chain(["slide", "door"], seed=2)
+    true_peak, reasons = {}, {}
+    for cautious in (False, True):
+        with TwinSession(spec, seed=0) as session:
+            jm = _joint_models(session)[spec.components[0].name]
+            shift = 0.023 * jm.motion_direction(0.0)  # the slide's fingers close along its motion
+            on_post = replace(jm, grasp_point=jm.grasp_point + shift, origin=jm.origin + shift)
+            watch = TrueForceWatch(session.robot, session)
+            result = Toggler(watch).toggle(on_post, cautious=cautious)
+            assert result.outcome == "failed" and result.reason.endswith("while descending, motion stopped")
+            assert session.component_states()[0] == 0
+            true_peak[cautious], reasons[cautious] = watch.peak, result.reason
+    config = PrimitiveConfig()
+    assert f"> {config.cautious_contact_force:.0f} N" in reasons[True]
+    assert true_peak[True] < config.cautious_contact_force + 15.0 < config.force_limit < true_peak[False]
 
 
 def test_a_box_far_from_the_overview_camera_is_found_and_solved_end_to_end():
@@ -232,19 +253,47 @@ def test_a_door_left_part_way_open_is_pushed_on_from_where_it_stands():
         assert result.peak_force < PrimitiveConfig().force_limit
 
 
-def test_a_door_left_short_of_its_end_stop_is_pushed_into_it_under_its_plate():
+@pytest.mark.parametrize("degrees", [72.0, 50.0])
+def test_a_door_left_short_of_its_end_stop_is_pushed_into_it_under_its_plate(degrees):
     """A door let go short of its 85 deg stop sinks under its own weight over its neighbour (78 -> 66 deg in
     45 s under the harsh grip), where the next descent lands on it. Where it stands is not seen (its handle hides
-    its marker), so the pads come in under the plate from outside its reach and turn it into its stop."""
+    its marker), so the pads come in under the plate from outside its reach and turn it into its stop. At 50
+    deg, the lowest it is placed for, the plate's free edge stands just above the pads' entry height: they
+    meet it side-on, diving under it (at their entry height they pressed a door at 47 deg down to 43 deg, and
+    under the harsh profile one at 49 deg on its end face, along the plate into the hinge, at 90 N)."""
     spec = placed(paper_family("test", seed=0)[0], (0.38, 0.12, -0.9))  # not the placement of the tests above
     with TwinSession(spec, seed=0) as session:
         world = twin_world(session)
         door = spec.index_of("door-0")
         angle = session.component_qpos[door]
-        session.data.qpos[angle] = np.radians(72.0)
+        session.data.qpos[angle] = np.radians(degrees)
         session.robot.wait(0.5)
-        assert np.degrees(session.data.qpos[angle]) < 75.0
+        assert np.degrees(session.data.qpos[angle]) < degrees + 3.0
         marker = spec.components[door].marker
         result = world.toggler.toggle(world.joint_models[marker], opening=True, raised=True)
         assert result.outcome == "moved" and np.degrees(session.data.qpos[angle]) > 83.0
         assert result.peak_force < PrimitiveConfig().force_limit
+
+
+def test_a_door_held_open_is_pushed_shut_in_vain_under_the_force_limit():
+    """A door that jams as soon as it moves (a sticky hinge, every try), pushed shut by the pads' edges on its
+    plate, with the F/T reading 30 ms late and commands 10 ms late: the push ends blocked or failed, the door
+    where it stood, the true wrist force under the limit (~30 N here)."""
+    sticky = RealityProfile(
+        name="sticky-and-late",
+        force_torque=ForceTorqueReality(rate_hz=100.0, delay=0.030),
+        arm=ArmReality(command_latency=0.010),
+        physics=PhysicsReality(jam_probability=1.0),
+    )
+    spec = placed(paper_family("test", seed=0)[0], (0.45, -0.15, 2.2))
+    with TwinSession(spec, seed=0, reality=sticky) as session:
+        world = twin_world(session)
+        door = spec.index_of("door-0")
+        angle = session.component_qpos[door]
+        session.data.qpos[angle] = np.radians(84.0)
+        session.robot.wait(1.0)  # (the jam this move started is released half a second after it)
+        watch = TrueForceWatch(session.robot, session)
+        world.toggler.robot = watch
+        result = world.toggler.toggle(world.joint_models[spec.components[door].marker], opening=False)
+        assert result.outcome in ("blocked", "failed") and np.degrees(session.data.qpos[angle]) > 75.0, result
+        assert watch.peak < PrimitiveConfig().force_limit, watch.peak_during

@@ -8,10 +8,12 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 
-from _twin_trial import evaluation_world  # noqa: E402  (scripts/ is not a package)
+from _twin_trial import TrueForceWatch, evaluation_world  # noqa: E402  (scripts/ is not a package)
 
 from skills.twin_world import TwinWorld  # noqa: E402
 from twin.session import TwinSession  # noqa: E402
+
+__all__ = ["TrueForceWatch", "twin_world"]
 
 
 def twin_world(session: TwinSession, seed: int = 0) -> TwinWorld:

@@ -486,20 +486,23 @@ def contacts(time: float, *pairs: tuple[int, int]) -> types.SimpleNamespace:
 
 @pytest.fixture(scope="module")
 def jam_parts():
-    """Handle geoms, gripper bodies, travel, door-0's index, its handle and a gripper geom, a floor geom."""
+    """Each component's geoms, gripper bodies, travel, door-0's index, its handle and a gripper geom, a floor geom,
+    door-0's plate."""
     with session() as s:
         m, names = s.model, s.scene.names
+        parts = [np.flatnonzero(m.geom_bodyid == m.body(names.components[c.name].body).id) for c in SPEC.components]
         handles = np.array([m.geom(names.components[c.name].handle).id for c in SPEC.components])
         gripper = subtree_bodies(m, m.body("xarm7/gripper/xarm_gripper_base_link").id)
         pad = int(np.flatnonzero(np.isin(m.geom_bodyid, gripper))[0])
         floor = int(np.flatnonzero(m.geom_bodyid == 0)[0])
         door = SPEC.index_of("door-0")
-        return handles, gripper, s.travel.copy(), door, int(handles[door]), pad, floor, m
+        plate = m.geom(f"{names.components['door-0'].body}:plate").id
+        return parts, gripper, s.travel.copy(), door, int(handles[door]), pad, floor, m, plate
 
 
 def test_a_jam_holds_while_the_gripper_touches_the_handle_and_ends_half_a_second_after_it_lets_go(jam_parts):
-    handles, gripper, travel, door, handle, pad, floor, model = jam_parts
-    jams = Jams(model, handles, gripper, travel, probability=1.0, release_after=0.5)
+    parts, gripper, travel, door, handle, pad, floor, model, _ = jam_parts
+    jams = Jams(model, parts, gripper, travel, probability=1.0, release_after=0.5)
     held = np.array([c != door for c in range(len(SPEC.components))])  # door-0 free, the others latched
     rest = np.zeros(len(SPEC.components))
     jams.reset(np.random.default_rng(0), rest)
@@ -519,9 +522,24 @@ def test_a_jam_holds_while_the_gripper_touches_the_handle_and_ends_half_a_second
     assert jams.update(contacts(2.125), moved + 0.1, held) and jams.jammed[door]  # moved on: a new try
 
 
+def test_a_door_pushed_by_its_plate_is_in_one_try_for_as_long_as_the_push_lasts(jam_parts):
+    parts, gripper, travel, door, _, pad, _, model, plate = jam_parts
+    jams = Jams(model, parts, gripper, travel, probability=0.5, release_after=0.5)
+    held = np.array([c != door for c in range(len(SPEC.components))])
+    draws = []
+    for seed in range(40):
+        jams.reset(np.random.default_rng(seed), np.zeros(len(SPEC.components)))
+        for k in range(1, 41):  # a 4 s push on the plate that turns the door on and on
+            jams.update(contacts(0.1 * k, (plate, pad)), np.full(len(SPEC.components), 0.05 * k), held)
+        draws.append(jams._rng.bit_generator.state["state"]["state"])
+        fresh = np.random.default_rng(seed)
+        fresh.random()  # exactly one draw: the try that began with the push
+        assert draws[-1] == fresh.bit_generator.state["state"]["state"]
+
+
 def test_a_component_jams_on_about_a_fraction_p_of_its_tries(jam_parts):
-    handles, gripper, travel, door, handle, pad, _, model = jam_parts
-    jams = Jams(model, handles, gripper, travel, probability=0.5, release_after=0.5)
+    parts, gripper, travel, door, handle, pad, _, model, _ = jam_parts
+    jams = Jams(model, parts, gripper, travel, probability=0.5, release_after=0.5)
     held = np.array([c != door for c in range(len(SPEC.components))])
     rest = np.zeros(len(SPEC.components))
     jammed = []
