@@ -285,6 +285,9 @@ class DoorPushing:
                 break
         if result is None:
             result = self._verdict(progress, forces, PUSHED_IN_VAIN)
+        # off the plate along its normal before letting go: held pressed on a latched plate (the command runs
+        # ``lead`` into it) while the gripper opened, a harsh latch's play built 65 N on the wrist
+        self._back_off(door, (1.0 - max(progress, 0.0)) * door.travel + math.pi / 2)
         self.phase = "retreating"
         self._let_go_and_retreat()
         self.phase = "moving"
@@ -417,8 +420,9 @@ class DoorPushing:
         return self._verdict(progress, forces)  # a latch was decided on the way: short of it, no evidence
 
     def _back_off(self, door: DoorPush, angle: float) -> None:
-        """Take the pad off the handle's face (along its normal) before lifting: pressed on, it would drag
-        the handle up with it."""
+        """Take the pad off the handle's face (along its normal, :meth:`DoorPush.face_normal` at ``angle``; a
+        quarter turn more is the plate's top face) before lifting: pressed on, it would drag the handle up with
+        it."""
         c = self.config
         p = c.push
         away = self.robot.tcp_pose_in_base()

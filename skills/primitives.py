@@ -7,7 +7,9 @@ and retreats. A door whose handle the pads could not hold is then pushed, in the
 (:mod:`skills.door_push`; ``door_push``): a door's handle moves along its own post, so pinching it moves the
 door by pad friction alone, which a weak grip does not give (harsh profile: 12 of 60 trials ended with the
 handle slipping out). A pushed door opens under the inner face of a finger pad pressed on the back of its
-handle, and closes under the pads' edges pressed on its plate.
+handle, and closes under the pads' edges pressed on its plate; doors are always shut that way
+(``push.close_by_push``). Beside a door that may stand open over the part (``cautious``), descents are slow
+and stop at a light touch (:mod:`skills.door_clearance`).
 
 Motion is differential IK on the robot-only model at a 10 ms control tick, targets sent to the position
 servos. The wrist wrench is read every tick and filtered (a running median over
