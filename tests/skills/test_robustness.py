@@ -85,6 +85,22 @@ def test_a_cautious_descent_meets_a_part_in_its_way_at_a_light_touch():
     assert true_peak[True] < config.cautious_contact_force + 15.0 < config.force_limit < true_peak[False]
 
 
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_cautious_descent_is_not_stopped_by_sensor_noise(seed):
+    """At 7 N of F/T force noise the 15 N stop of a cautious descent is passed by noise alone (both seeds here
+    stop with nothing in the way when it is fixed); the stop rises with the noise measured as the arm comes to
+    rest above the part, and the free part is moved."""
+    noisy = RealityProfile(name="noisy-ft", force_torque=ForceTorqueReality(force_noise=7.0))
+    spec = generate_chain(["slide", "door"], seed=2)
+    for margin, outcome in ((PrimitiveConfig().cautious_noise_margin, "moved"), (0.0, "failed")):
+        with TwinSession(spec, seed=seed, reality=noisy) as session:
+            jm = _joint_models(session)[spec.components[0].name]
+            toggler = Toggler(session.robot, replace(PrimitiveConfig(), cautious_noise_margin=margin))
+            result = toggler.toggle(jm, cautious=True)
+            assert result.outcome == outcome, result
+            assert toggler.force_noise() == pytest.approx(7.0, rel=0.2)
+
+
 def test_a_box_far_from_the_overview_camera_is_found_and_solved_end_to_end():
     spec = paper_family("test")[1]
     spec = replace(spec, box=replace(spec.box, pose=(0.3083, 0.1521, 0.2397)))  # corner of the workspace
