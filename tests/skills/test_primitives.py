@@ -80,3 +80,57 @@ def test_ik_reaches_targets_over_the_box_to_a_millimetre():
         q = ik.solve(top_down(np.array(target), 0.3))
         ik.set_joints(q)
         assert np.linalg.norm(ik.tcp_pose()[:3, 3] - target) < 0.001
+
+
+class _HeldTCP:
+    """A robot whose TCP is held by a spring along base x (fingers closed on a handle that jammed): the
+    wrist force is ``stiffness`` times the TCP's displacement from ``neutral`` [N], the servos ideal."""
+
+    def __init__(self, stiffness: float, stretch: float) -> None:
+        self.kinematics = ArmKinematics()
+        self.q = solve_reachable(self.kinematics)
+        self.kinematics.set_joints(self.q)
+        self.neutral = self.kinematics.tcp_pose()[0, 3] - stretch
+        self.stiffness = stiffness
+        self.time = 0.0
+
+    def tcp_pose_in_base(self) -> np.ndarray:
+        self.kinematics.set_joints(self.q)
+        return self.kinematics.tcp_pose()
+
+    def wrench(self) -> np.ndarray:  # the spring pulls the TCP back towards neutral
+        return np.array([-self.stiffness * (self.tcp_pose_in_base()[0, 3] - self.neutral), 0, 0, 0, 0, 0])
+
+    def ft_rotation_in_base(self) -> np.ndarray:
+        return np.eye(3)
+
+    def joint_positions(self) -> np.ndarray:
+        return self.q.copy()
+
+    def joint_limits(self) -> np.ndarray:
+        return np.array([[-6.3, 6.3]] * 7)
+
+    def command_joint_positions(self, q: np.ndarray) -> None:
+        self.q = np.array(q, dtype=float)
+
+    def wait(self, seconds: float) -> None:
+        self.time += seconds
+
+
+def solve_reachable(kinematics: ArmKinematics) -> np.ndarray:
+    return kinematics.solve(top_down(np.array([0.45, 0.0, 0.2]), 0.0))
+
+
+def test_a_withdrawal_backs_off_a_held_grip_only_until_the_load_is_relieved():
+    """Stopped with 60 N on a grip that a jam holds (3 mm of stretch), the arm backs off along the load and
+    stops there: carried the whole ``relieve_distance`` (5 mm) it would push the held handle 2 mm the other
+    way (-40 N)."""
+    robot = _HeldTCP(stiffness=20_000.0, stretch=0.003)
+    toggler = Toggler(robot)
+    toggler.guard = False  # as in a withdrawal
+    for _ in range(toggler.config.force_filter_samples):
+        toggler._sense()
+    assert np.linalg.norm(toggler.force_in_base) == pytest.approx(60.0, rel=0.02)
+    toggler._relieve()
+    load = robot.wrench()[0]
+    assert abs(load) < 10.0, load
