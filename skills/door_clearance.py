@@ -32,7 +32,22 @@ def door_overhang(door: JointModel, from_fraction: float) -> tuple[float, float]
     that the flap and handle of ``door`` cover from above, standing anywhere between ``from_fraction`` of its
     travel and its end stop. Along the hinge it covers the flap's width, ``DOOR_HALF`` either side of the
     handle."""
+    return _overhang(DoorPush.of(door, 0.0), door.travel, from_fraction)
+
+
+def near_open_door(door: JointModel, from_fraction: float, point: np.ndarray, radius: float) -> bool:
+    """Whether ``point`` [m] comes within ``radius`` [m], horizontally, of the floor space ``door`` may
+    overhang standing between ``from_fraction`` of its travel and its end stop (:func:`door_overhang`)."""
     push = DoorPush.of(door, 0.0)
+    low, high = _overhang(push, door.travel, from_fraction)
+    d = point - push.origin
+    u, v = float(d @ push.e_x), abs(float(d @ push.axis))
+    du = max(low - u, 0.0, u - high)
+    dv = max(v - DOOR_HALF, 0.0)
+    return math.hypot(du, dv) < radius
+
+
+def _overhang(push: DoorPush, travel: float, from_fraction: float) -> tuple[float, float]:
     free_edge = push.contact[0] + HANDLE_MARGIN - HANDLE_SIZE / 2
     handle_back = push.contact[0]
     handle_front = handle_back - HANDLE_SIZE
@@ -41,23 +56,11 @@ def door_overhang(door: JointModel, from_fraction: float) -> tuple[float, float]
     corners = ((0.0, bottom), (0.0, push.plate_top), (free_edge, bottom), (free_edge, push.plate_top),
                (handle_front, top), (handle_back, top))  # fmt: skip
     low, high = math.inf, -math.inf
-    for angle in np.linspace(from_fraction * door.travel, door.travel, SAMPLED_ANGLES):
+    for angle in np.linspace(from_fraction * travel, travel, SAMPLED_ANGLES):
         c, s = math.cos(angle), math.sin(angle)
         for x, z in corners:
             low, high = min(low, x * c - z * s), max(high, x * c - z * s)
     return low, high
-
-
-def near_open_door(door: JointModel, from_fraction: float, point: np.ndarray, radius: float) -> bool:
-    """Whether ``point`` [m] comes within ``radius`` [m], horizontally, of the floor space ``door`` may
-    overhang standing between ``from_fraction`` of its travel and its end stop (:func:`door_overhang`)."""
-    push = DoorPush.of(door, 0.0)
-    low, high = door_overhang(door, from_fraction)
-    d = point - push.origin
-    u, v = float(d @ push.e_x), abs(float(d @ push.axis))
-    du = max(low - u, 0.0, u - high)
-    dv = max(v - DOOR_HALF, 0.0)
-    return math.hypot(du, dv) < radius
 
 
 __all__ = ["door_overhang", "near_open_door"]

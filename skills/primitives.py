@@ -47,6 +47,12 @@ from skills.kinematics import ArmKinematics, top_down
 from skills.toggle_result import ToggleResult
 
 SLIPPED_OFF = "latched: held until the grasp slipped"
+INCOMPLETE_TRAVEL = "IncompleteTravel"
+"""Reason prefix of a motion that ran its course short of ``moved_fraction`` (no latch read)."""
+STOPPED = "motion stopped"
+"""End of the reason of a motion the force guard stopped: ``... while <phase>, motion stopped``."""
+STOPPED_DESCENDING = f"while descending, {STOPPED}"
+"""End of the reason of a try the force guard stopped on the way down onto the handle."""
 PADS_LOST_HOLD = ("SlipDetected", "GraspFailure", SLIPPED_OFF)
 """Reasons of a pinch that ended for want of a hold on the handle (it slipped out, the grasp closed on nothing,
 or the part held until the pads slid off: a latch, or a door heavier than the grip holds). A door is then
@@ -233,7 +239,7 @@ class Toggler(DoorPushing):
         self.peak_force = max(self.peak_force, magnitude)
         if self.guard and magnitude > self.limit:
             raise ForceLimitExceeded(
-                f"force limit: {magnitude:.0f} N > {self.limit:.0f} N while {self.phase}, motion stopped"
+                f"force limit: {magnitude:.0f} N > {self.limit:.0f} N while {self.phase}, {STOPPED}"
             )
 
     def force_noise(self) -> float:
@@ -388,7 +394,7 @@ class Toggler(DoorPushing):
         marker). A door seen lower is left to a retry's push from where it stands: under a plate that low
         the top-up's pads pass over it and read "moved"."""
         result = self._push(jm, opening, covered)
-        if opening and self.config.push.top_up and result.reason.startswith("IncompleteTravel"):
+        if opening and self.config.push.top_up and result.reason.startswith(INCOMPLETE_TRAVEL):
             if where_is is not None and where_is() is not None:
                 return result
             topped = self._attempt(lambda: self._top_up_door(jm))
@@ -442,14 +448,14 @@ class Toggler(DoorPushing):
         self.robot.command_gripper(c.pregrasp_closure)
         self.phase = "approaching"
         self.travel_to(above, c.approach_time)
-        noise = self.force_noise()
         self.robot.tare()  # fingers open, arm still: the load of the gripper alone
         self._force_window.clear()  # older samples were taken with another zero
         self.phase = "descending"
         if not self.cautious:
             self.move_to(target, c.descend_time)
             return
-        self.limit = max(c.cautious_contact_force, c.cautious_noise_margin * noise)
+        # (the raw samples kept are all from before the tare: coming to rest above the part)
+        self.limit = max(c.cautious_contact_force, c.cautious_noise_margin * self.force_noise())
         try:
             self.move_to(target, c.cautious_descend_time)
         finally:
@@ -550,7 +556,7 @@ class Toggler(DoorPushing):
         if latched is not None and progress < c.blocked_progress and peak >= c.push_force:
             return ToggleResult("blocked", latched, progress, peak, forces=forces)
         return ToggleResult(
-            "failed", f"IncompleteTravel: only {progress:.0%} of the travel covered", progress, peak, forces=forces
+            "failed", f"{INCOMPLETE_TRAVEL}: only {progress:.0%} of the travel covered", progress, peak, forces=forces
         )
 
     def _check_grip(self, progress: float) -> None:

@@ -38,15 +38,13 @@ from models.robot import Robot
 from skills.door_clearance import near_open_door
 from skills.joint_model import JointModel, joint_model
 from skills.perception import MarkerDetection, MarkerDetector, kind_of, lid_height, upright_pose
-from skills.primitives import Toggler, ToggleResult
+from skills.primitives import STOPPED_DESCENDING, Toggler, ToggleResult
 from skills.scene_survey import SceneSurvey, SurveyConfig
 
 MOVED_DISTANCE = 0.01
 """A re-observed marker this far from its closed pose has moved [m]..."""
 MOVED_ANGLE = math.radians(20)
 """... or turned this much [rad]."""
-STOPPED_DESCENDING = "while descending, motion stopped"
-"""End of the reason of a try the force guard stopped on the way down onto the handle."""
 DOOR_STAYED = "SlipDetected: the door stayed shut"
 """Reason of a try whose fingers went the whole way while the door's marker stayed at its closed pose."""
 
