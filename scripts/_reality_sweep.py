@@ -255,7 +255,8 @@ def plot(summary: dict[str, Any], path: Path) -> None:
         ax.set_xlabel("level (0 ideal, 1 realistic, 2 harsh)")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=7)
+    if series:  # (a summary written before any factor's trial ended has none)
+        axes[0].legend(fontsize=7)
     ax = axes[-1]
     noise = sorted((p for p in summary["points"] if p["series"] == FORCE_NOISE_SERIES), key=lambda p: p["level"])
     if noise:
