@@ -118,6 +118,10 @@ class PrimitiveConfig:
     15 N of noise a fixed 5 N let the noise walk the path 3 cm off the arc (68 N on the wrist)."""
     comply_limit: float = 0.03
     """Farthest the path yields across itself [m]."""
+    comply_return_time: float = 0.25
+    """Time constant of a door path's return to the planned arc past the end of the travel [s]: yielding on into
+    the end stop hid the load that tells a door is open (a top-up push then took 17 s more), and an offset kept
+    there met the stop with 71 N (F/T delayed 30 ms)."""
     release_time: float = 0.4
     retreat_time: float = 0.8
     lift_time: float = 0.8
@@ -209,6 +213,8 @@ class PrimitiveConfig:
                 "comply_gain [m/(N s)], comply_deadband [N], comply_noise_margin and comply_limit [m] must be >= 0,"
                 f" got {self.comply_gain}, {self.comply_deadband}, {self.comply_noise_margin}, {self.comply_limit}"
             )
+        if self.comply_return_time < self.tick:
+            raise ValueError(f"comply_return_time must be >= tick [s], got {self.comply_return_time}")
         if not 0.0 < self.cautious_contact_force < self.force_limit:
             raise ValueError(
                 "need 0 < cautious_contact_force < force_limit [N], got "
@@ -545,8 +551,10 @@ class Toggler(DoorPushing):
             self._tick(target)
             direction = sign * jm.motion_direction(fraction)
             opposing = float(-np.dot(self.force_in_base, direction))
-            if jm.kind == "door":  # (slides and wheels yielding too were read latched while free)
+            if jm.kind == "door" and s <= 1.0:  # (slides and wheels yielding too were read latched while free)
                 across = self._yield_across(across, direction)
+            elif s > 1.0:  # back to the planned arc past the travel: the end stop's load tells the door is open
+                across = across * (1.0 - c.tick / c.comply_return_time)
             forces.append(opposing)
             progress = self.progress = self._progress(jm, sign, begin)
             if opposing >= max(forces):
