@@ -240,7 +240,7 @@ class Toggler(DoorPushing):
         self._joint_limits = tuple(robot.joint_limits().T)  # (low, high) [rad]: an arm's servo ranges are fixed
         self._force_window: collections.deque[np.ndarray] = collections.deque(maxlen=self.config.force_filter_samples)
         self._raw_forces: collections.deque[np.ndarray] = collections.deque(maxlen=self.config.noise_samples)
-        """The last raw wrist forces in the base frame [N]: how noisy the sensor is, for a cautious descent."""
+        """The last raw wrist forces in the base frame [N]: how noisy the sensor is (:attr:`rest_noise`)."""
         self.force_in_base = np.zeros(3)
         """The filtered wrist force after the last tick, in the base frame [N]."""
         self.phase = "moving"
@@ -540,6 +540,8 @@ class Toggler(DoorPushing):
         progress_at_peak = 0.0
         in_end_stop = False  # felt the door reach its end stop: open, whatever the pads do next
         across = np.zeros(3)  # the path's offset across itself, yielding to the load there [m, base frame]
+        yields = jm.kind == "door"  # (slides and wheels yielding too were read latched while free)
+        returning = 1.0 - c.tick / c.comply_return_time  # the offset kept per tick past the travel
         self.ik.set_joints(self.robot.joint_positions())
         for k in range(1, last_tick + 1):
             paced = pace * c.breakaway_pace * k if k <= slow else c.breakaway_fraction + pace * (k - slow)
@@ -551,10 +553,8 @@ class Toggler(DoorPushing):
             self._tick(target)
             direction = sign * jm.motion_direction(fraction)
             opposing = float(-np.dot(self.force_in_base, direction))
-            if jm.kind == "door" and s <= 1.0:  # (slides and wheels yielding too were read latched while free)
-                across = self._yield_across(across, direction)
-            elif s > 1.0:  # back to the planned arc past the travel: the end stop's load tells the door is open
-                across = across * (1.0 - c.tick / c.comply_return_time)
+            if yields:  # past the travel, back to the planned arc: the end stop's load tells the door is open
+                across = self._yield_across(across, direction) if s <= 1.0 else across * returning
             forces.append(opposing)
             progress = self.progress = self._progress(jm, sign, begin)
             if opposing >= max(forces):
