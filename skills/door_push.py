@@ -46,7 +46,11 @@ class DoorPushConfig:
     keeps the pad on the face."""
     contact_force: float = 3.0
     """Normal force on the handle's back face that means the pad is pressing on it [N] (10 sigma of the harsh
-    F/T noise; a light free door may turn before it is felt: then no slide test is needed)."""
+    F/T noise; a light free door may turn before it is felt: then no slide test is needed)..."""
+    contact_noise_margin: float = 3.0
+    """... or this many times the noise of the filtered force (:meth:`Toggler.filtered_noise_now`), if larger:
+    at 15 N of F/T noise the noise alone passed 3 N before the pads met a door latched open, its push was then
+    counted from there and had gone past ``blocked_progress`` when the plate pressed back (64 N)."""
     slide_turn: float = math.radians(7.0)
     """Turn of the pad since it first pressed after which a face that turned less than half as much means
     the pad is sliding along a latched handle [rad] (a jammed door: the pad slid ~12 deg and over the post)."""
@@ -59,15 +63,15 @@ class DoorPushConfig:
     (at 45 mm a jammed door put 170 N on the wrist before the guard could stop the arm)."""
     close_time: float = 4.0
     """Time of a closing push [s] (~30 mm/s at the pads)."""
-    search_down_to: float = math.radians(50.0)
-    """Lowest angle at which a door believed open may stand [rad]: short of its stop it sinks under its own
-    weight (66 deg within 45 s), and a latch holds it wherever it was when engaged. Until the pads have pressed
-    on the plate or passed this angle, a closing push moves at ``search_speed``."""
     search_speed: float = 0.015
     """Speed of the pads along the arc while they search for the plate of a door that may stand below its stop
     [m/s]: a harsh door latched open at 71.5 deg, met at the schedule's ~40 mm/s, put 99 N on the wrist before
     the late reading passed ``blocked_force``; its progress, counted from where the pads began rather than
-    where they first pressed, had also passed ``blocked_progress``, so no latch was read."""
+    where they first pressed, had also passed ``blocked_progress``, so no latch was read. A door believed open
+    may stand anywhere: short of its stop it sinks under its own weight (66 deg within 45 s), a latch holds it
+    wherever it was when engaged, and one that fell shut is only met on the lid; until the pads have pressed on
+    the plate, a closing push moves at this speed all the way (searching down to 50 deg only, the pads met a
+    door fallen shut at ~40 mm/s with 72 N)."""
     end_force: float = 20.0
     """Force magnitude at which a door pushed most of the way closed is taken to lie on the lid and the push
     stops there [N] (pressed on by a TCP a few mm off, the lid put 80-130 N on the wrist)."""
@@ -242,10 +246,10 @@ class DoorPushing:
 
         self.phase = "actuating"
         lead = p.lead / (door.travel * p.close_x)
-        end = 1.0
-        ticks = round(p.close_time / c.tick)
-        search_step = p.search_speed * c.tick / (door.travel * p.close_x)  # per tick, as a fraction of the travel
-        search_end = 1.0 - p.search_down_to / door.travel
+        end = 1.0  # closed
+        ticks = round(p.close_time * self.slowdown / c.tick)
+        contact = max(p.contact_force, p.contact_noise_margin * self.filtered_noise_now())
+        search_step = p.search_speed / self.slowdown * c.tick / (door.travel * p.close_x)  # per tick, of the travel
 
         def scheduled(k: float) -> float:  # where the pads are sent at (schedule) tick k: slow onto the lid
             u = min(1.0, k / ticks)
@@ -262,24 +266,28 @@ class DoorPushing:
         while schedule < ticks + round(2 * c.settle_time / c.tick):
             k += 1
             step = 1.0
-            if pressed_from is None and scheduled(schedule) < search_end:
+            if pressed_from is None:
                 nominal = scheduled(schedule + 1.0) - scheduled(schedule)
                 step = min(1.0, search_step / nominal) if nominal > 0 else 1.0
             schedule += step
             s = min(scheduled(schedule), max(progress, start) + lead)
-            closing_in = max(0.0, 1.0 - k * c.tick / p.approach_time) * (p.gap + p.depth)  # onto the plate gently
+            closing_in = max(0.0, 1.0 - k * c.tick / (p.approach_time * self.slowdown)) * (p.gap + p.depth)
             self._tick(tcp_for(door.point_at((1.0 - s) * door.travel, on_plate + np.array([0.0, closing_in]))))
             turn = door.turn_of(self._pad_edge(door, p.pad_half_width))
             progress = self.progress = start + (turn_at_start - turn) / door.travel
             angle = (1.0 - max(progress, 0.0)) * door.travel
             forces.append(float(self.force_in_base @ door.motion_direction(angle)))  # opposing a closing motion
             magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
-            if pressed_from is None and forces[-1] > p.contact_force:
+            if pressed_from is None and forces[-1] > contact:
                 pressed_from = progress
-            if progress >= c.moved_fraction and magnitude > p.end_force:  # the plate is on the lid: stop
-                end = min(end, max(progress, c.moved_fraction))
+            if progress >= c.moved_fraction and magnitude > p.end_force:
+                # the plate is on the lid: stop at once. (Easing on to where the pads were, a door that fell
+                # shut and was met on the lid at 15 mm/s loaded the wrist by 5-8 N per tick to 71 N.)
+                break
             pushed = progress - (start if pressed_from is None else max(pressed_from, start))
-            if pushed < c.blocked_progress and (forces[-1] > c.blocked_force or magnitude > c.blocked_magnitude):
+            # (a door that fell shut ahead of the pads is first pressed on the lid: closed, not latched)
+            short = progress < c.moved_fraction and pushed < c.blocked_progress
+            if short and (forces[-1] > c.blocked_force or magnitude > c.blocked_magnitude):
                 result = ToggleResult("blocked", PUSHED_IN_VAIN, progress, max(forces),
                                       forces=forces)  # fmt: skip
                 break
@@ -326,7 +334,7 @@ class DoorPushing:
         finally:
             self.cautious = cautious
         self.phase = "actuating"
-        ticks = round(p.top_up_time / c.tick)
+        ticks = round(p.top_up_time * self.slowdown / c.tick)
         forces: list[float] = []
         edge_x = x_start
         self.ik.set_joints(self.robot.joint_positions())
@@ -368,14 +376,15 @@ class DoorPushing:
         x = door.contact[0] - p.depth
 
         def pressed(k: int) -> np.ndarray:  # the pad's point on the door at tick k: climbing the face at first
-            return np.array([x, door.contact[1] + p.climb * min(k * c.tick / p.climb_time, 1.0)])
+            return np.array([x, door.contact[1] + p.climb * min(k * c.tick / (p.climb_time * self.slowdown), 1.0)])
 
         def climb_turn(k: int) -> float:  # what the climb alone adds to the pad's turn about the hinge [rad]
             return math.atan2(pressed(k)[1], x) - math.atan2(door.contact[1], x)
 
         lead = p.lead / (door.travel * float(np.hypot(*door.contact)))
         end = 1.0 + p.overtravel
-        ticks = round(c.actuate_time / c.tick)
+        contact = max(p.contact_force, p.contact_noise_margin * self.filtered_noise_now())
+        ticks = round(c.actuate_time * self.slowdown / c.tick)
         forces: list[float] = []
         progress = 0.0
         pressed_at: tuple[float, float] | None = None  # (progress, face angle) when the pad first pressed
@@ -384,7 +393,7 @@ class DoorPushing:
         turn_at_start = door.turn_of(self._pad_edge(door, p.pad_offset))
         for k in range(1, ticks + 1 + round(2 * c.settle_time / c.tick)):
             s = min(start + (end - start) * min(1.0, k / ticks), max(progress, start) + lead)
-            closing_in = max(0.0, 1.0 - k * c.tick / p.approach_time) * (p.gap + p.depth)
+            closing_in = max(0.0, 1.0 - k * c.tick / (p.approach_time * self.slowdown)) * (p.gap + p.depth)
             self._tick(tcp_for(door.point_at(s * door.travel, pressed(k) + np.array([closing_in, 0.0]))))
             pad_edge = self._pad_edge(door, p.pad_offset)
             progress = self.progress = start + (door.turn_of(pad_edge) - turn_at_start - climb_turn(k)) / door.travel
@@ -395,7 +404,7 @@ class DoorPushing:
             if s > 1.0 and magnitude > c.overtravel_force:  # in the end stop: stop here
                 end = max(1.0, min(progress, s))
             face = door.angle_from_contact(pad_edge) / door.travel
-            if normal > p.contact_force:
+            if normal > contact:
                 last_pressed, last_face = progress, face
                 if pressed_at is None:
                     pressed_at = (progress, face)

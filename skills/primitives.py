@@ -13,7 +13,10 @@ and stop at a light touch (:mod:`skills.door_clearance`).
 
 Motion is differential IK on the robot-only model at a 10 ms control tick, targets sent to the position
 servos. The wrist wrench is read every tick and filtered (a running median over
-``force_filter_samples`` ticks, so no single noisy sample decides anything). While actuating, the
+``force_filter_samples`` ticks, so no single noisy sample decides anything). The sensor's noise is measured
+as the arm comes to rest above each part: a noisy sensor is tared on more readings (``tare_noise``), its median
+is longer (``filtered_noise``), and every motion in contact is slowed by the same ratio (:attr:`Toggler.slowdown`),
+so that a force rising against a stop builds no more during the longer median's delay. While actuating, the
 filtered force — rotated into the base frame, tared with the fingers open — is projected on the
 handle's direction of motion: if the force opposing the motion exceeds ``blocked_force`` while the
 measured progress is below ``blocked_progress``, the component is latched: the arm backs off to where
@@ -177,7 +180,25 @@ class PrimitiveConfig:
     """Time over which the closure's rise is measured [s]."""
     force_filter_samples: int = 5
     """Ticks in the running median of the wrench (5 x 10 ms: a 50 ms window, short beside the 0.13 s
-    it took the fastest latched attempt to build up force, long enough that no single sample decides)."""
+    it took the fastest latched attempt to build up force, long enough that no single sample decides)..."""
+    filtered_noise: float = 4.0
+    """... or more, up to ``force_filter_max_samples``, so that the median's noise stays under this [N per axis]
+    for the F/T force noise measured as the arm came to rest above the part: a median of n samples spreads
+    sqrt(pi/2)/sqrt(n) times the noise. Longer from 7.2 N of noise on (at 15 N: 23 ticks); with 5 ticks at 15 N
+    every toggle's filtered force passed ``blocked_force`` by noise alone and read latched (sweep: 0 of 3
+    solved)."""
+    tare_noise: float = 1.0
+    """Largest error of the F/T tare wanted [N per axis]: the tare averages ten readings, or as many as bring the
+    noise measured above the part under this (up to ``tare_max_samples``): at 15 N of noise ten readings left a
+    5 N bias per axis, which on top of a grasp's 21 N sideways load read a free wheel latched."""
+    tare_max_samples: int = 400
+    """Most readings a tare averages (a real sensor's bias reset samples at ~1 kHz: 0.4 s)."""
+    force_filter_max_samples: int = 30
+    """Longest running median of the wrench [ticks]. A longer median is later by half its growth, so every
+    motion in contact (descent, closing on the handle, actuation, pushes) is slowed by the same ratio
+    (:attr:`Toggler.slowdown`): a force rising against a stop then builds no more during the delay than it
+    does with the 5-tick median. At 15 N of noise a 23-tick median at full pace met a door shut on its lid
+    with 100 N (random agent)."""
     door_push: bool = True
     """Push a door (:mod:`skills.door_push`) when pinching its handle failed for want of a hold
     (:data:`PADS_LOST_HOLD`): a pinched post moves the door by pad friction alone, which a weak grip does not
@@ -196,8 +217,17 @@ class PrimitiveConfig:
     100-300 N that tore grasps off, and below the F/T range (150 N)."""
 
     def __post_init__(self) -> None:
-        if self.force_filter_samples < 1:
-            raise ValueError(f"force_filter_samples must be >= 1, got {self.force_filter_samples}")
+        if not 1 <= self.force_filter_samples <= self.force_filter_max_samples:
+            raise ValueError(
+                "need 1 <= force_filter_samples <= force_filter_max_samples [ticks], got "
+                f"{self.force_filter_samples}, {self.force_filter_max_samples}"
+            )
+        if self.filtered_noise <= 0.0 or self.tare_noise <= 0.0:
+            raise ValueError(
+                f"filtered_noise and tare_noise must be > 0 [N], got {self.filtered_noise}, {self.tare_noise}"
+            )
+        if self.tare_max_samples < TARE_SAMPLES:
+            raise ValueError(f"tare_max_samples must be >= {TARE_SAMPLES}, got {self.tare_max_samples}")
         if not 0.0 < self.blocked_force < self.blocked_magnitude < self.force_limit:
             raise ValueError(
                 "need 0 < blocked_force < blocked_magnitude < force_limit [N], got "
@@ -220,6 +250,13 @@ class PrimitiveConfig:
                 "need 0 < cautious_contact_force < force_limit [N], got "
                 f"{self.cautious_contact_force}, {self.force_limit}"
             )
+
+
+TARE_SAMPLES = 10
+"""Readings a tare averages at low noise (the :class:`models.robot.Robot` protocol's default)."""
+
+_MEDIAN_SPREAD = math.sqrt(math.pi / 2)
+"""Spread of the median of n samples of a Gaussian, times sqrt(n), over the samples' spread (large n)."""
 
 
 def _median_rows(rows: collections.abc.Sequence[np.ndarray]) -> np.ndarray:
@@ -260,6 +297,9 @@ class Toggler(DoorPushing):
         """The force guard's threshold now [N]: ``force_limit``, or ``cautious_contact_force`` in a cautious descent."""
         self.cautious = False
         """Whether the toggle in progress descends cautiously (``toggle(cautious=True)``)."""
+        self.slowdown = 1.0
+        """How much slower than configured the motions in contact of the toggle in progress run [-]: the
+        running median's length over ``force_filter_samples`` (1 below 7.2 N of F/T noise)."""
 
     # -- force -------------------------------------------------------------------------------------
     def reset_force_watch(self) -> None:
@@ -287,6 +327,24 @@ class Toggler(DoorPushing):
         if len(self._raw_forces) < 10:
             return 0.0
         return float(np.sqrt(np.mean(np.var(np.array(self._raw_forces), axis=0))))
+
+    def filter_samples(self, noise: float) -> int:
+        """Ticks in the running median of the wrench for an F/T force noise ``noise`` [N, rms per axis]:
+        ``force_filter_samples``, or as many as keep the median's noise under ``filtered_noise``."""
+        c = self.config
+        needed = math.ceil((_MEDIAN_SPREAD * noise / c.filtered_noise) ** 2)
+        return max(c.force_filter_samples, min(needed, c.force_filter_max_samples))
+
+    def filtered_noise_now(self) -> float:
+        """The noise of the filtered force in the toggle in progress [N per axis]: the F/T force noise measured
+        above the part through the running median of its length."""
+        return _MEDIAN_SPREAD * self.rest_noise / math.sqrt(self._force_window.maxlen or 1)
+
+    def tare_samples(self, noise: float) -> int:
+        """Readings a tare averages for an F/T force noise ``noise`` [N, rms per axis]: ten, or as many as keep
+        the tare's error under ``tare_noise``."""
+        c = self.config
+        return max(TARE_SAMPLES, min(math.ceil((noise / c.tare_noise) ** 2), c.tare_max_samples))
 
     def _clip(self, q: np.ndarray) -> np.ndarray:
         """``q`` within the servo ranges [rad] (``np.clip`` for finite ``q``, without its dispatch layers)."""
@@ -356,7 +414,7 @@ class Toggler(DoorPushing):
         """Ramp the gripper command from its pre-grasp closure to fully closed at ``close_speed``, then
         hold for ``close_time`` while the grip builds."""
         c = self.config
-        ramp = max(1, round((1.0 - c.pregrasp_closure) / c.close_speed / c.tick))
+        ramp = max(1, round((1.0 - c.pregrasp_closure) / c.close_speed * self.slowdown / c.tick))
         hold = self.ik.tcp_pose()
         for k in range(1, ramp + 1):
             self.robot.command_gripper(c.pregrasp_closure + (1.0 - c.pregrasp_closure) * k / ramp)
@@ -488,15 +546,17 @@ class Toggler(DoorPushing):
         self.phase = "approaching"
         self.travel_to(above, c.approach_time)
         self.rest_noise = self.force_noise()  # coming to rest above the part
-        self.robot.tare()  # fingers open, arm still: the load of the gripper alone
-        self._force_window.clear()  # older samples were taken with another zero
+        self.robot.tare(self.tare_samples(self.rest_noise))  # fingers open, arm still: the gripper's load alone
+        # older samples were taken with another zero; the window is as long as this noise needs
+        self._force_window = collections.deque(maxlen=self.filter_samples(self.rest_noise))
+        self.slowdown = self._force_window.maxlen / c.force_filter_samples
         self.phase = "descending"
         if not self.cautious:
-            self.move_to(target, c.descend_time)
+            self.move_to(target, c.descend_time * self.slowdown)
             return
         self.limit = max(c.cautious_contact_force, c.cautious_noise_margin * self.rest_noise)
         try:
-            self.move_to(target, c.cautious_descend_time)
+            self.move_to(target, c.cautious_descend_time * self.slowdown)
         finally:
             self.limit = c.force_limit
 
@@ -523,7 +583,7 @@ class Toggler(DoorPushing):
 
     def _actuate(self, jm: JointModel, sign: float, begin: float, at_grasp: np.ndarray) -> ToggleResult:
         c = self.config
-        ticks = round(c.actuate_time / c.tick)
+        ticks = round(c.actuate_time * self.slowdown / c.tick)
         forces: list[float] = []
         progress = 0.0
         path_length = (

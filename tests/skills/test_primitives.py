@@ -3,6 +3,7 @@ sensor; unreachable and non-finite IK targets are typed failures."""
 
 import numpy as np
 import pytest
+from world_fixtures import TrueForceWatch
 
 from models.generator import generate_chain
 from skills import MarkerDetector, joint_model, lid_height, select_markers, upright_pose
@@ -57,6 +58,24 @@ def test_a_free_slide_then_the_door_it_released_are_opened(chain):
     assert door.outcome == "moved", door.reason
     assert session.component_states()[1] == 1
     assert 5.0 < door.sim_time < 18.0  # a slow descent, the over-travel into the end stop, a return through the transit
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_free_door_opened_then_closed_by_a_push_is_read_closed_both_ways(seed):
+    """Pushed over its top, a door falls shut under its own weight ahead of the pads, which first press on it
+    on the lid: closed, not latched (read "latched: pushed without progress" on every seed here before), and
+    met there gently (the pads stop as the plate is felt on the lid)."""
+    spec = generate_chain(["door", "slide"], seed=seed)
+    with TwinSession(spec, seed=0) as session:
+        door = perceived_joint_models(session)["door-0"]
+        watch = TrueForceWatch(session.robot, session)
+        toggler = Toggler(watch)
+        assert toggler.toggle(door).outcome == "moved" and session.component_states()[0] == 1
+        watch.peak = 0.0
+        closing = toggler.toggle(door, opening=False)
+        assert closing.outcome == "moved", closing.reason
+        assert session.component_states()[0] == 0
+        assert watch.peak < 45.0
 
 
 def test_a_free_wheel_is_turned_open():
@@ -145,6 +164,10 @@ def test_a_withdrawal_backs_off_a_held_grip_only_until_the_load_is_relieved():
         ("comply_gain", -0.001, "comply_gain"),
         ("comply_limit", -0.01, "comply_limit"),
         ("comply_return_time", 0.0, "comply_return_time"),
+        ("filtered_noise", 0.0, "filtered_noise"),
+        ("tare_noise", -1.0, "tare_noise"),
+        ("tare_max_samples", 5, "tare_max_samples"),
+        ("force_filter_max_samples", 4, "force_filter_max_samples"),
     ],
 )
 def test_a_config_with_an_impossible_pace_or_yield_is_a_clear_error(field, value, message):

@@ -92,13 +92,33 @@ def test_a_cautious_descent_is_not_stopped_by_sensor_noise(seed):
     rest above the part, and the free part is moved."""
     noisy = RealityProfile(name="noisy-ft", force_torque=ForceTorqueReality(force_noise=7.0))
     spec = generate_chain(["slide", "door"], seed=2)
-    for margin, outcome in ((PrimitiveConfig().cautious_noise_margin, "moved"), (0.0, "failed")):
+    fixed = replace(PrimitiveConfig(), cautious_noise_margin=0.0, tare_noise=1e9)  # and a ten-reading tare
+    for config, outcome in ((PrimitiveConfig(), "moved"), (fixed, "failed")):
         with TwinSession(spec, seed=seed, reality=noisy) as session:
             jm = _joint_models(session)[spec.components[0].name]
-            toggler = Toggler(session.robot, replace(PrimitiveConfig(), cautious_noise_margin=margin))
+            toggler = Toggler(session.robot, config)
             result = toggler.toggle(jm, cautious=True)
             assert result.outcome == outcome, result
             assert toggler.force_noise() == pytest.approx(7.0, rel=0.2)
+
+
+@pytest.mark.parametrize("seed", [1, 3])
+def test_at_15_n_of_sensor_noise_a_latched_part_reads_blocked_and_a_free_one_moved(seed):
+    """At 15 N of F/T force noise (rms per axis) a 5-tick median and a 10-reading tare read a free slide latched
+    (both seeds here); a filter and a tare sized to the noise measured above the part read both parts right."""
+    noisy = RealityProfile(name="noisy-ft", force_torque=ForceTorqueReality(force_noise=15.0))
+    spec = generate_chain(["slide", "door"], seed=2)  # the door is latched until the slide is open
+    fixed = replace(PrimitiveConfig(), filtered_noise=1e9, tare_noise=1e9)
+    for config, slide_outcome in ((PrimitiveConfig(), "moved"), (fixed, "blocked")):
+        with TwinSession(spec, seed=seed, reality=noisy) as session:
+            slide, door = (_joint_models(session)[c.name] for c in spec.components)
+            toggler = Toggler(session.robot, config)
+            assert toggler.toggle(door).outcome == "blocked"
+            assert toggler.toggle(slide).outcome == slide_outcome
+            assert session.component_states().tolist() == [int(slide_outcome == "moved"), 0]
+    toggler = Toggler(session.robot)
+    assert (toggler.filter_samples(15.0), toggler.tare_samples(15.0)) == (23, 225)
+    assert (toggler.filter_samples(0.3), toggler.tare_samples(0.3)) == (5, 10)  # the realistic sensor's
 
 
 def test_a_box_far_from_the_overview_camera_is_found_and_solved_end_to_end():
