@@ -95,6 +95,10 @@ def _load_gripper(path: Path) -> mjcf.RootElement:
         joint.range = [0.0, 0.85]
         joint.limited = True
     gripper.find("actuator", "fingers_actuator").name = "fingers"
+    # the left and right finger linkages never meet (12 mm or more apart at any opening; their pads do meet)
+    for left in ("left_outer_knuckle", "left_inner_knuckle"):
+        for right in ("right_outer_knuckle", "right_inner_knuckle"):
+            gripper.contact.add("exclude", body1=left, body2=right)
     gripper.model = "gripper"  # its namescope: xarm7/gripper/...
     return gripper
 
@@ -130,6 +134,12 @@ def build_xarm7(config: XArm7Config | None = None) -> mjcf.RootElement:
             ctrlrange=joint.range,
         )
 
+    # pairs whose bounding spheres overlap at every step but which no joint angle brings together (nearest over
+    # the joint ranges: base-link1 0.2 mm, base-link2 28 mm; link2-link4 can meet, at -51 mm: kept), taken out
+    # of the narrow phase with the pairs below: 6.4 -> 3.9 us of a 30 us step
+    for body1, body2 in (("base", "link1"), ("base", "link2")):
+        robot.contact.add("exclude", body1=body1, body2=body2)
+
     link7 = robot.find("body", "link7")
     flange = link7.add("body", name="flange")
     flange.add("site", name="ft_site", size=[0.005], rgba=[1, 0.5, 0, 1], group=4)
@@ -144,6 +154,9 @@ def build_xarm7(config: XArm7Config | None = None) -> mjcf.RootElement:
     # as Menagerie mounts the gripper on link7: at its origin, turned half a turn about z
     mount = flange.add("site", name="gripper_mount", quat=[0, 0, 0, 1], size=[0.002], group=4)
     mount.attach(gripper)
+    # link6 is 50 mm or more from every finger link at any turn of joint 7 and any opening of the fingers
+    for finger in ("left_outer_knuckle", "left_inner_knuckle", "right_outer_knuckle", "right_inner_knuckle"):
+        robot.contact.add("exclude", body1=robot.find("body", "link6"), body2=gripper.find("body", finger))
 
     _name_unnamed(robot)
     return robot
