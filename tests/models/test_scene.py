@@ -1,6 +1,7 @@
 """Every generated model compiles and steps warning-free (the Menagerie model test), names everything,
 exports loadable files, and refuses specs the twin cannot build."""
 
+import itertools
 from dataclasses import replace
 
 import mujoco
@@ -108,3 +109,55 @@ def test_unreachable_box_pose_names_the_components_out_of_reach():
     far = replace(spec, box=replace(spec.box, pose=(1.2, 0.0, 0.0)))
     with pytest.raises(UnreachableBoxPose, match="door-0"):
         build_scene(far)
+
+
+def _nearest_over(model, data, geom_pairs, joints, values):
+    """The least distance [m] between each geom pair (ids) over a grid of joint values, capped at 5 cm:
+    ``joints`` lists groups of joint names set together, ``values`` each group's values."""
+    addresses = [[model.joint(j).qposadr[0] for j in group] for group in joints]
+    nearest = dict.fromkeys(geom_pairs, 0.05)
+    for combination in itertools.product(*values):
+        for group, value in zip(addresses, combination, strict=True):
+            data.qpos[group] = value
+        mujoco.mj_forward(model, data)
+        for a, b in geom_pairs:
+            nearest[(a, b)] = min(nearest[(a, b)], mujoco.mj_geomDistance(model, data, a, b, 0.05, None))
+    return nearest
+
+
+def test_the_contact_pairs_left_out_never_meet_at_any_joint_angle_and_the_ones_that_can_stay():
+    """Pairs taken out of the contact test (their bounding spheres overlap at every step, which cost a mesh-mesh
+    narrow phase each) must be kept apart by the kinematics over the joints' whole ranges; the upper arm and
+    the forearm can fold into each other: that pair stays in."""
+    model = build_scene(paper_family("test")[0]).compile()
+    data = mujoco.MjData(model)
+    geom = {model.geom(i).name: i for i in range(model.ngeom)}
+
+    def excluded(a: str, b: str) -> bool:
+        b1, b2 = sorted(int(model.geom_bodyid[geom[g]]) for g in (a, b))
+        return (b1 << 16) + b2 in set(model.exclude_signature.tolist())
+
+    links = (("left", "outer", 8), ("left", "inner", 12), ("right", "outer", 13), ("right", "inner", 17))
+    fingers = [f"xarm7/gripper/{side}_{part}_knuckle_geom{n}" for side, part, n in links]
+    finger_joints = [model.joint(j).name for j in range(model.njnt) if "gripper" in model.joint(j).name]
+    cases = [  # (geom pairs, joint groups, values of each group)
+        ([("xarm7/base_geom0", "xarm7/link1_geom1")], [["xarm7/joint1"]], [np.linspace(-np.pi, np.pi, 13)]),
+        ([("xarm7/base_geom0", "xarm7/link2_geom2")], [["xarm7/joint2"]], [np.radians(np.linspace(-118, 120, 25))]),
+        (
+            [("xarm7/link6_geom6", f) for f in fingers],
+            [["xarm7/joint7"], finger_joints],
+            [np.linspace(-np.pi, np.pi, 13), np.linspace(0.0, 0.85, 4)],
+        ),  # fmt: skip
+        ([(a, b) for a in fingers[:2] for b in fingers[2:]], [finger_joints], [np.linspace(0.0, 0.85, 8)]),
+    ]
+    for pairs, joints, values in cases:
+        assert all(excluded(a, b) for a, b in pairs), pairs
+        nearest = _nearest_over(model, data, [(geom[a], geom[b]) for a, b in pairs], joints, values)
+        assert min(nearest.values()) > 0.0, nearest
+    upper_arm, forearm = "xarm7/link2_geom2", "xarm7/link4_geom4"
+    assert not excluded(upper_arm, forearm)
+    folded = _nearest_over(
+        model, data, [(geom[upper_arm], geom[forearm])], [["xarm7/joint3"], ["xarm7/joint4"]],
+        [np.linspace(-np.pi, np.pi, 13), np.radians(np.linspace(-11, 225, 24))],
+    )  # fmt: skip
+    assert min(folded.values()) < 0.0
