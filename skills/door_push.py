@@ -63,15 +63,16 @@ class DoorPushConfig:
     (at 45 mm a jammed door put 170 N on the wrist before the guard could stop the arm)."""
     close_time: float = 4.0
     """Time of a closing push [s] (~30 mm/s at the pads)."""
-    search_speed: float = 0.015
+    search_speed: float = 0.010
     """Speed of the pads along the arc while they search for the plate of a door that may stand below its stop
     [m/s]: a harsh door latched open at 71.5 deg, met at the schedule's ~40 mm/s, put 99 N on the wrist before
     the late reading passed ``blocked_force``; its progress, counted from where the pads began rather than
-    where they first pressed, had also passed ``blocked_progress``, so no latch was read. A door believed open
-    may stand anywhere: short of its stop it sinks under its own weight (66 deg within 45 s), a latch holds it
-    wherever it was when engaged, and one that fell shut is only met on the lid; until the pads have pressed on
-    the plate, a closing push moves at this speed all the way (searching down to 50 deg only, the pads met a
-    door fallen shut at ~40 mm/s with 72 N)."""
+    where they first pressed, had also passed ``blocked_progress``, so no latch was read. At 15 mm/s one
+    latched at 84 deg loaded the pads by 5 N per tick, and the harsh reading (30 ms late) caught it at 62 N.
+    A door believed open may stand anywhere: short of its stop it sinks under its own weight (66 deg within
+    45 s), a latch holds it wherever it was when engaged, and one that fell shut is only met on the lid; until
+    the pads have pressed on the plate, a closing push moves at this speed all the way (searching down to 50
+    deg only, the pads met a door fallen shut at ~40 mm/s with 72 N)."""
     end_force: float = 20.0
     """Force magnitude at which a door pushed most of the way closed is taken to lie on the lid and the push
     stops there [N] (pressed on by a TCP a few mm off, the lid put 80-130 N on the wrist)."""
