@@ -1,6 +1,8 @@
-"""Train the memory agent in the symbolic simulator and write its memory.
+"""Train the memory agent in the symbolic simulator or end to end in the twin, and write its memory.
 
-    python scripts/train.py --specs FILE... --episodes E --memory MEM.sqlite [--seed S]
+    python scripts/train.py --specs FILE... --episodes E --memory MEM.sqlite [--seed S] [--resume]
+    python scripts/train.py --specs FILE... --episodes E --memory MEM.sqlite --sim twin \
+        [--reality ideal|realistic|harsh|FILE.json] [--calibration FILE.json] [--seed S] [--resume]
     python scripts/train.py --specs FILE... --episodes E --agent DEEP --checkpoint FILE [--seed S]
 
 ``DEEP`` is one of dqn, model-based, mt-dqn, mt-model-based.
@@ -11,11 +13,21 @@ interrupted run keeps every finished episode and the log always matches the memo
 existing memory continues it, and several trainers may share one file. ``MEM.sqlite.train.json`` is an
 export of the file's training log (every run's resolved arguments and versions, every episode's
 outcome), written when training ends or stops. Ctrl-C or SIGTERM stops after the current episode.
+
+``--sim twin`` runs each episode end to end in the MuJoCo twin under the reality profile ``--reality``
+(perception from rendered images with ``--calibration``, the primitives, the F/T outcomes), and the memory
+keeps only what the robot sensed: the outcomes it read and the poses it perceived, never the simulator's
+truth. Each episode is stored with its provenance (``twin``, the profile, its simulated robot time);
+``scripts/memory.py MEM.sqlite`` shows how much of a memory came from where. ``--resume`` continues the
+latest run of the same command in the memory (same specs, episodes, seed, sim, profile, calibration and
+budget): the episodes it stored are not run again, so a run killed and resumed ends with the memory an
+uninterrupted one writes (a kill loses at most the episode in progress).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sqlite3
 import sys
@@ -40,6 +52,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--checkpoint", default=None, help="output checkpoint (dqn and model-based agents)")
     parser.add_argument("--seed", type=int, default=0, help="world seed of episode 0; episode e uses seed + e")
     parser.add_argument("--max-actions", type=int, default=50, help="action budget per training episode")
+    parser.add_argument("--sim", choices=("symbolic", "twin"), default="symbolic", help="where episodes run")
+    parser.add_argument("--reality", default=None, help="twin reality profile: ideal, realistic, harsh or FILE.json")
+    parser.add_argument("--calibration", default=None, help="twin: the cell's calibration file (calibrate.py)")
+    parser.add_argument("--resume", action="store_true", help="continue the latest run of this same command")
     args = parser.parse_args(argv)
     if args.episodes < 1 or args.max_actions < 1:
         fail("--episodes and --max-actions must be >= 1")
@@ -49,7 +65,12 @@ def main(argv: list[str] | None = None) -> int:
         specs = [load_spec(path) for path in args.specs]
     except SpecError as err:
         fail(str(err))
+    if args.sim == "symbolic" and (args.reality is not None or args.calibration is not None):
+        fail("--reality and --calibration are for --sim twin")
+    twin = _twin_setup(args, specs) if args.sim == "twin" else None
     if args.agent != "memory":
+        if twin is not None:
+            fail("--sim twin trains the memory agent only (deep agents train in the symbolic simulator)")
         if args.checkpoint is None or args.memory is not None:
             fail(f"--agent {args.agent} trains a network: give --checkpoint FILE (and no --memory)")
         _check_writable(Path(args.checkpoint), "--checkpoint")
@@ -58,26 +79,36 @@ def main(argv: list[str] | None = None) -> int:
         fail("the memory agent needs --memory MEM.sqlite")
     memory_path = Path(args.memory)
     _check_writable(memory_path, "--memory")
+    command = {key: value for key, value in vars(args).items() if key != "resume"}
     try:
         store = MemoryStore(args.memory)
-        run_id = store.begin_training_run({"command": "train", **vars(args), "versions": versions()})
+        run_id, done_seeds = _resumed_run(store, command) if args.resume else (None, set())
+        if run_id is None:
+            run_id = store.begin_training_run({"command": "train", **command, "versions": versions()})
     except LearningError as err:
         fail(str(err))
     except sqlite3.OperationalError as err:  # e.g. a read-only directory for SQLite's journal
         fail(f"--memory {memory_path}: cannot write ({err})")
 
     log_path = Path(args.memory + ".train.json")
-    solved = done = 0
+    solved = 0
+    done = len(done_seeds)
+    if done:
+        print(f"resuming training run {run_id}: {done} of {args.episodes} episode(s) already in the memory")
     with StopRequests("episode") as stop:
         try:
-            for e in tqdm(range(args.episodes), desc="training", unit="episode", disable=None):
+            todo = [e for e in range(args.episodes) if args.seed + e not in done_seeds]
+            for e in tqdm(todo, desc=f"training ({args.sim})", unit="episode", disable=None):
                 if stop.requested:
                     break
                 spec = specs[e % len(specs)]
-                agent = MemoryAgent(store, learn=True)
+                agent = MemoryAgent(store, learn=True, config=None if twin is None else twin.controller)
                 agent.episode_label, agent.episode_seed, agent.training_run = spec.name, args.seed + e, run_id
-                result = run_episode(agent, SymbolicWorld(spec, args.seed + e), spec.name, args.seed + e,
-                                     args.max_actions)  # fmt: skip
+                if twin is None:
+                    result = run_episode(agent, SymbolicWorld(spec, args.seed + e), spec.name, args.seed + e,
+                                         args.max_actions)  # fmt: skip
+                else:
+                    result = twin.episode(agent, spec, args.seed + e, args.max_actions)
                 solved, done = solved + result.solved, done + 1
         except KeyboardInterrupt:
             pass
@@ -91,6 +122,41 @@ def main(argv: list[str] | None = None) -> int:
               file=sys.stderr)  # fmt: skip
         return 130
     return 0
+
+
+def _resumed_run(store: MemoryStore, command: dict) -> tuple[int | None, set[int]]:
+    """The latest training run in ``store`` made by the same ``command`` (versions aside) and the seeds of the
+    episodes it stored; (None, empty) when there is none."""
+    for run in reversed(store.training_log()):
+        config = dict(run["config"])  # type: ignore[arg-type]
+        config.pop("versions", None)
+        config.pop("command", None)
+        if config == json.loads(json.dumps(command)):
+            return run["id"], {e["seed"] for e in run["episodes"]}  # type: ignore[union-attr]
+    return None, set()
+
+
+def _twin_setup(args: argparse.Namespace, specs: list):
+    """The twin episode runner for ``--sim twin`` (the twin loads only when asked); a calibration must be the
+    one of this cell (profile and box height), as ``trial.py`` checks."""
+    from _twin_training import TwinTraining
+
+    from models.calibration import CalibrationError, CellCalibration
+    from twin.errors import TwinError
+    from twin.reality import load_profile
+
+    try:
+        reality = load_profile(args.reality or "ideal")
+        calibration = CellCalibration.load(args.calibration) if args.calibration else None
+    except (TwinError, CalibrationError) as err:
+        fail(str(err))
+    for path, spec in zip(args.specs, specs, strict=True):
+        if calibration is not None:
+            try:
+                calibration.check_cell(reality.name, reality.cell_seed, spec.box.size[2], spec=str(path))
+            except CalibrationError as err:
+                fail(f"--calibration {args.calibration} for spec {spec.name}: {err}")
+    return TwinTraining(reality, calibration)
 
 
 def _check_writable(path: Path, flag: str) -> None:

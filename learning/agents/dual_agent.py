@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -89,6 +90,12 @@ class MemoryAgent(DualAgent):
         """World seed stored with the episode (the training log)."""
         self.training_run: int | None = None
         """Training-run id from ``MemoryStore.begin_training_run`` the episode belongs to."""
+        self.episode_source = "symbolic"
+        """Where the episode is experienced (``learning.memory.SOURCES``), stored as its provenance."""
+        self.episode_profile: str | None = None
+        """The twin's reality profile of the episode (twin episodes), stored as its provenance."""
+        self.robot_clock: Callable[[], float] | None = None
+        """Reads the simulated robot time the episode has taken so far [s] (twin episodes): stored with it."""
         self._observation: SceneObservation | None = None
 
     def initial_prior(self, observation: SceneObservation) -> np.ndarray:
@@ -113,4 +120,7 @@ class MemoryAgent(DualAgent):
             num_actions=len(self.decisions),
             seed=self.episode_seed,
             training_run=self.training_run,
+            source=self.episode_source,
+            profile=self.episode_profile,
+            robot_time=None if self.robot_clock is None else float(self.robot_clock()),
         )

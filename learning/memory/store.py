@@ -14,6 +14,11 @@ file (SQLite serialises their transactions) and the history accumulates. :meth:`
 it back; ``MEM.sqlite.train.json`` is an export of it. Schema 1 files (no log) are read as they are
 and upgraded in place when trained further.
 
+Each episode also keeps its provenance (schema 3): where it was experienced (``symbolic``: the symbolic
+simulator; ``twin``: end to end in the MuJoCo twin, writing only what the robot sensed), under which reality
+profile, and how much simulated robot time it took [s]; :meth:`MemoryStore.provenance` sums them up.
+Episodes of schema 1 and 2 files, which only the symbolic simulator could write, count as ``symbolic``.
+
 A file that is not a puzzlebox memory (not SQLite, another application's database, a newer schema)
 or that is damaged (truncated, failed integrity check, malformed rows) raises
 :class:`~learning.errors.MemoryFileError`; it is never read as an empty memory.
@@ -39,8 +44,10 @@ from learning.errors import MemoryFileError
 MEMORY_FORMAT = "puzzlebox-memory"
 PAIR_VALUE_SIZE = 6
 """Per stored pair: 4 probabilities [s_j, s_i] and the confidence of j's two blocks."""
-SCHEMA_VERSION = 2
-READABLE_SCHEMAS = ("1", "2")
+SCHEMA_VERSION = 3
+READABLE_SCHEMAS = ("1", "2", "3")
+SOURCES = ("symbolic", "twin")
+"""Where an episode was experienced: the symbolic simulator, or end to end in the twin."""
 
 _LOG_SCHEMA = """
 CREATE TABLE training_runs (id INTEGER PRIMARY KEY, started REAL NOT NULL, config TEXT NOT NULL);
@@ -48,6 +55,13 @@ ALTER TABLE episodes ADD COLUMN seed INTEGER;
 ALTER TABLE episodes ADD COLUMN training_run INTEGER REFERENCES training_runs(id);
 """
 """What schema 2 adds to schema 1: the training log."""
+
+_PROVENANCE_SCHEMA = """
+ALTER TABLE episodes ADD COLUMN source TEXT;
+ALTER TABLE episodes ADD COLUMN profile TEXT;
+ALTER TABLE episodes ADD COLUMN robot_time REAL;
+"""
+"""What schema 3 adds to schema 2: each episode's provenance (NULL source: symbolic, from before it)."""
 
 _SCHEMA = (
     """
@@ -62,6 +76,7 @@ CREATE TABLE independence_entries (
     episode INTEGER NOT NULL REFERENCES episodes(id), kind TEXT NOT NULL, value BLOB NOT NULL);
 """
     + _LOG_SCHEMA
+    + _PROVENANCE_SCHEMA
 )
 
 BUSY_TIMEOUT = 120.0
@@ -98,6 +113,8 @@ class MemoryStore:
         self._independence: dict[str, list[np.ndarray]] = defaultdict(list)
         self._cache: dict[tuple[str, ...], Bucket] = {}
         self.num_episodes = 0
+        self._provenance: list[tuple[str, str | None, float | None]] = []
+        """(source, profile, robot time [s]) of every episode, oldest first."""
         self._schema = str(SCHEMA_VERSION)
         self._conn: sqlite3.Connection | None = None
         if self.path is not None:
@@ -180,6 +197,11 @@ class MemoryStore:
 
     def _load(self, conn: sqlite3.Connection, path: Path) -> None:
         self.num_episodes = conn.execute("SELECT COUNT(*) FROM episodes").fetchone()[0]
+        if self._schema == "3":
+            rows = conn.execute("SELECT source, profile, robot_time FROM episodes ORDER BY id").fetchall()
+            self._provenance = [(source or "symbolic", profile, robot_time) for source, profile, robot_time in rows]
+        else:
+            self._provenance = [("symbolic", None, None)] * self.num_episodes
         for kind_i, kind_j, key, value in conn.execute(
             "SELECT kind_i, kind_j, key, value FROM pair_entries ORDER BY rowid"
         ):
@@ -204,14 +226,17 @@ class MemoryStore:
 
     # -- the training log ----------------------------------------------------------------------------
     def _upgrade(self) -> None:
-        """Add the training log to a schema 1 file (once, whichever trainer gets there first)."""
+        """Add the training log (schema 1) and the provenance columns (schema 1 and 2) to an older file (once,
+        whichever trainer gets there first)."""
         if self._conn is None or self._schema == str(SCHEMA_VERSION):
             return
         conn = self._conn
         conn.execute("BEGIN IMMEDIATE")  # hold the write lock: another trainer may be upgrading too
         try:
-            if conn.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()[0] == "1":
-                for statement in filter(str.strip, _LOG_SCHEMA.split(";")):
+            schema = conn.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()[0]
+            missing = {"1": _LOG_SCHEMA + _PROVENANCE_SCHEMA, "2": _PROVENANCE_SCHEMA}.get(schema, "")
+            if missing:
+                for statement in filter(str.strip, missing.split(";")):
                     conn.execute(statement)
                 conn.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", (str(SCHEMA_VERSION),))
             conn.commit()
@@ -275,6 +300,9 @@ class MemoryStore:
         num_actions: int = 0,
         seed: int | None = None,
         training_run: int | None = None,
+        source: str = "symbolic",
+        profile: str | None = None,
+        robot_time: float | None = None,
     ) -> None:
         """Store one episode's learned graph.
 
@@ -285,7 +313,13 @@ class MemoryStore:
             independence: ``(N, 2)`` probability that each component is independent, per state.
             spec, solved, num_actions, seed: the episode's outcome, for the training log.
             training_run: id from :meth:`begin_training_run` (None: an episode outside a logged run).
+            source: where the episode was experienced (:data:`SOURCES`); ``profile`` the twin's reality profile
+                and ``robot_time`` the episode's simulated robot time [s] (twin episodes).
         """
+        if source not in SOURCES:
+            raise ValueError(f"unknown episode source {source!r}; known: {list(SOURCES)}")
+        if robot_time is not None and not (math.isfinite(robot_time) and robot_time >= 0.0):
+            raise ValueError(f"robot_time must be a finite time >= 0 [s], got {robot_time}")
         n = len(kinds)
         pairs = [
             (kinds[i], kinds[j], keys[i, j].astype(np.float64), pair_values[i, j].astype(np.float64))
@@ -298,9 +332,9 @@ class MemoryStore:
             self._upgrade()
             with self._conn:  # one transaction: the episode (log row included) is stored whole or not at all
                 cursor = self._conn.execute(
-                    "INSERT INTO episodes (spec, solved, num_actions, created, seed, training_run) "
-                    "VALUES (?, ?, ?, ?, ?, ?)",
-                    (spec, int(solved), num_actions, time.time(), seed, training_run),
+                    "INSERT INTO episodes (spec, solved, num_actions, created, seed, training_run, source, profile, "
+                    "robot_time) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                    (spec, int(solved), num_actions, time.time(), seed, training_run, source, profile, robot_time),
                 )
                 episode = cursor.lastrowid
                 self._conn.executemany(
@@ -317,6 +351,22 @@ class MemoryStore:
             self._independence[kind].append(v)
         self._cache.clear()
         self.num_episodes += 1
+        self._provenance.append((source, profile, robot_time))
+
+    def provenance(self) -> dict[str, object]:
+        """Where the memory's episodes come from: per source (:data:`SOURCES`) the number of episodes, and for
+        twin episodes their simulated robot hours and the count per reality profile."""
+        out: dict[str, dict[str, object]] = {source: {"episodes": 0} for source in SOURCES}
+        for source, profile, robot_time in self._provenance:
+            entry = out[source]
+            entry["episodes"] = int(entry["episodes"]) + 1  # type: ignore[call-overload]
+            if source == "twin":
+                entry["robot_hours"] = float(entry.get("robot_hours", 0.0)) + (robot_time or 0.0) / 3600.0  # type: ignore[arg-type]
+                profiles = entry.setdefault("profiles", {})
+                profiles[profile or "?"] = profiles.get(profile or "?", 0) + 1  # type: ignore[union-attr]
+        out["twin"].setdefault("robot_hours", 0.0)
+        out["twin"].setdefault("profiles", {})
+        return {"episodes": self.num_episodes, **out}
 
     # -- reading -----------------------------------------------------------------------------------
     def pair_bucket(self, kind_i: str, kind_j: str) -> Bucket | None:
@@ -345,6 +395,7 @@ class MemoryStore:
     def summary(self) -> dict[str, object]:
         return {
             "episodes": self.num_episodes,
+            "provenance": {source: self.provenance()[source] for source in SOURCES},
             "pair_buckets": {f"{a}->{b}": len(v) for (a, b), v in sorted(self._pairs.items())},
             "independence_buckets": {k: len(v) for k, v in sorted(self._independence.items())},
             "position_scale": self.position_scale,

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from learning.errors import MemoryFileError
-from learning.memory import MemoryStore
+from learning.memory import SCHEMA_VERSION, MemoryStore
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -53,8 +53,8 @@ def test_a_schema_1_file_is_read_as_it_is_and_upgraded_when_trained(tmp_path):
     conn = sqlite3.connect(path)  # make it the schema 1 file an earlier version wrote
     with conn:
         conn.execute("DROP TABLE training_runs")
-        conn.execute("ALTER TABLE episodes DROP COLUMN training_run")
-        conn.execute("ALTER TABLE episodes DROP COLUMN seed")
+        for column in ("training_run", "seed", "source", "profile", "robot_time"):
+            conn.execute(f"ALTER TABLE episodes DROP COLUMN {column}")
         conn.execute("UPDATE meta SET value = '1' WHERE key = 'schema_version'")
     conn.close()
     store = MemoryStore.open_existing(path)
@@ -64,7 +64,35 @@ def test_a_schema_1_file_is_read_as_it_is_and_upgraded_when_trained(tmp_path):
     log = store.training_log()
     assert [(r["id"], [e["spec"] for e in r["episodes"]]) for r in log] == [(None, ["old"]), (run, ["new"])]
     meta = dict(sqlite3.connect(path).execute("SELECT key, value FROM meta").fetchall())
-    assert meta["schema_version"] == "2"
+    assert meta["schema_version"] == str(SCHEMA_VERSION) == "3"
+    assert store.provenance()["symbolic"] == {"episodes": 2}  # what a schema 1 file held was symbolic
+
+
+def test_a_schema_2_file_counts_its_episodes_symbolic_and_takes_twin_episodes_with_their_provenance(tmp_path):
+    path = tmp_path / "two.sqlite"
+    store = MemoryStore(path)
+    _episode(store, spec="old", num_actions=3)
+    store.close()
+    conn = sqlite3.connect(path)  # the schema 2 file the previous version wrote
+    with conn:
+        for column in ("source", "profile", "robot_time"):
+            conn.execute(f"ALTER TABLE episodes DROP COLUMN {column}")
+        conn.execute("UPDATE meta SET value = '2' WHERE key = 'schema_version'")
+    conn.close()
+    store = MemoryStore.open_existing(path)
+    assert store.provenance()["symbolic"] == {"episodes": 1} and store.provenance()["twin"]["episodes"] == 0
+    _episode(store, spec="a", source="twin", profile="realistic", robot_time=1800.0)
+    _episode(store, spec="b", source="twin", profile="harsh", robot_time=900.0)
+    _episode(store, spec="c")
+    store.close()
+    provenance = MemoryStore.open_existing(path).provenance()  # read back from the file
+    assert provenance == {
+        "episodes": 4,
+        "symbolic": {"episodes": 2},
+        "twin": {"episodes": 2, "robot_hours": 0.75, "profiles": {"realistic": 1, "harsh": 1}},
+    }
+    with pytest.raises(ValueError, match="unknown episode source 'robot'"):
+        _episode(MemoryStore(), source="robot")
 
 
 @pytest.mark.parametrize("trainers", [2, 4])
