@@ -5,6 +5,7 @@ the reality gap in the twin.
         --out DIR [--quick] [--runs R] [--seeds S] [--workers W | --ray auto|ADDRESS]
     python scripts/experiment.py reality --out DIR [--quick] [--runs R] [--memory MEM.sqlite] [--workers W | --ray ...]
     python scripts/experiment.py faults --out DIR [--quick] [--runs R]
+    python scripts/experiment.py twin-learning --out DIR [--quick] [--runs R] [--seeds S] [--workers W | --ray ...]
 
 Writes ``DIR/<protocol>.json`` (every point, mean and std over training seeds and each seed's value,
 the settings), ``DIR/<protocol>.png`` (success and mean actions, like the paper's Fig. 3 panels) and
@@ -52,13 +53,14 @@ from learning.experiments.report import episodes_to_solve_table
 PLANNED = ("disassembly",)
 REALITY = "reality"
 FAULTS = "faults"
+TWIN_LEARNING = "twin-learning"
 ALL = "all"
 AGENTS = (*SYMBOLIC_AGENTS, *DEEP_AGENTS)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("protocol", choices=(*PROTOCOLS, ALL, REALITY, FAULTS, *PLANNED))
+    parser.add_argument("protocol", choices=(*PROTOCOLS, ALL, REALITY, FAULTS, TWIN_LEARNING, *PLANNED))
     parser.add_argument("--agents", default=None, help=f"comma-separated, from {list(AGENTS)} (reality: memory)")
     parser.add_argument("--out", required=True, help="output directory (also the resume cache of deep jobs)")
     parser.add_argument("--quick", action="store_true", help="CI size: few runs, one training seed, short schedules")
@@ -78,6 +80,8 @@ def main(argv: list[str] | None = None) -> int:
         return _reality(args)
     if args.protocol == FAULTS:
         return _faults(args)
+    if args.protocol == TWIN_LEARNING:
+        return _twin_learning(args)
     if args.memory is not None:
         fail("--memory is for the reality protocol (the symbolic protocols train their own)")
     if args.agents is None:
@@ -163,6 +167,28 @@ def _reality(args: argparse.Namespace) -> int:
     except LearningError as err:
         fail(str(err))
     return _report(out, "reality", summary)
+
+
+def _twin_learning(args: argparse.Namespace) -> int:
+    from _twin_learning import TwinLearningConfig, run_twin_learning
+
+    if args.agents not in (None, "memory") or args.memory is not None:
+        fail("the twin-learning protocol runs the memory agent from its own memories (no --agents, no --memory)")
+    if args.workers is not None and args.workers < 1:
+        fail("--workers must be >= 1")
+    config = TwinLearningConfig().quick() if args.quick else TwinLearningConfig()
+    config = _with_runs(config, args.runs, "placements", 1)
+    if args.seeds is not None:
+        if args.seeds < 1:
+            fail(f"--seeds must be >= 1, got {args.seeds}")
+        config = replace(config, seeds=tuple(range(args.seeds)))
+    out = Path(args.out)
+    _write_config(out, TWIN_LEARNING, args, twin_learning=asdict(config))
+    try:
+        summary = run_twin_learning(out, config, args.workers, args.ray)
+    except LearningError as err:
+        fail(str(err))
+    return _report(out, TWIN_LEARNING, summary)
 
 
 def _faults(args: argparse.Namespace) -> int:

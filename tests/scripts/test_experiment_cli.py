@@ -1,6 +1,7 @@
 """experiment.py --quick runs every symbolic protocol end to end and writes JSON, PNG and tables."""
 
 import json
+import sqlite3
 import subprocess
 import sys
 from pathlib import Path
@@ -117,3 +118,40 @@ def test_reality_sweep_command_line_mistakes_are_one_line(tmp_path):
         assert bad.returncode == 2 and words in bad.stderr and "Traceback" not in bad.stderr, bad.stderr
     symbolic = experiment("variants", "--out", tmp_path / "out")
     assert symbolic.returncode == 2 and "needs --agents" in symbolic.stderr
+
+
+def test_quick_twin_learning_trains_each_start_in_the_twin_measures_its_checkpoints_and_resumes(tmp_path):
+    result = experiment("twin-learning", "--out", tmp_path, "--quick", "--workers", 1)
+    assert result.returncode == 0, result.stderr
+    data = json.loads((tmp_path / "twin-learning.json").read_text())
+    points = {(p["start"], p["hours"]): p for p in data["points"]}
+    assert set(points) == {("empty", 0.0), ("empty", 0.02), ("symbolic", 0.0), ("symbolic+twin", 0.0),
+                           ("symbolic+twin", 0.02)}  # fmt: skip
+    assert all(p["seeds"][0]["trials"] == 1 and 0.0 <= p["success_rate"] <= 1.0 for p in points.values())
+    chains = {c["start"]: c for c in (json.loads(f.read_text())["record"] for f in (tmp_path / "chains").glob("*"))}
+    for start in ("empty", "symbolic+twin"):  # each checkpoint was taken once its robot time was reached
+        assert all(c["robot_hours"] >= c["hours"] for c in chains[start]["checkpoints"])
+        assert chains[start]["checkpoints"][-1]["twin_episodes"] >= 1
+    assert chains["empty"]["checkpoints"][0] == {"hours": 0.0, "robot_hours": 0.0, "memory": "empty-s0@0h.sqlite",
+                                                 "twin_episodes": 0, "episodes": 0}  # fmt: skip
+    assert (
+        chains["symbolic"]["checkpoints"][0]["episodes"] == 9 == chains["symbolic+twin"]["checkpoints"][0]["episodes"]
+    )
+    memories = tmp_path / "memories"  # the symbolic start and the symbolic part of symbolic+twin are one memory
+    symbolic, both = (sqlite3.connect(memories / f"{s}-s0@0h.sqlite") for s in ("symbolic", "symbolic+twin"))
+    query = "SELECT kind_i, kind_j, key, value FROM pair_entries ORDER BY rowid"
+    assert symbolic.execute(query).fetchall() == both.execute(query).fetchall()
+    assert (tmp_path / "twin-learning.png").read_bytes().startswith(b"\x89PNG")
+    assert "| empty | 0 |" in (tmp_path / "twin-learning.md").read_text()
+    trials = sorted((tmp_path / "trials").glob("*.json"))
+    stamps = [t.stat().st_mtime_ns for t in trials]
+    again = experiment("twin-learning", "--out", tmp_path, "--quick", "--workers", 1)  # resumes: all reused
+    assert again.returncode == 0, again.stderr
+    assert [t.stat().st_mtime_ns for t in trials] == stamps
+    for args, words in (
+        (("--agents", "dqn"), "memory agent"),
+        (("--runs", "0"), "--runs"),
+        (("--seeds", "0"), "--seeds"),
+    ):
+        bad = experiment("twin-learning", "--out", tmp_path / "bad", *args)
+        assert bad.returncode == 2 and words in bad.stderr and "Traceback" not in bad.stderr, bad.stderr

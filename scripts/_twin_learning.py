@@ -1,0 +1,279 @@
+"""``experiment.py twin-learning``: the paper's robot learning curve, closed in simulation.
+
+The memory agent learns on the 9 paper training boxes, each episode at a random reachable placement, end
+to end in the twin under a reality profile (``realistic``), and is measured on the unseen paper test boxes
+(also placed at random) after 0, 0.25, 0.5, 1 and 2 hours of simulated robot experience, from three
+starts:
+
+- ``empty``: an empty memory (the paper's robot, which had no prior experience);
+- ``symbolic``: a memory trained in the symbolic simulator only (``symbolic_episodes`` episodes), no robot
+  time: what simulation is worth before a robot touches a box;
+- ``symbolic+twin``: that symbolic memory, then experience in the twin.
+
+Each start is run for every training seed (the spread in the plot). The cell is calibrated from ChArUco
+images first (``_calibration_run``); training stores only what the robot sensed (``_twin_training``).
+
+Everything is a task of ``learning.runner`` (``--workers K``, or Ray): one training chain per start and
+seed (its memory file grows episode by episode in ``DIR/memories/``, and a copy of it is taken at each
+checkpoint, atomically: a chain killed part-way resumes from its file and its copies), then one trial per
+start, seed, checkpoint, test box and placement (``DIR/trials/``). The same command resumes. The summary
+is ``DIR/twin-learning.{json,md,png}``: mean actions and success against robot hours, mean and spread over
+seeds, with the paper's real-robot figures beside them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import sqlite3
+import statistics
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from _cli import write_json
+from _reality_sweep import _raise_failures, calibration_task
+from _trial_task import trial_task
+from _twin_training import TwinTraining
+
+from learning import MemoryAgent, SymbolicWorld, run_episode, summarise
+from learning.memory import MemoryStore
+from learning.runner import RecordStore, Task, make_executor, run_tasks
+from models.calibration import CellCalibration
+from models.generator import paper_family
+from twin.reality import RealityProfile, load_profile
+
+STARTS = ("empty", "symbolic", "symbolic+twin")
+"""Where a learning curve starts (see the module docstring)."""
+PAPER_ROBOT = {0.0: 26.0, 0.5: 10.0, 1.0: 8.8}
+"""The paper's real robot: mean actions on an unseen box after that many hours of robot experience."""
+PAPER_FINAL = 6.6
+"""... and in its final trials (~30 training episodes)."""
+
+
+@dataclass(frozen=True)
+class TwinLearningConfig:
+    """What ``experiment.py twin-learning`` runs."""
+
+    profile: str = "realistic"
+    hours: tuple[float, ...] = (0.0, 0.25, 0.5, 1.0, 2.0)
+    """Simulated robot experience at which the test boxes are measured [h]."""
+    seeds: tuple[int, ...] = (0, 1)
+    """Training seeds (each start is run once per seed)."""
+    placements: int = 2
+    """Random reachable placements of each test box, per checkpoint."""
+    test_boxes: int = 3
+    """How many of the paper test boxes are measured (all three but in CI)."""
+    symbolic_episodes: int = 9
+    """Episodes of symbolic training of the ``symbolic`` starts (one per training box)."""
+    max_actions: int = 30
+    """Action budget of a test trial and of a training episode (the paper's robot timeout)."""
+    train_seed: int = 70000
+    """World seed of training episode e of seed s: ``train_seed + 1000 s + e``."""
+    eval_seed: int = 60000
+    """Placement seeds of the test trials: ``eval_seed + placement`` (the same at every checkpoint)."""
+    cell_seed: int = 0
+
+    def quick(self) -> TwinLearningConfig:
+        """CI size: checkpoints at 0 and 0.02 h, one seed, one placement of one test box, 8 actions."""
+        return dataclasses.replace(self, hours=(0.0, 0.02), seeds=(0,), placements=1, max_actions=8, test_boxes=1)
+
+    def starts(self) -> tuple[str, ...]:
+        return STARTS
+
+
+def _snapshot(store_path: Path, target: Path) -> None:
+    """A consistent copy of the SQLite memory at ``store_path``, written to ``target`` atomically."""
+    fd, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    os.close(fd)
+    try:
+        with sqlite3.connect(store_path) as source, sqlite3.connect(name) as copy:
+            source.backup(copy)
+        os.replace(name, target)
+    finally:
+        if os.path.exists(name):
+            os.unlink(name)
+
+
+def _symbolic_training(store: MemoryStore, seed: int, episodes: int, max_actions: int) -> None:
+    """The ``symbolic`` starts' memory: ``episodes`` symbolic episodes on the training boxes (seeded by ``seed``)."""
+    train = paper_family("train", seed=0)
+    for e in range(episodes):
+        spec = train[e % len(train)]
+        agent = MemoryAgent(store, learn=True)
+        agent.episode_label, agent.episode_seed = spec.name, 1000 * seed + e
+        run_episode(agent, SymbolicWorld(spec, 1000 * seed + e), spec.name, 1000 * seed + e, max_actions)
+
+
+def training_chain(settings: dict[str, Any], context: dict[str, Any]) -> dict[str, Any]:
+    """One start's learning in the twin (a runner task): its memory grows in ``context['dir']`` and is copied
+    at each checkpoint of ``settings['hours']``; a chain killed part-way goes on from its file."""
+    start, seed = settings["start"], settings["seed"]
+    folder = Path(context["dir"])
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{start}-s{seed}.sqlite"
+    store = MemoryStore(path)
+    try:
+        if start != "empty" and store.num_episodes == 0:
+            _symbolic_training(store, seed, settings["symbolic_episodes"], settings["max_actions"])
+        twin = TwinTraining(RealityProfile.from_dict(settings["reality"]),
+                            CellCalibration.from_dict(settings["calibration"]))  # fmt: skip
+        train = paper_family("train", seed=0)
+        hours = [0.0] if start == "symbolic" else sorted(settings["hours"])
+        checkpoints, skipped = [], []
+        for h in hours:
+            while store.provenance()["twin"]["robot_hours"] < h:
+                # (resumed: the episodes stored are not run again; one the cell could not run stores nothing)
+                e = store.provenance()["twin"]["episodes"] + len(skipped)
+                spec = train[e % len(train)]
+                agent = MemoryAgent(store, learn=True, config=twin.controller)
+                agent.episode_label, agent.episode_seed = spec.name, settings["train_seed"] + 1000 * seed + e
+                before = store.num_episodes
+                result = twin.episode(agent, spec, agent.episode_seed, settings["max_actions"])
+                if store.num_episodes == before:
+                    skipped.append({"episode": e, "spec": spec.name, "ended": result.ended})
+            target = folder / f"{start}-s{seed}@{h:g}h.sqlite"
+            if not target.exists():
+                _snapshot(path, target)
+            provenance = store.provenance()
+            checkpoints.append({
+                "hours": h, "robot_hours": provenance["twin"]["robot_hours"], "memory": target.name,
+                "twin_episodes": provenance["twin"]["episodes"], "episodes": provenance["episodes"],
+            })  # fmt: skip
+        log = store.training_log()
+    finally:
+        store.close()
+    return {"start": start, "seed": seed, "checkpoints": checkpoints, "skipped": skipped,
+            "episodes": [e for run in log for e in run["episodes"]]}  # fmt: skip
+
+
+def run_twin_learning(
+    out: Path, config: TwinLearningConfig, workers: int | None = None, ray: str | None = None
+) -> dict[str, Any]:
+    """Run (or resume) the experiment into ``out``; returns the summary written to ``out/twin-learning.json``.
+
+    Raises:
+        LearningError: a task failed (every other one is kept for the resume).
+    """
+    out.mkdir(parents=True, exist_ok=True)
+    reality = load_profile(config.profile)
+    tests = paper_family("test", seed=0)[: config.test_boxes]
+    begin = time.perf_counter()
+    with make_executor(workers, ray) as executor:
+        calibrations = run_tasks([Task(reality.name, calibration_task,
+                                       {"spec": tests[0].to_dict(), "profile": reality.to_dict()})],
+                                 RecordStore(out / "calibrations"), executor, desc="calibration")  # fmt: skip
+        _raise_failures(calibrations)
+        calibration = calibrations.records[reality.name]["calibration"]
+        memories = out / "memories"
+        chains = [
+            Task(f"{start}-s{seed}", training_chain, {
+                "start": start, "seed": seed, "hours": list(config.hours), "reality": reality.to_dict(),
+                "calibration": calibration, "symbolic_episodes": config.symbolic_episodes,
+                "max_actions": config.max_actions, "train_seed": config.train_seed,
+            }, context={"dir": str(memories)})
+            for start in STARTS for seed in config.seeds
+        ]  # fmt: skip
+        trained = run_tasks(chains, RecordStore(out / "chains"), executor, desc="training in the twin")
+        _raise_failures(trained)
+        trials, where = [], {}
+        for chain in chains:
+            record = trained.records[chain.key]
+            for checkpoint in record["checkpoints"]:
+                for spec in tests:
+                    for placement in range(config.placements):
+                        key = f"{chain.key}@{checkpoint['hours']:g}h-{spec.name}-p{placement}"
+                        trials.append(trial_task(
+                            key, spec, config.eval_seed + placement, sim="twin", agent="memory",
+                            max_actions=config.max_actions, memory=str(memories / checkpoint["memory"]),
+                            reality=reality.to_dict(), calibration=calibration,
+                        ))  # fmt: skip
+                        where[key] = (record["start"], record["seed"], checkpoint["hours"])
+        measured = run_tasks(trials, RecordStore(out / "trials"), executor, desc="test trials",
+                             postfix=lambda r: f"solved {sum(x['solved'] for x in r.values())}/{len(r)}")  # fmt: skip
+        _raise_failures(measured)
+    summary = _summary(config, reality.name, trained.records, measured.records, where)
+    summary["wall_time_s"] = time.perf_counter() - begin
+    write_json(out / "twin-learning.json", summary)
+    (out / "twin-learning.md").write_text(markdown(summary))
+    plot(summary, out / "twin-learning.png")
+    return summary
+
+
+def _summary(config, profile, chains, trials, where) -> dict[str, Any]:
+    points = []
+    for start in STARTS:
+        for hours in [0.0] if start == "symbolic" else sorted(config.hours):
+            per_seed = []
+            for seed in config.seeds:
+                runs = [trials[k] for k, w in where.items() if w == (start, seed, hours)]
+                figures = summarise(runs, config.max_actions)
+                chain = chains[f"{start}-s{seed}"]
+                robot = next(c["robot_hours"] for c in chain["checkpoints"] if c["hours"] == hours)
+                per_seed.append({"seed": seed, "trials": len(runs), "success_rate": figures["success_rate"],
+                                 "mean_actions": figures["mean_actions"], "robot_hours": robot})  # fmt: skip
+            actions = [s["mean_actions"] for s in per_seed]
+            success = [s["success_rate"] for s in per_seed]
+            points.append({
+                "start": start, "hours": hours, "mean_actions": statistics.fmean(actions),
+                "mean_actions_std": statistics.pstdev(actions), "success_rate": statistics.fmean(success),
+                "success_rate_std": statistics.pstdev(success), "seeds": per_seed,
+            })  # fmt: skip
+    return {"config": dataclasses.asdict(config), "profile": profile, "points": points,
+            "paper_robot": {str(h): a for h, a in PAPER_ROBOT.items()}, "paper_final": PAPER_FINAL}  # fmt: skip
+
+
+def markdown(summary: dict[str, Any]) -> str:
+    config = summary["config"]
+    lines = [
+        "# Learning in the twin: the paper's robot learning curve, closed in simulation",
+        "",
+        f"The memory agent trained end to end in the twin (`{summary['profile']}` profile) on the paper training "
+        f"boxes at random placements, measured on the unseen test boxes ({config['placements']} random placements "
+        f"each, {config['max_actions']} actions per trial), mean and spread over {len(config['seeds'])} training "
+        "seed(s).",
+        "",
+        "| start | robot hours | solved | mean actions | paper (real robot) |",
+        "|---|---|---|---|---|",
+    ]
+    for p in summary["points"]:
+        paper = PAPER_ROBOT.get(p["hours"]) if p["start"] == "empty" else None
+        lines.append(
+            f"| {p['start']} | {p['hours']:g} | {p['success_rate']:.1%} ± {p['success_rate_std']:.1%} "
+            f"| {p['mean_actions']:.2f} ± {p['mean_actions_std']:.2f} | {'-' if paper is None else paper} |"
+        )
+    lines += ["", f"The paper's robot in its final trials: {PAPER_FINAL} actions.", ""]
+    if "wall_time_s" in summary:
+        lines += [f"Wall time: {summary['wall_time_s'] / 60:.1f} min.", ""]
+    return "\n".join(lines)
+
+
+def plot(summary: dict[str, Any], path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharex=True)
+    hours = sorted(summary["config"]["hours"])
+    for start in STARTS:
+        pts = [p for p in summary["points"] if p["start"] == start]
+        if start == "symbolic":  # no robot time: a flat line across the curve
+            pts = [dict(pts[0], hours=h) for h in hours]
+        for ax, key in zip(axes, ("mean_actions", "success_rate"), strict=True):
+            ax.errorbar([p["hours"] for p in pts], [p[key] for p in pts], yerr=[p[f"{key}_std"] for p in pts],
+                        marker="o", capsize=3, label=start, linestyle="--" if start == "symbolic" else "-")  # fmt: skip
+    axes[0].plot(list(PAPER_ROBOT), list(PAPER_ROBOT.values()), "k*", markersize=10, label="paper, real robot")
+    axes[0].axhline(PAPER_FINAL, color="k", linestyle=":", linewidth=1, label="paper, final trials")
+    axes[0].set_ylabel("mean actions (unsolved count the budget)")
+    axes[1].set_ylabel("solved [-]")
+    for ax in axes:
+        ax.set_xlabel("simulated robot experience [h]")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(f"learning in the twin ({summary['profile']})")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
