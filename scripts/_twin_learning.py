@@ -10,7 +10,10 @@ starts:
   time: what simulation is worth before a robot touches a box;
 - ``symbolic+twin``: that symbolic memory, then experience in the twin.
 
-Each start is run for every training seed (the spread in the plot). The cell is calibrated from ChArUco
+Each start is run for every training seed (the spread in the plot). Beside them, the deep agents
+(``dqn``, ``model-based``: ``deep_agents``) trained to convergence in the symbolic simulator (the paper
+protocols' 650 episodes on the 9 training variants, one network per training seed) run the same test trials:
+the paper's robot figures for them are 5.4 and 21.2 actions. The cell is calibrated from ChArUco
 images first (``_calibration_run``); training stores only what the robot sensed (``_twin_training``).
 
 Everything is a task of ``learning.runner`` (``--workers K``, or Ray): one training chain per start and
@@ -39,10 +42,12 @@ from _trial_task import trial_task
 from _twin_training import TwinTraining
 
 from learning import MemoryAgent, SymbolicWorld, run_episode, summarise
+from learning.experiments.deep_protocols import TrainingJob, job_task
+from learning.experiments.protocol import ProtocolConfig
 from learning.memory import MemoryStore
 from learning.runner import RecordStore, Task, make_executor, run_tasks
 from models.calibration import CellCalibration
-from models.generator import paper_family
+from models.generator import TRAIN_INDICES, paper_family
 from twin.reality import RealityProfile, load_profile
 
 STARTS = ("empty", "symbolic", "symbolic+twin")
@@ -51,6 +56,8 @@ PAPER_ROBOT = {0.0: 26.0, 0.5: 10.0, 1.0: 8.8}
 """The paper's real robot: mean actions on an unseen box after that many hours of robot experience."""
 PAPER_FINAL = 6.6
 """... and in its final trials (~30 training episodes)."""
+PAPER_DEEP = {"dqn": 5.4, "model-based": 21.2}
+"""The paper's deep agents on the real robot (model-free after 700 episodes; model-based, 3 of 5 timed out)."""
 
 
 @dataclass(frozen=True)
@@ -75,10 +82,18 @@ class TwinLearningConfig:
     eval_seed: int = 60000
     """Placement seeds of the test trials: ``eval_seed + placement`` (the same at every checkpoint)."""
     cell_seed: int = 0
+    deep_agents: tuple[str, ...] = ("dqn", "model-based")
+    """Deep agents measured beside the memory (trained in the symbolic simulator only; empty: none)."""
+    deep_episodes: int = 650
+    """Their symbolic training episodes over the 9 training variants (the paper protocols' converged count)."""
+    deep_eval_runs: int = 10
+    """Runs per unseen variant of their symbolic evaluation at the end of training (reported, not used)."""
 
     def quick(self) -> TwinLearningConfig:
-        """CI size: checkpoints at 0 and 0.02 h, one seed, one placement of one test box, 8 actions."""
-        return dataclasses.replace(self, hours=(0.0, 0.02), seeds=(0,), placements=1, max_actions=8, test_boxes=1)
+        """CI size: checkpoints at 0 and 0.02 h, one seed, one placement of one test box, 8 actions; DQN
+        trained 10 episodes."""
+        return dataclasses.replace(self, hours=(0.0, 0.02), seeds=(0,), placements=1, max_actions=8, test_boxes=1,
+                                   deep_agents=("dqn",), deep_episodes=10, deep_eval_runs=1)  # fmt: skip
 
     def starts(self) -> tuple[str, ...]:
         return STARTS
@@ -161,6 +176,8 @@ def run_twin_learning(
     reality = load_profile(config.profile)
     tests = paper_family("test", seed=0)[: config.test_boxes]
     begin = time.perf_counter()
+    phases: dict[str, float] = {}
+    deep_records: dict[str, Any] = {}
     with make_executor(workers, ray) as executor:
         calibrations = run_tasks([Task(reality.name, calibration_task,
                                        {"spec": tests[0].to_dict(), "profile": reality.to_dict()})],
@@ -176,8 +193,16 @@ def run_twin_learning(
             }, context={"dir": str(memories)})
             for start in STARTS for seed in config.seeds
         ]  # fmt: skip
+        phases["calibration_s"] = time.perf_counter() - begin
+        deep_jobs = _deep_jobs(config, out / "deep")
+        if deep_jobs:
+            deep = run_tasks(deep_jobs, RecordStore(out / "deep" / "jobs"), executor, desc="deep agents (symbolic)")
+            _raise_failures(deep)
+            deep_records = deep.records
+        phases["deep_training_s"] = time.perf_counter() - begin - sum(phases.values())
         trained = run_tasks(chains, RecordStore(out / "chains"), executor, desc="training in the twin")
         _raise_failures(trained)
+        phases["twin_training_s"] = time.perf_counter() - begin - sum(phases.values())
         trials, where = [], {}
         for chain in chains:
             record = trained.records[chain.key]
@@ -191,18 +216,42 @@ def run_twin_learning(
                             reality=reality.to_dict(), calibration=calibration,
                         ))  # fmt: skip
                         where[key] = (record["start"], record["seed"], checkpoint["hours"])
+        for job in deep_jobs:
+            record = deep_records[job.key]
+            agent, seed = job.settings["job"]["agent"], job.settings["job"]["seed"]
+            for spec in tests:
+                for placement in range(config.placements):
+                    key = f"{job.key}-{spec.name}-p{placement}"
+                    trials.append(trial_task(
+                        key, spec, config.eval_seed + placement, sim="twin", agent=agent,
+                        max_actions=config.max_actions, checkpoint=str(out / "deep" / "jobs" / record["checkpoint"]),
+                        reality=reality.to_dict(), calibration=calibration,
+                    ))  # fmt: skip
+                    where[key] = (agent, seed, 0.0)
         measured = run_tasks(trials, RecordStore(out / "trials"), executor, desc="test trials",
                              postfix=lambda r: f"solved {sum(x['solved'] for x in r.values())}/{len(r)}")  # fmt: skip
         _raise_failures(measured)
-    summary = _summary(config, reality.name, trained.records, measured.records, where)
+        phases["test_trials_s"] = time.perf_counter() - begin - sum(phases.values())
+    summary = _summary(config, reality.name, trained.records, measured.records, where, deep_records)
     summary["wall_time_s"] = time.perf_counter() - begin
+    summary["wall_time_by_phase_s"] = phases
     write_json(out / "twin-learning.json", summary)
     (out / "twin-learning.md").write_text(markdown(summary))
     plot(summary, out / "twin-learning.png")
     return summary
 
 
-def _summary(config, profile, chains, trials, where) -> dict[str, Any]:
+def _deep_jobs(config: TwinLearningConfig, folder: Path) -> list[Task]:
+    """One runner task per deep agent and training seed: the paper protocols' k = 9 training job, trained
+    ``deep_episodes`` episodes, its network written to ``folder/jobs/<agent>-v9-s<seed>.pt``."""
+    protocol = ProtocolConfig(runs_per_variant=config.deep_eval_runs)
+    return [
+        job_task(TrainingJob(agent, len(TRAIN_INDICES), seed, (config.deep_episodes,)), protocol, folder)
+        for agent in config.deep_agents for seed in config.seeds
+    ]  # fmt: skip
+
+
+def _summary(config, profile, chains, trials, where, deep=None) -> dict[str, Any]:
     points = []
     for start in STARTS:
         for hours in [0.0] if start == "symbolic" else sorted(config.hours):
@@ -221,8 +270,28 @@ def _summary(config, profile, chains, trials, where) -> dict[str, Any]:
                 "mean_actions_std": statistics.pstdev(actions), "success_rate": statistics.fmean(success),
                 "success_rate_std": statistics.pstdev(success), "seeds": per_seed,
             })  # fmt: skip
+    for agent in config.deep_agents:
+        per_seed = []
+        for seed in config.seeds:
+            runs = [trials[k] for k, w in where.items() if w == (agent, seed, 0.0)]
+            figures = summarise(runs, config.max_actions)
+            symbolic = next(iter((deep or {}).get(f"{agent}-v{len(TRAIN_INDICES)}-s{seed}", {}).get("evaluations", [])),
+                            {})  # fmt: skip
+            per_seed.append({"seed": seed, "trials": len(runs), "success_rate": figures["success_rate"],
+                             "mean_actions": figures["mean_actions"], "robot_hours": 0.0,
+                             "symbolic_success_rate": symbolic.get("success_rate"),
+                             "symbolic_mean_actions": symbolic.get("mean_actions")})  # fmt: skip
+        actions = [s["mean_actions"] for s in per_seed]
+        success = [s["success_rate"] for s in per_seed]
+        points.append({
+            "start": agent, "deep": True, "hours": 0.0, "training_episodes": config.deep_episodes,
+            "mean_actions": statistics.fmean(actions), "mean_actions_std": statistics.pstdev(actions),
+            "success_rate": statistics.fmean(success), "success_rate_std": statistics.pstdev(success),
+            "seeds": per_seed, "paper_robot": PAPER_DEEP.get(agent),
+        })  # fmt: skip
     return {"config": dataclasses.asdict(config), "profile": profile, "points": points,
-            "paper_robot": {str(h): a for h, a in PAPER_ROBOT.items()}, "paper_final": PAPER_FINAL}  # fmt: skip
+            "paper_robot": {str(h): a for h, a in PAPER_ROBOT.items()}, "paper_final": PAPER_FINAL,
+            "paper_deep": PAPER_DEEP}  # fmt: skip
 
 
 def markdown(summary: dict[str, Any]) -> str:
@@ -239,14 +308,17 @@ def markdown(summary: dict[str, Any]) -> str:
         "|---|---|---|---|---|",
     ]
     for p in summary["points"]:
-        paper = PAPER_ROBOT.get(p["hours"]) if p["start"] == "empty" else None
+        paper = PAPER_ROBOT.get(p["hours"]) if p["start"] == "empty" else p.get("paper_robot")
+        start = f"{p['start']} ({p['training_episodes']} symbolic episodes)" if p.get("deep") else p["start"]
         lines.append(
-            f"| {p['start']} | {p['hours']:g} | {p['success_rate']:.1%} ± {p['success_rate_std']:.1%} "
+            f"| {start} | {p['hours']:g} | {p['success_rate']:.1%} ± {p['success_rate_std']:.1%} "
             f"| {p['mean_actions']:.2f} ± {p['mean_actions_std']:.2f} | {'-' if paper is None else paper} |"
         )
     lines += ["", f"The paper's robot in its final trials: {PAPER_FINAL} actions.", ""]
     if "wall_time_s" in summary:
-        lines += [f"Wall time: {summary['wall_time_s'] / 60:.1f} min.", ""]
+        phases = ", ".join(f"{k.removesuffix('_s').replace('_', ' ')} {v / 60:.1f}"
+                           for k, v in summary.get("wall_time_by_phase_s", {}).items())  # fmt: skip
+        lines += [f"Wall time: {summary['wall_time_s'] / 60:.1f} min ({phases} min).", ""]
     return "\n".join(lines)
 
 
@@ -265,6 +337,14 @@ def plot(summary: dict[str, Any], path: Path) -> None:
         for ax, key in zip(axes, ("mean_actions", "success_rate"), strict=True):
             ax.errorbar([p["hours"] for p in pts], [p[key] for p in pts], yerr=[p[f"{key}_std"] for p in pts],
                         marker="o", capsize=3, label=start, linestyle="--" if start == "symbolic" else "-")  # fmt: skip
+    for p in (p for p in summary["points"] if p.get("deep")):  # no robot time: flat, dotted
+        for ax, key in zip(axes, ("mean_actions", "success_rate"), strict=True):
+            ax.errorbar(hours, [p[key]] * len(hours), yerr=[p[f"{key}_std"]] * len(hours), marker=".", capsize=2,
+                        linestyle=":", label=f"{p['start']} (symbolic)")  # fmt: skip
+        if p.get("paper_robot") is not None:
+            axes[0].plot([hours[-1]], [p["paper_robot"]], "kx", markersize=8)
+            axes[0].annotate(f"paper {p['start']}", (hours[-1], p["paper_robot"]), fontsize=7,
+                             textcoords="offset points", xytext=(-40, 4))  # fmt: skip
     axes[0].plot(list(PAPER_ROBOT), list(PAPER_ROBOT.values()), "k*", markersize=10, label="paper, real robot")
     axes[0].axhline(PAPER_FINAL, color="k", linestyle=":", linewidth=1, label="paper, final trials")
     axes[0].set_ylabel("mean actions (unsolved count the budget)")

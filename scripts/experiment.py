@@ -6,6 +6,7 @@ the reality gap in the twin.
     python scripts/experiment.py reality --out DIR [--quick] [--runs R] [--memory MEM.sqlite] [--workers W | --ray ...]
     python scripts/experiment.py faults --out DIR [--quick] [--runs R]
     python scripts/experiment.py twin-learning --out DIR [--quick] [--runs R] [--seeds S] [--workers W | --ray ...]
+                                 [--agents memory,dqn,model-based]
 
 Writes ``DIR/<protocol>.json`` (every point, mean and std over training seeds and each seed's value,
 the settings), ``DIR/<protocol>.png`` (success and mean actions, like the paper's Fig. 3 panels) and
@@ -172,11 +173,17 @@ def _reality(args: argparse.Namespace) -> int:
 def _twin_learning(args: argparse.Namespace) -> int:
     from _twin_learning import TwinLearningConfig, run_twin_learning
 
-    if args.agents not in (None, "memory") or args.memory is not None:
-        fail("the twin-learning protocol runs the memory agent from its own memories (no --agents, no --memory)")
+    if args.memory is not None:
+        fail("the twin-learning protocol runs the memory agent from its own memories (no --memory)")
     if args.workers is not None and args.workers < 1:
         fail("--workers must be >= 1")
     config = TwinLearningConfig().quick() if args.quick else TwinLearningConfig()
+    if args.agents is not None:  # the memory's curve always; the deep agents asked for beside it
+        agents = [a.strip() for a in args.agents.split(",") if a.strip()]
+        unknown = [a for a in agents if a not in ("memory", *DEEP_AGENTS)]
+        if unknown or "memory" not in agents:
+            fail(f"twin-learning --agents: memory and any of {list(DEEP_AGENTS)}, got {agents}")
+        config = replace(config, deep_agents=tuple(a for a in agents if a != "memory"))
     config = _with_runs(config, args.runs, "placements", 1)
     if args.seeds is not None:
         if args.seeds < 1:

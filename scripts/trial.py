@@ -34,6 +34,7 @@ or ``--force`` (start over).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -202,7 +203,8 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(args.out)
     not_results = ("out", "resume", "force", "workers", "ray")  # where and how it runs changes no record
     experiment = {"command": "trial", **{k: v for k, v in vars(args).items() if k not in not_results}}
-    workers = args.workers or (None if args.sim == "twin" else 1)  # symbolic runs last less than a hand-over
+    # symbolic runs last less than a hand-over; a pool is started for no more twin runs than there are
+    workers = args.workers or (min(os.cpu_count() or 1, len(specs) * args.runs) if args.sim == "twin" else 1)
     try:
         executor = make_executor(workers, args.ray)
     except RunnerError as err:

@@ -126,8 +126,13 @@ def test_quick_twin_learning_trains_each_start_in_the_twin_measures_its_checkpoi
     data = json.loads((tmp_path / "twin-learning.json").read_text())
     points = {(p["start"], p["hours"]): p for p in data["points"]}
     assert set(points) == {("empty", 0.0), ("empty", 0.02), ("symbolic", 0.0), ("symbolic+twin", 0.0),
-                           ("symbolic+twin", 0.02)}  # fmt: skip
+                           ("symbolic+twin", 0.02), ("dqn", 0.0)}  # fmt: skip
     assert all(p["seeds"][0]["trials"] == 1 and 0.0 <= p["success_rate"] <= 1.0 for p in points.values())
+    # the deep agent ran the same test trial from the network it trained in the symbolic simulator
+    dqn_trial = json.loads((tmp_path / "trials" / "dqn-v9-s0-paper-test-0-p0.json").read_text())["record"]
+    assert dqn_trial["spec"] == "paper-test-0" and dqn_trial["actions"], dqn_trial
+    assert (tmp_path / "deep" / "jobs" / "dqn-v9-s0.pt").stat().st_size > 0
+    assert points[("dqn", 0.0)]["seeds"][0]["symbolic_success_rate"] is not None
     chains = {c["start"]: c for c in (json.loads(f.read_text())["record"] for f in (tmp_path / "chains").glob("*"))}
     for start in ("empty", "symbolic+twin"):  # each checkpoint was taken once its robot time was reached
         assert all(c["robot_hours"] >= c["hours"] for c in chains[start]["checkpoints"])
@@ -149,7 +154,8 @@ def test_quick_twin_learning_trains_each_start_in_the_twin_measures_its_checkpoi
     assert again.returncode == 0, again.stderr
     assert [t.stat().st_mtime_ns for t in trials] == stamps
     for args, words in (
-        (("--agents", "dqn"), "memory agent"),
+        (("--agents", "dqn"), "memory and any of"),
+        (("--agents", "memory,ppo"), "memory and any of"),
         (("--runs", "0"), "--runs"),
         (("--seeds", "0"), "--seeds"),
     ):
