@@ -46,8 +46,10 @@ def trial_task(
     reality: dict[str, Any] | None = None,
     calibration: dict[str, Any] | None = None,
     video: str | None = None,
+    misreport_kind: bool = False,
 ) -> Task:
-    """The task of one run (``reality`` and ``calibration`` as their ``to_dict()``; twin only)."""
+    """The task of one run (``reality`` and ``calibration`` as their ``to_dict()``; twin only;
+    ``misreport_kind``: one component's kind told wrong, drawn from the seed)."""
     settings = {
         "sim": sim, "spec": spec.to_dict(), "seed": seed, "agent": agent, "max_actions": max_actions,
         "memory": str(Path(memory).resolve()) if memory else None,
@@ -56,6 +58,8 @@ def trial_task(
         "checkpoint_sha256": file_sha256(checkpoint) if checkpoint else None,
         "reality": reality, "calibration": calibration,
     }  # fmt: skip
+    if misreport_kind:  # only then: the settings (and hashes) of every other task stay as they were
+        settings["misreport_kind"] = True
     return Task(key, run_trial, settings, context={"video": video} if video else None)
 
 
@@ -90,7 +94,8 @@ def _run(spec: PuzzleSpec, settings: Mapping[str, Any], video: str | None) -> di
         calibration = CellCalibration.from_dict(settings["calibration"]) if settings["calibration"] else None
         return run_twin_trial(spec, settings["seed"], settings["agent"], memory, settings["max_actions"],
                               Path(video) if video else None,
-                              settings["checkpoint"], reality, calibration, on_action=_on_action)  # fmt: skip
+                              settings["checkpoint"], reality, calibration, on_action=_on_action,
+                              misreport_kind=settings.get("misreport_kind", False))  # fmt: skip
     agent = make_agent(settings["agent"], spec, memory, settings["checkpoint"])
     world = SymbolicWorld(spec, settings["seed"])
     return run_episode(agent, world, spec.name, settings["seed"], settings["max_actions"], _on_action).to_dict()

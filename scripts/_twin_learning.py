@@ -337,10 +337,12 @@ def plot(summary: dict[str, Any], path: Path) -> None:
         for ax, key in zip(axes, ("mean_actions", "success_rate"), strict=True):
             ax.errorbar([p["hours"] for p in pts], [p[key] for p in pts], yerr=[p[f"{key}_std"] for p in pts],
                         marker="o", capsize=3, label=start, linestyle="--" if start == "symbolic" else "-")  # fmt: skip
-    for p in (p for p in summary["points"] if p.get("deep")):  # no robot time: flat, dotted
+    deep = [p for p in summary["points"] if p.get("deep")]
+    for i, p in enumerate(deep):  # no robot time: a flat line, its seeds' spread shaded
         for ax, key in zip(axes, ("mean_actions", "success_rate"), strict=True):
-            ax.errorbar(hours, [p[key]] * len(hours), yerr=[p[f"{key}_std"]] * len(hours), marker=".", capsize=2,
-                        linestyle=":", label=f"{p['start']} (symbolic)")  # fmt: skip
+            color = f"C{3 + i}"
+            ax.axhline(p[key], linestyle=":", color=color, label=f"{p['start']} (symbolic only)")
+            ax.axhspan(p[key] - p[f"{key}_std"], p[key] + p[f"{key}_std"], color=color, alpha=0.07)
         if p.get("paper_robot") is not None:
             axes[0].plot([hours[-1]], [p["paper_robot"]], "kx", markersize=8)
             axes[0].annotate(f"paper {p['start']}", (hours[-1], p["paper_robot"]), fontsize=7,

@@ -6,7 +6,7 @@ from __future__ import annotations
 import hashlib
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -19,6 +19,7 @@ from learning.belief import BeliefConfig
 from learning.memory import MemoryStore
 from models import PuzzleSpec
 from models.calibration import CellCalibration
+from models.kinds import PUZZLE_KINDS
 from skills import MarkerDetector, SkillError
 from skills.twin_world import TwinWorld
 from twin import Renderer, VideoWriter
@@ -132,23 +133,38 @@ def annotate(frame: np.ndarray, detector: MarkerDetector) -> np.ndarray:
 
 
 def evaluation_world(
-    session: TwinSession, robot: Any = None, calibration: CellCalibration | None = None, seed: int = 0
+    session: TwinSession,
+    robot: Any = None,
+    calibration: CellCalibration | None = None,
+    seed: int = 0,
+    told_kinds: Mapping[str, str] | None = None,
 ) -> TwinWorld:
     """The world a twin trial runs on ``session`` (through ``robot``, default the session's): the spec's
     goal and markers, ``calibration`` (default: the nominal one, exact only under ``ideal``), and — for
-    scoring only, never for deciding — the simulator's component states and names."""
+    scoring only, never for deciding — the simulator's component states and names. ``told_kinds`` (component
+    name -> kind) overrides what the pipeline is told of those components' kinds (a misreported kind)."""
     spec = session.spec
     by_marker = {c.marker: i for i, c in enumerate(spec.components)}
+    told = told_kinds or {}
     return TwinWorld(
         robot if robot is not None else session.robot,
         calibration if calibration is not None else nominal_calibration(session),
-        {c.marker: c.kind for c in spec.components},
+        {c.marker: told.get(c.name, c.kind) for c in spec.components},
         spec.components[spec.index_of(spec.goal.component)].marker,
         goal_state=spec.goal.state,
         seed=seed,
         ground_truth=lambda m: int(session.component_states()[by_marker[m]]),
         names={c.marker: c.name for c in spec.components},
     )
+
+
+def wrong_kind(spec: PuzzleSpec, seed: int) -> dict[str, str]:
+    """One component of ``spec`` and a kind it is not, drawn from ``seed``: the symbolic protocols' "wrong
+    kind" fault (``FaultConfig.misreported_kinds = 1``) for a twin trial."""
+    rng = np.random.default_rng([seed, 0x6B1D])
+    component = spec.components[int(rng.integers(len(spec.components)))]
+    others = [k for k in PUZZLE_KINDS if k != component.kind]
+    return {component.name: others[int(rng.integers(len(others)))]}
 
 
 def run_twin_trial(
@@ -162,15 +178,19 @@ def run_twin_trial(
     reality: RealityProfile | str | None = None,
     calibration: CellCalibration | None = None,
     on_action: Callable[[Any], None] | None = None,
+    misreport_kind: bool = False,
 ) -> dict[str, Any]:
     """One end-to-end trial; returns the contract's run entry plus a ``timeline`` and figures.
 
     ``reality`` is the twin's reality profile (default ``ideal``); ``calibration`` the cell's camera
-    calibration (default: the twin's nominal, datasheet calibration — exact only under ``ideal``)."""
+    calibration (default: the twin's nominal, datasheet calibration — exact only under ``ideal``);
+    ``misreport_kind``: the pipeline is told one component's kind wrong (:func:`wrong_kind`; in the entry as
+    ``told_kinds``)."""
     wall = time.perf_counter()
     by_marker = {c.marker: i for i, c in enumerate(spec.components)}
     with TwinSession(spec, seed=seed, reality=reality) as session:
         spec = session.spec  # placed by the profile, if it places boxes
+        told_kinds = wrong_kind(spec, seed) if misreport_kind else {}
         robot = session.robot
         renderer = writer = None
         if video is not None:
@@ -182,7 +202,7 @@ def run_twin_trial(
         world = None
         pose_errors: dict[str, float] = {}
         try:
-            world = evaluation_world(session, robot, calibration, seed)
+            world = evaluation_world(session, robot, calibration, seed, told_kinds)
             watch.doing = lambda: f"{world.toggler.phase}, action {len(world.log) + 1}"
             for c in spec.components:  # perceived closed pose against the simulator's (evaluation only)
                 truth = session.data.site(session.scene.names.components[c.name].frame_site).xpos
@@ -207,6 +227,8 @@ def run_twin_trial(
     entry["peak_true_wrist_force_n"] = watch.peak
     entry["peak_true_wrist_force_during"] = watch.peak_during
     entry["sensed_sha256"] = sensed.hexdigest()
+    if misreport_kind:
+        entry["told_kinds"] = told_kinds
     entry["timeline"] = [
         {**asdict(a), "component": spec.components[by_marker[a.marker]].name,
          "pose_error_m": pose_errors.get(spec.components[by_marker[a.marker]].name)}

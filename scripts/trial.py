@@ -2,7 +2,7 @@
 
     python scripts/trial.py --specs FILE... [--memory MEM.sqlite] --sim {symbolic,twin} --runs K --seed S \
                             --max-actions M --out DIR [--agent NAME] [--video] \
-                            [--reality ideal|realistic|harsh|FILE.json] [--calibration FILE.json] \
+                            [--reality ideal|realistic|harsh|FILE.json] [--calibration FILE.json] [--wrong-kind] \
                             [--workers K | --ray auto|ADDRESS] [--resume | --force]
 
 ``--sim twin`` runs each trial end to end in the MuJoCo twin (ArUco perception, the agent, mink
@@ -13,7 +13,9 @@ single run). ``--reality`` picks the twin's reality profile (sensor noise, calib
 friction, jams, slips, the box placed anywhere reachable; default ``ideal``), ``--calibration`` the
 cell's camera calibration made by ``scripts/calibrate.py`` (default: the nominal, datasheet
 calibration, exact only under ``ideal``); a calibration made for another cell (another profile,
-``cell_seed`` or box height) is refused.
+``cell_seed`` or box height) is refused. ``--wrong-kind`` tells the pipeline (skills and agent) one
+component's kind wrong in every run, drawn from the run's seed (the run's ``told_kinds``): the force limits
+must hold when a slide is pulled along a wheel's arc.
 
 Runs are tasks of ``learning.runner``: ``--workers K`` runs them in K worker processes (default: one per
 core for ``--sim twin``; in-process for ``--sim symbolic``, whose runs last less than handing them over),
@@ -102,6 +104,7 @@ def _tasks(args, specs, reality, calibration, out: Path) -> list:
                 max_actions=args.max_actions, memory=args.memory, checkpoint=args.checkpoint,
                 reality=reality.to_dict() if reality is not None else None,
                 calibration=calibration.to_dict() if calibration is not None else None, video=video,
+                misreport_kind=args.wrong_kind,
             ))  # fmt: skip
     return tasks
 
@@ -143,6 +146,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--checkpoint", default=None, help="checkpoint from train.py (deep agents)")
     parser.add_argument("--video", action="store_true", help="record rollout videos (twin only)")
     parser.add_argument(
+        "--wrong-kind", action="store_true",
+        help="twin: tell the pipeline one component's kind wrong in every run (drawn from the run's seed)",
+    )  # fmt: skip
+    parser.add_argument(
         "--reality", default="ideal", help="twin reality profile: ideal, realistic, harsh or a JSON file"
     )
     parser.add_argument("--calibration", default=None, help="camera calibration from scripts/calibrate.py (twin)")
@@ -169,6 +176,8 @@ def main(argv: list[str] | None = None) -> int:
         fail("--video needs --sim twin")
     if args.sim != "twin" and (args.reality != "ideal" or args.calibration):
         fail("--reality and --calibration need --sim twin")
+    if args.sim != "twin" and args.wrong_kind:
+        fail("--wrong-kind needs --sim twin (the symbolic protocols' faults: experiment.py noise)")
     reality = calibration = None
     if args.sim == "twin":
         from models.calibration import CalibrationError, CellCalibration

@@ -62,6 +62,8 @@ def test_trial_refuses_bad_requests_without_traceback(tmp_path):
     assert video.returncode == 2 and "Traceback" not in video.stderr and "--sim twin" in video.stderr
     no_memory = run(ROOT / "scripts/trial.py", *common, "--sim", "twin", "--agent", "memory")
     assert no_memory.returncode == 2 and "Traceback" not in no_memory.stderr and "--memory" in no_memory.stderr
+    wrong_kind = run(ROOT / "scripts/trial.py", *common, "--sim", "symbolic", "--agent", "dual", "--wrong-kind")
+    assert wrong_kind.returncode == 2 and "Traceback" not in wrong_kind.stderr and "--sim twin" in wrong_kind.stderr
     broken = tmp_path / "broken.json"
     broken.write_text("{")
     bad_spec = run(ROOT / "scripts/trial.py", *common[:1], broken, *common[2:], "--sim", "symbolic", "--agent", "dual")
@@ -300,3 +302,33 @@ def test_executor_mistakes_are_one_line(tmp_path):
         result = run(*_symbolic_trial(specs, out, 2, *flags)[1:])
         assert result.returncode == 2 and message in result.stderr and "Traceback" not in result.stderr, flags
         assert len(result.stderr.strip().splitlines()) == 1 and not out.exists(), "refused before writing anything"
+
+
+def test_a_misreported_kind_is_drawn_from_the_seed_and_is_never_the_true_kind():
+    from _twin_trial import wrong_kind
+
+    from models.generator import paper_family
+
+    spec = paper_family("test")[0]
+    kinds = {c.name: c.kind for c in spec.components}
+    draws = [wrong_kind(spec, seed) for seed in range(60)]
+    assert all(len(d) == 1 and kinds[n] != k for d in draws for n, k in d.items())
+    assert {n for d in draws for n in d} == set(kinds)  # every component can be the one misreported
+    assert draws == [wrong_kind(spec, seed) for seed in range(60)]
+
+
+def test_a_twin_trial_told_a_wrong_kind_stays_under_the_force_limit(tmp_path):
+    """The oracle toggles every part on the solution; one of them is told as another kind: its pull follows
+    the wrong path, and the arm must stop, not force it (the true wrist force stays under the 60 N limit)."""
+    from skills.primitives import PrimitiveConfig
+
+    specs = tmp_path / "specs"
+    assert run(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", specs).returncode == 0
+    out = tmp_path / "out"
+    result = run(ROOT / "scripts/trial.py", "--specs", specs / "paper-test-0.json", "--sim", "twin", "--agent",
+                 "oracle", "--runs", 1, "--seed", 3, "--max-actions", 8, "--out", out, "--wrong-kind")  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    entry = json.loads((out / "results.json").read_text())["runs"][0]
+    (told,) = entry["told_kinds"].items()
+    assert told[0] in {a["component"] for a in entry["timeline"]}  # the misreported part was tried
+    assert entry["peak_true_wrist_force_n"] < PrimitiveConfig().force_limit

@@ -168,6 +168,9 @@ def test_a_withdrawal_backs_off_a_held_grip_only_until_the_load_is_relieved():
         ("tare_noise", -1.0, "tare_noise"),
         ("tare_max_samples", 5, "tare_max_samples"),
         ("force_filter_max_samples", 4, "force_filter_max_samples"),
+        ("lift_contact_force", 60.0, "lift_contact_force"),
+        ("lift_sidestep", -0.01, "lift_sidestep"),
+        ("lift_slow_time", 0.0, "lift_slow_time"),
     ],
 )
 def test_a_config_with_an_impossible_pace_or_yield_is_a_clear_error(field, value, message):
