@@ -34,7 +34,9 @@ def footprint(spec, name):
 def assert_lockers_sit_next_to_what_they_lock(spec):
     for rule in spec.locks:
         gap = polygon_gap(footprint(spec, rule.locker), footprint(spec, rule.locked))
-        assert gap <= NEIGHBOUR_GAP + 1e-9, (rule, gap)
+        # 1 um: the layout is checked before it is turned lengthwise and centred, and the turn's trigonometry
+        # moves a footprint by nanometres (random-n14-multi seed 124: 0.030000007 m)
+        assert gap <= NEIGHBOUR_GAP + 1e-6, (rule, gap)
         kinds = (spec.components[spec.index_of(rule.locker)].kind, spec.components[spec.index_of(rule.locked)].kind)
         assert may_neighbour(*kinds), rule
 

@@ -102,10 +102,11 @@ def test_a_cautious_descent_is_not_stopped_by_sensor_noise(seed):
             assert toggler.force_noise() == pytest.approx(7.0, rel=0.2)
 
 
-@pytest.mark.parametrize("seed", [1, 3])
+@pytest.mark.parametrize("seed", [1, 5])
 def test_at_15_n_of_sensor_noise_a_latched_part_reads_blocked_and_a_free_one_moved(seed):
     """At 15 N of F/T force noise (rms per axis) a 5-tick median and a 10-reading tare read a free slide latched
-    (both seeds here); a filter and a tare sized to the noise measured above the part read both parts right."""
+    (both seeds here; 4 of seeds 0-7); a filter and a tare sized to the noise measured above the part read both
+    parts right (all 8)."""
     noisy = RealityProfile(name="noisy-ft", force_torque=ForceTorqueReality(force_noise=15.0))
     spec = generate_chain(["slide", "door"], seed=2)  # the door is latched until the slide is open
     fixed = replace(PrimitiveConfig(), filtered_noise=1e9, tare_noise=1e9)
