@@ -137,7 +137,7 @@ def training_chain(settings: dict[str, Any], context: dict[str, Any]) -> dict[st
                             CellCalibration.from_dict(settings["calibration"]))  # fmt: skip
         train = paper_family("train", seed=0)
         hours = [0.0] if start == "symbolic" else sorted(settings["hours"])
-        checkpoints, skipped = [], []
+        checkpoints, skipped, runs = [], [], []
         for h in hours:
             while store.provenance()["twin"]["robot_hours"] < h:
                 # (resumed: the episodes stored are not run again; one the cell could not run stores nothing)
@@ -147,6 +147,8 @@ def training_chain(settings: dict[str, Any], context: dict[str, Any]) -> dict[st
                 agent.episode_label, agent.episode_seed = spec.name, settings["train_seed"] + 1000 * seed + e
                 before = store.num_episodes
                 result = twin.episode(agent, spec, agent.episode_seed, settings["max_actions"])
+                runs.append({"episode": e, "spec": spec.name, "seed": agent.episode_seed, "solved": result.solved,
+                             "num_actions": result.num_actions, "ended": result.ended})  # fmt: skip
                 if store.num_episodes == before:
                     skipped.append({"episode": e, "spec": spec.name, "ended": result.ended})
             target = folder / f"{start}-s{seed}@{h:g}h.sqlite"
@@ -160,7 +162,7 @@ def training_chain(settings: dict[str, Any], context: dict[str, Any]) -> dict[st
         log = store.training_log()
     finally:
         store.close()
-    return {"start": start, "seed": seed, "checkpoints": checkpoints, "skipped": skipped,
+    return {"start": start, "seed": seed, "checkpoints": checkpoints, "skipped": skipped, "runs": runs,
             "episodes": [e for run in log for e in run["episodes"]]}  # fmt: skip
 
 
@@ -290,8 +292,25 @@ def _summary(config, profile, chains, trials, where, deep=None) -> dict[str, Any
             "seeds": per_seed, "paper_robot": PAPER_DEEP.get(agent),
         })  # fmt: skip
     return {"config": dataclasses.asdict(config), "profile": profile, "points": points,
-            "paper_robot": {str(h): a for h, a in PAPER_ROBOT.items()}, "paper_final": PAPER_FINAL,
-            "paper_deep": PAPER_DEEP}  # fmt: skip
+            "training": _training_outcomes(chains), "paper_robot": {str(h): a for h, a in PAPER_ROBOT.items()},
+            "paper_final": PAPER_FINAL, "paper_deep": PAPER_DEEP}  # fmt: skip
+
+
+def _training_outcomes(chains: dict[str, Any]) -> dict[str, Any]:
+    """Per start, over seeds: the twin training episodes run, solved, and why the others ended (box, part, error;
+    "out of actions" when the budget ran out). Episodes of an execution that was resumed are counted from the
+    part that ran last."""
+    out: dict[str, Any] = {}
+    for chain in chains.values():
+        entry = out.setdefault(chain["start"], {"episodes": 0, "solved": 0, "ended": {}})
+        for run in chain.get("runs", []):
+            entry["episodes"] += 1
+            entry["solved"] += run["solved"]
+            if not run["solved"]:
+                parts = run["ended"].split(": ")
+                why = f"{run['spec']} {': '.join(parts[:2])}" if run["ended"] else f"{run['spec']} out of actions"
+                entry["ended"][why] = entry["ended"].get(why, 0) + 1
+    return {k: v for k, v in out.items() if v["episodes"]}
 
 
 def markdown(summary: dict[str, Any]) -> str:
@@ -315,6 +334,10 @@ def markdown(summary: dict[str, Any]) -> str:
             f"| {p['mean_actions']:.2f} ± {p['mean_actions_std']:.2f} | {'-' if paper is None else paper} |"
         )
     lines += ["", f"The paper's robot in its final trials: {PAPER_FINAL} actions.", ""]
+    for start, t in summary.get("training", {}).items():
+        reasons = "; ".join(f"{why} x{n}" for why, n in sorted(t["ended"].items(), key=lambda kv: -kv[1]))
+        lines += [f"Training in the twin, `{start}`: {t['solved']} of {t['episodes']} episodes solved"
+                  + (f"; the others ended: {reasons}." if reasons else "."), ""]  # fmt: skip
     if "wall_time_s" in summary:
         phases = ", ".join(f"{k.removesuffix('_s').replace('_', ' ')} {v / 60:.1f}"
                            for k, v in summary.get("wall_time_by_phase_s", {}).items())  # fmt: skip

@@ -146,6 +146,9 @@ def test_quick_twin_learning_trains_each_start_in_the_twin_measures_its_checkpoi
     symbolic, both = (sqlite3.connect(memories / f"{s}-s0@0h.sqlite") for s in ("symbolic", "symbolic+twin"))
     query = "SELECT kind_i, kind_j, key, value FROM pair_entries ORDER BY rowid"
     assert symbolic.execute(query).fetchall() == both.execute(query).fetchall()
+    for start in ("empty", "symbolic+twin"):  # every training episode is solved or says why it ended
+        t = data["training"][start]
+        assert t["episodes"] >= 1 and t["solved"] + sum(t["ended"].values()) == t["episodes"]
     assert (tmp_path / "twin-learning.png").read_bytes().startswith(b"\x89PNG")
     assert "| empty | 0 |" in (tmp_path / "twin-learning.md").read_text()
     trials = sorted((tmp_path / "trials").glob("*.json"))
