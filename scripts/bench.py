@@ -13,7 +13,8 @@
   first in the process (renderer, scene and IK model built) and a second one (kept from the first);
 - scale (``scripts/_bench_scale.py``): each executor's overhead per no-op task, and twin trials per hour of
   the same T oracle trials on one worker, on a local pool (one worker per core) and on a local Ray cluster,
-  one after the other in this run, with each one's speed-up over one worker.
+  one after the other in this run, with each one's speed-up over one worker: start-up included, and warm
+  (after one trial per worker).
 Single-threaded numpy is enforced for the agent figures (one core).
 """
 
