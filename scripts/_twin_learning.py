@@ -42,7 +42,7 @@ from _trial_task import trial_task
 from _twin_training import TwinTraining
 
 from learning import MemoryAgent, SymbolicWorld, run_episode, summarise
-from learning.experiments.deep_protocols import TrainingJob, job_task
+from learning.experiments.deep_protocols import TrainingJob, job_key, job_task
 from learning.experiments.protocol import ProtocolConfig
 from learning.memory import MemoryStore
 from learning.runner import RecordStore, Task, make_executor, run_tasks
@@ -265,35 +265,32 @@ def _summary(config, profile, chains, trials, where, deep=None) -> dict[str, Any
                 robot = next(c["robot_hours"] for c in chain["checkpoints"] if c["hours"] == hours)
                 per_seed.append({"seed": seed, "trials": len(runs), "success_rate": figures["success_rate"],
                                  "mean_actions": figures["mean_actions"], "robot_hours": robot})  # fmt: skip
-            actions = [s["mean_actions"] for s in per_seed]
-            success = [s["success_rate"] for s in per_seed]
-            points.append({
-                "start": start, "hours": hours, "mean_actions": statistics.fmean(actions),
-                "mean_actions_std": statistics.pstdev(actions), "success_rate": statistics.fmean(success),
-                "success_rate_std": statistics.pstdev(success), "seeds": per_seed,
-            })  # fmt: skip
+            points.append({"start": start, "hours": hours, **_over_seeds(per_seed), "seeds": per_seed})
     for agent in config.deep_agents:
         per_seed = []
         for seed in config.seeds:
             runs = [trials[k] for k, w in where.items() if w == (agent, seed, 0.0)]
             figures = summarise(runs, config.max_actions)
-            symbolic = next(iter((deep or {}).get(f"{agent}-v{len(TRAIN_INDICES)}-s{seed}", {}).get("evaluations", [])),
-                            {})  # fmt: skip
+            job = (deep or {}).get(job_key(agent, len(TRAIN_INDICES), seed), {})
+            symbolic = next(iter(job.get("evaluations", [])), {})
             per_seed.append({"seed": seed, "trials": len(runs), "success_rate": figures["success_rate"],
                              "mean_actions": figures["mean_actions"], "robot_hours": 0.0,
                              "symbolic_success_rate": symbolic.get("success_rate"),
                              "symbolic_mean_actions": symbolic.get("mean_actions")})  # fmt: skip
-        actions = [s["mean_actions"] for s in per_seed]
-        success = [s["success_rate"] for s in per_seed]
-        points.append({
-            "start": agent, "deep": True, "hours": 0.0, "training_episodes": config.deep_episodes,
-            "mean_actions": statistics.fmean(actions), "mean_actions_std": statistics.pstdev(actions),
-            "success_rate": statistics.fmean(success), "success_rate_std": statistics.pstdev(success),
-            "seeds": per_seed, "paper_robot": PAPER_DEEP.get(agent),
-        })  # fmt: skip
+        points.append({"start": agent, "deep": True, "hours": 0.0, "training_episodes": config.deep_episodes,
+                       **_over_seeds(per_seed), "seeds": per_seed, "paper_robot": PAPER_DEEP.get(agent)})  # fmt: skip
     return {"config": dataclasses.asdict(config), "profile": profile, "points": points,
             "training": _training_outcomes(chains), "paper_robot": {str(h): a for h, a in PAPER_ROBOT.items()},
             "paper_final": PAPER_FINAL, "paper_deep": PAPER_DEEP}  # fmt: skip
+
+
+def _over_seeds(per_seed: list[dict[str, Any]]) -> dict[str, float]:
+    """Mean and spread (population std) over training seeds of the mean actions and the success rate."""
+    out = {}
+    for key in ("mean_actions", "success_rate"):
+        values = [s[key] for s in per_seed]
+        out[key], out[f"{key}_std"] = statistics.fmean(values), statistics.pstdev(values)
+    return out
 
 
 def _training_outcomes(chains: dict[str, Any]) -> dict[str, Any]:

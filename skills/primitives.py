@@ -133,6 +133,7 @@ class PrimitiveConfig:
     opened under the handle of an open door (which stands past vertical over its neighbours) brought the pad
     up against it at the 60 N guard with 84 N true (paper-train-0, realistic)."""
     lift_noise_margin: float = 3.0
+    """... or this many times the filtered F/T noise of the toggle, if larger: noise must not read as a touch."""
     lift_slow_height: float = 0.02
     """The first part of that lift runs slowly [m]: what stands over the pads is met within a centimetre or two
     of the handle (an open door's post 8 mm over a pad), and met at the lift's full pace (~15 cm/s) the wrist
@@ -321,9 +322,6 @@ class Toggler(DoorPushing):
         self.limit = self.config.force_limit
         """The force guard's threshold now [N]: ``force_limit``, or ``cautious_contact_force`` in a cautious descent."""
         self.cautious = False
-        self._sidestep_sign = 0.0
-        """Which way along the pads the lift of the current retreat steps first (0: it has not stepped)."""
-        self._sidestep_from = np.zeros(3)
         """Whether the toggle in progress descends cautiously (``toggle(cautious=True)``)."""
         self.slowdown = 1.0
         """How much slower than configured the motions in contact of the toggle in progress run [-]: the
@@ -766,7 +764,6 @@ class Toggler(DoorPushing):
 
     def _let_go_and_retreat(self, guarded: bool = True) -> None:
         """Open, move up and go to rest; a force stop on the way withdraws unguarded."""
-        self._sidestep_sign = 0.0
         try:
             self.guard = guarded
             self._retreat_moves()
@@ -790,56 +787,53 @@ class Toggler(DoorPushing):
 
     def _lift_clear(self, height: float) -> None:
         """Lift the open gripper by ``height`` [m], stopping at a light touch (``lift_contact_force``); on one,
-        back off, step sideways along the pads (away from the load first, then the other way) and lift again.
-        Withdrawing (guard off), or when neither side clears, the lift runs as before, under the full guard."""
+        back off, step ``lift_sidestep`` along the pads (the TCP's x: parallel to the handle between them, which
+        the step then never pushes), first to the side the load pushed towards, then to the other, and lift
+        again. Withdrawing (guard off), or when neither side clears, the lift runs under the full guard."""
         c = self.config
-        if not self.guard:
-            up = self.robot.tcp_pose_in_base()
-            up[2, 3] += height
-            self.move_to(up, c.retreat_time)
-            return
-        limit = self.limit
         top = self.robot.tcp_pose_in_base()[2, 3] + height
-        try:
+        if self.guard:
+            limit = self.limit
             self.limit = max(c.lift_contact_force, c.lift_noise_margin * self.filtered_noise_now())
-            for step in (0.0, 1.0, -1.0):
-                try:
-                    if step:
-                        self._sidestep(step)
-                    up = self.robot.tcp_pose_in_base()
-                    up[2, 3] = min(up[2, 3] + c.lift_slow_height, top)
-                    self.move_to(up, c.lift_slow_time)
-                    up[2, 3] = top
-                    self.move_to(up, c.retreat_time)
-                    return
-                except ForceLimitExceeded:
-                    self.guard = False
+            origin, away = None, np.zeros(3)
+            try:
+                for side in (0.0, 1.0, -1.0):
                     try:
-                        self._relieve()
-                    finally:
-                        self.guard = True
-        finally:
-            self.limit = limit
+                        if side:
+                            self._step_along_pads(origin, side * away)
+                        up = self.robot.tcp_pose_in_base()
+                        up[2, 3] = min(up[2, 3] + c.lift_slow_height, top)
+                        self.move_to(up, c.lift_slow_time)
+                        up[2, 3] = top
+                        self.move_to(up, c.retreat_time)
+                        return
+                    except ForceLimitExceeded:
+                        if origin is None:  # which way the first touch pushed, before backing off from it
+                            away = self.force_in_base.copy()
+                        self.guard = False
+                        try:
+                            self._relieve()
+                        finally:
+                            self.guard = True
+                        if origin is None:
+                            origin = self.robot.tcp_pose_in_base()[:3, 3].copy()
+            finally:
+                self.limit = limit
         up = self.robot.tcp_pose_in_base()
         up[2, 3] = top
         self.move_to(up, c.retreat_time)
 
-    def _sidestep(self, side: float) -> None:
-        """Move the TCP ``lift_sidestep`` along its x axis (the pads' length: parallel to the handle between
-        them), towards the load's side of it for ``side`` = 1 and the other for -1 (the load points away from
-        what was met), back from where the last step took it."""
-        c = self.config
+    def _step_along_pads(self, origin: np.ndarray, away: np.ndarray) -> None:
+        """Move the TCP to ``lift_sidestep`` from ``origin`` (base frame [m]) along its x axis, on the side of
+        ``away`` (a load's direction: it points from what was met), at its present height."""
         pose = self.robot.tcp_pose_in_base()
         along = pose[:3, 0].copy()
         along[2] = 0.0
         along /= np.linalg.norm(along)
-        if self._sidestep_sign == 0.0:
-            self._sidestep_sign = 1.0 if float(self.force_in_base @ along) >= 0.0 else -1.0
-            self._sidestep_from = pose[:3, 3].copy()
         target = pose.copy()
-        target[:3, 3] = self._sidestep_from + side * self._sidestep_sign * c.lift_sidestep * along
+        target[:3, 3] = origin + math.copysign(self.config.lift_sidestep, float(away @ along)) * along
         target[2, 3] = pose[2, 3]
-        self.move_to(target, c.retreat_time)
+        self.move_to(target, self.config.retreat_time)
 
     def go_rest(self) -> None:
         """Back to the rest posture by joint interpolation (no IK: always feasible); a force stop on the
