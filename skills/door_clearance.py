@@ -47,6 +47,31 @@ def near_open_door(door: JointModel, from_fraction: float, point: np.ndarray, ra
     return math.hypot(du, dv) < radius
 
 
+def lean_away(doors: list[JointModel], start: np.ndarray, end: np.ndarray) -> np.ndarray | None:
+    """The horizontal unit vector (base frame) in which a gripper holding a handle that moves from ``start`` to
+    ``end`` [m] should lean to keep its upper part away from ``doors`` that may stand open over it
+    (:func:`near_open_door`): across each door's hinge line, away from its flap's closed footprint (a door at
+    its stop stands beside its hinge line, its post reaching out past it over the neighbour). None when there
+    are no doors or they stand on opposite sides (leaning from one would lean into the other). A door the
+    handle passes only beside, along its hinge line (off the flap's width at both ends), is not leant from:
+    its flap stands up across that way, and leaning over the hinge line brought the knuckles onto the standing
+    plate's edge."""
+    total = np.zeros(3)
+    for door in doors:
+        push = DoorPush.of(door, 0.0)
+        along = sorted(float((p - push.origin) @ push.axis) for p in (start, end))
+        if along[0] > DOOR_HALF or along[1] < -DOOR_HALF:
+            continue
+        point = start
+        across = push.e_x.copy()
+        across[2] = 0.0
+        across /= np.linalg.norm(across)
+        middle = (push.contact[0] + HANDLE_MARGIN - HANDLE_SIZE / 2) / 2  # of the closed flap, from the hinge
+        total += across if float((point - push.origin) @ push.e_x) > middle else -across
+    size = float(np.linalg.norm(total))
+    return total / size if size > 0.5 else None
+
+
 def _overhang(push: DoorPush, travel: float, from_fraction: float) -> tuple[float, float]:
     free_edge = push.contact[0] + HANDLE_MARGIN - HANDLE_SIZE / 2
     handle_back = push.contact[0]

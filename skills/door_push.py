@@ -371,7 +371,9 @@ class DoorPushing:
         perception error is ~3 deg here) cancels in its change since the pad first pressed on the face.
         A swing is only as far as the pad last pressed on the face: past it the pad is in the air (over the
         post of a latched door, within the slide test's turn; or past a door that was not where it was
-        placed)."""
+        placed). The start of the travel, up to ``breakaway_fraction``, is swept at ``breakaway_pace`` as a
+        pinch's is: at full pace a pad pressed on the post of a wheel told to be a door went from 10 to 65 N in
+        40 ms, before the filtered reading (~40 ms late) showed any of it; at that pace it peaked at 40 N."""
         c = self.config
         p = c.push
         x = door.contact[0] - p.depth
@@ -386,14 +388,19 @@ class DoorPushing:
         end = 1.0 + p.overtravel
         contact = max(p.contact_force, p.contact_noise_margin * self.filtered_noise_now())
         ticks = round(c.actuate_time * self.slowdown / c.tick)
+        pace = (end - start) / ticks  # of the travel per tick, past the slow start
+        slow_span = max(0.0, c.breakaway_fraction - start)  # the start of the travel, driven slowly as a pinch's
+        slow = slow_span / (pace * c.breakaway_pace)  # ticks of the slow start
+        last_tick = math.ceil(slow + (end - start - slow_span) / pace - 1e-9)
         forces: list[float] = []
         progress = 0.0
         pressed_at: tuple[float, float] | None = None  # (progress, face angle) when the pad first pressed
         last_pressed, last_face = start, 0.0  # progress and face angle when the pad last pressed on the face
         self.ik.set_joints(self.robot.joint_positions())
         turn_at_start = door.turn_of(self._pad_edge(door, p.pad_offset))
-        for k in range(1, ticks + 1 + round(2 * c.settle_time / c.tick)):
-            s = min(start + (end - start) * min(1.0, k / ticks), max(progress, start) + lead)
+        for k in range(1, last_tick + 1 + round(2 * c.settle_time / c.tick)):
+            paced = pace * c.breakaway_pace * k if k <= slow else slow_span + pace * (k - slow)
+            s = min(start + paced, end, max(progress, start) + lead)
             closing_in = max(0.0, 1.0 - k * c.tick / (p.approach_time * self.slowdown)) * (p.gap + p.depth)
             self._tick(tcp_for(door.point_at(s * door.travel, pressed(k) + np.array([closing_in, 0.0]))))
             pad_edge = self._pad_edge(door, p.pad_offset)

@@ -35,7 +35,7 @@ import numpy as np
 from models import ComponentObservation, SceneObservation, TryResult
 from models.calibration import CellCalibration
 from models.robot import Robot
-from skills.door_clearance import near_open_door
+from skills.door_clearance import lean_away, near_open_door
 from skills.joint_model import JointModel, joint_model
 from skills.perception import MarkerDetection, MarkerDetector, kind_of, lid_height, upright_pose
 from skills.primitives import STOPPED_DESCENDING, Toggler, ToggleResult
@@ -47,6 +47,10 @@ MOVED_ANGLE = math.radians(20)
 """... or turned this much [rad]."""
 DOOR_STAYED = "SlipDetected: the door stayed shut"
 """Reason of a try whose fingers went the whole way while the door's marker stayed at its closed pose."""
+HELD_UNDER_PINCH_AND_PUSH = "latched: the door stayed shut under the pinch and the push"
+"""Reason of a door seen shut after a pinch and then a push both went the whole way: held (a latch or a jam). The
+push's own reading can miss it: on a latched door whose post the pad rode over before the load reached
+``push.blocked_force`` (28 N of 30), and which it then pressed on something else near the end of the arc."""
 
 
 @dataclass(frozen=True)
@@ -154,6 +158,8 @@ class TwinWorld:
             raised = door_at is None
         self.unsettled.discard(marker)
         overhanging = self._doors_overhanging(marker, opening)
+        jm = self.joint_models[marker]
+        lean = lean_away([self.joint_models[d] for d in overhanging], *(jm.grasp_point_at(f) for f in (0.0, 1.0)))
         for attempt in range(1 + self.config.max_retries):
             attempts = attempt + 1
             result: ToggleResult = self.toggler.toggle(
@@ -163,6 +169,7 @@ class TwinWorld:
                 door_at=door_at,
                 raised=raised,
                 cautious=bool(overhanging),
+                lean=lean,
             )
             peak, sim_time, wall_time = (
                 max(peak, result.peak_force),
@@ -178,6 +185,10 @@ class TwinWorld:
             if result.outcome != "failed":
                 break
             reasons.append(result.reason)
+            if lean is not None and result.reason.startswith("IKFailure"):
+                # leaning out of reach (tilted 20 deg outwards, the flange stands ~6 cm further out): half as much
+                # next time (10 deg still cleared a post), then upright
+                lean = 0.5 * lean if np.linalg.norm(lean) > 0.75 else None
             if attempt < self.config.max_retries and overhanging and result.reason.endswith(STOPPED_DESCENDING):
                 # the fingers met something on the way down beside a door that may stand short of its stop,
                 # leaning over this part: push that door up into its stop, then descend again
@@ -212,6 +223,8 @@ class TwinWorld:
             peak, sim_time = max(peak, result.peak_force), sim_time + result.sim_time
             wall_time += result.wall_time
             outcome = self._sensed_outcome(result, marker, opening)
+            if self._door_stayed_shut(outcome):
+                outcome = TryResult("blocked", HELD_UNDER_PINCH_AND_PUSH)
         if outcome.moved:
             self.states[index] ^= 1
         if outcome.outcome == "failed" and len(reasons) > self.config.max_retries:

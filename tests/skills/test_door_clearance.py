@@ -3,6 +3,7 @@ footprint the pipeline predicts from the marker pose alone, at every angle from 
 stop, and the footprint is tight where it matters (the handle leans back over the hinge line at the stop)."""
 
 import math
+from dataclasses import replace
 
 import mujoco
 import numpy as np
@@ -11,7 +12,7 @@ import pytest
 from models.kinds import DOOR_HALF
 from models.puzzle_box import build_puzzle_box
 from models.spec import spec_from_dict
-from skills.door_clearance import door_overhang, near_open_door
+from skills.door_clearance import door_overhang, lean_away, near_open_door
 from skills.door_push import DoorPush
 from skills.joint_model import joint_model
 
@@ -81,3 +82,29 @@ def test_a_grasp_point_beside_the_hinge_line_is_near_and_one_clear_of_the_flap_i
     ahead = push.origin + (high + 0.05) * push.e_x  # 50 mm beyond the highest the free edge can reach
     assert not near_open_door(door, 0.6, ahead, 0.045)
     assert near_open_door(door, 0.1, ahead, 0.045)  # a door that may stand at 8.5 deg reaches far out
+
+
+def test_a_gripper_leans_away_from_the_hinge_line_of_a_door_beside_it_and_stays_upright_between_two(box):
+    """The lean points from the door across its hinge line towards the part (where its post reaches out at the
+    stop); a handle that passes the door only along its hinge line, or sits between two doors' hinge lines, gets
+    no lean."""
+    model, data = box
+    data.qpos[0] = 0.0
+    mujoco.mj_forward(model, data)
+    door = joint_model("door", _frame(model, data))
+    push = DoorPush.of(door, 0.0)
+    beyond_hinge = push.origin - 0.04 * push.e_x  # a neighbour's handle 4 cm past the hinge line
+    lean = lean_away([door], beyond_hinge, beyond_hinge + 0.05 * push.axis)
+    assert lean is not None and lean @ -push.e_x == pytest.approx(1.0) and lean[2] == 0.0
+    beyond_edge = push.origin + 0.13 * push.e_x  # past the free edge: away the other way
+    assert lean_away([door], beyond_edge, beyond_edge) @ push.e_x == pytest.approx(1.0)
+    # a handle moving along the hinge axis that reaches the flap's width only at its end still leans
+    start = beyond_hinge - (DOOR_HALF + 0.03) * push.axis
+    assert lean_away([door], start, start + 0.05 * push.axis) is not None
+    # one that stays off the flap's width along the hinge line does not: the flap stands up across that way
+    assert lean_away([door], start, start + 0.01 * push.axis) is None
+    # a mirror-image door across the handle: leaning from one would lean into the other
+    mirrored = replace(door, axis=-door.axis, origin=2 * beyond_hinge - door.origin,
+                       grasp_point=2 * beyond_hinge - door.grasp_point)  # fmt: skip
+    assert lean_away([door, mirrored], beyond_hinge, beyond_hinge) is None
+    assert lean_away([], beyond_hinge, beyond_hinge) is None

@@ -9,9 +9,10 @@ import numpy as np
 from world_fixtures import twin_world
 
 from learning import DualAgent, OracleAgent, run_episode
-from models import World
+from models import TryResult, World
 from models.generator import generate_chain
-from skills.twin_world import TwinWorld
+from skills.primitives import ToggleResult
+from skills.twin_world import DOOR_STAYED, HELD_UNDER_PINCH_AND_PUSH, TwinWorld
 from twin.nominal_calibration import nominal_calibration
 from twin.session import TwinSession
 
@@ -96,3 +97,30 @@ def test_a_marker_nobody_can_see_is_reported_missing():
         TwinWorld(
             session.robot, nominal_calibration(session), {**{c.marker: c.kind for c in spec.components}, 9: "wheel"}, 1
         )
+
+
+def test_a_door_seen_shut_after_a_pinch_and_a_push_that_both_went_the_whole_way_is_blocked_not_failed():
+    """Both motions ran their course and the door's marker never left its closed pose: the door is held (a latch
+    the pad rode over, or a jam), which is evidence, not a failure to act. A door seen open after the push is a
+    move; a pinch alone that left it shut is followed by exactly one push."""
+    spec = generate_chain(["door", "slide"], seed=3)
+    with TwinSession(spec, seed=0) as session:
+        world = twin_world(session)
+        door = next(i for i, m in enumerate(world.markers) if world.marker_map[m] == "door")
+        calls = []
+
+        def toggle(jm, opening, **options):
+            calls.append(options.get("push", False))
+            return ToggleResult("moved", "", 0.95, 20.0)
+
+        for seen_after_push, expected in ((DOOR_STAYED, "blocked"), ("", "moved")):
+            looks = iter([TryResult("failed", f"{DOOR_STAYED} (2% of its travel)"),
+                          TryResult("failed", f"{seen_after_push} (1% of its travel)") if seen_after_push
+                          else TryResult("moved")])  # fmt: skip
+            world.toggler.toggle, world._sensed_outcome = toggle, lambda *_, looks=looks: next(looks)
+            calls.clear()
+            outcome = world.try_toggle(door)
+            assert calls == [False, True]
+            assert outcome.outcome == expected
+            assert outcome.reason == (HELD_UNDER_PINCH_AND_PUSH if expected == "blocked" else "")
+            world.states[door] = 0
