@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from learning.errors import ConfigError
+from learning.locker_tables import locker_free_table, open_free_rows
 
 
 @dataclass(frozen=True)
@@ -123,6 +124,16 @@ class Belief:
         held[1 + 2 * component + states[component]] = False
         return held
 
+    def held_masks(self, states: np.ndarray) -> np.ndarray:
+        """``(N, 1 + 2N)`` bool: row ``c`` is :meth:`held_mask` of ``c`` (all components at once)."""
+        n = self.num_components
+        states = np.asarray(states, dtype=np.int64)
+        components = np.arange(n)
+        held = np.zeros((n, hypothesis_count(n)), dtype=bool)
+        held[:, 1 + 2 * components + states] = True
+        held[components, 1 + 2 * components + states] = False
+        return held
+
     def probability_free(self, states: np.ndarray, component: int) -> float:
         """Marginal probability that ``component`` is not held in joint state ``states``."""
         block = self.probs[component, int(states[component])]
@@ -161,6 +172,34 @@ class Belief:
     def entropy(self) -> float:
         """Total entropy of the belief [nats]: the sum over the 2N independent blocks."""
         return float(block_entropy(self.probs).sum())
+
+    def free_rows(self, states_bits: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """``(len(rows), S)``: :meth:`free_probabilities` of the components ``rows`` only, transposed."""
+        return self.free_probabilities(states_bits)[:, rows].T
+
+    def single_locker_probs(self) -> np.ndarray:
+        """The belief itself (:attr:`probs`, not a copy): it already is the one-locker categoricals."""
+        return self.probs
+
+    def locker_probs(self) -> np.ndarray:
+        """``(N, 2, N, 2)``: ``[c, s_c, m, s_m] = P(Z[c, s_c] = (m, s_m))``."""
+        n = self.num_components
+        return self.probs[:, :, 1:].reshape(n, 2, n, 2)
+
+    def free_table(self) -> np.ndarray:
+        """``(N, 2^N)``: probability that component ``c`` is free in every joint state ``x`` (by doubling:
+        :func:`learning.locker_tables.locker_free_table`)."""
+        return locker_free_table(self.locker_probs())
+
+    def open_free_rows(self, rows: np.ndarray, goal: int, goal_state: int) -> np.ndarray:
+        """Rows ``rows`` of :meth:`free_table` on the non-goal states
+        (:func:`learning.locker_tables.open_free_rows`)."""
+        return open_free_rows(self.locker_probs(), rows, goal, goal_state)
+
+    def free_upper_bounds(self) -> np.ndarray:
+        """``(N, 2)``: the largest ``P(c free | y)`` over the joint states ``y`` with ``y_c = s`` (every other
+        component in the state that holds ``c`` least)."""
+        return np.clip(1.0 - self.locker_probs().min(axis=3).sum(axis=2), 0.0, 1.0)
 
     def locker_matrix(self) -> np.ndarray:
         """``(2N, 2N)`` view: entry ``[2c + s_c, 2m + s_m] = P(Z[c, s_c] = (m, s_m))``.

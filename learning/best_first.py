@@ -60,6 +60,12 @@ class BestFirstPlanner:
         self.expansions = 0
         """States expanded by all searches so far."""
         self._cache: dict[int, tuple[list[float], list[float]]] = {}
+        self._flips = [1 << c for c in range(n)]
+        self._prepare()
+
+    def _prepare(self) -> None:
+        """What :meth:`expand` reads, from the belief's additive one-locker structure."""
+        belief, n, goal, goal_state = self.belief, self.num_components, self.goal, self.goal_state
         lockers = belief.locker_matrix().reshape(n, 2, n, 2)  # [c, s_c, m, s_m]
         # the goal's block when it is toggled towards the goal: [m, s_m]
         self._goal_lockers = lockers[goal, 1 - goal_state]
@@ -75,7 +81,6 @@ class BestFirstPlanner:
         self._columns = np.arange(n)
         self._shifts = np.arange(n, dtype=np.int64)
         self._lockers_by_row = belief.locker_matrix()
-        self._flips = [1 << c for c in range(n)]
 
     def is_goal(self, x: int) -> bool:
         return ((x >> self.goal) & 1) == self.goal_state

@@ -4,13 +4,16 @@
 not move). Only block ``Z[n, x_n]`` changes, so the KL of the whole belief is that block's KL; the
 expectation is the mutual information between the outcome and the block, which is >= 0 and exactly
 0 when both outcomes leave the belief unchanged.
+
+Any :class:`learning.lock_belief.LockBelief` (one locker per block, or sets of lockers): the blocks are read
+as ``probs[c, s]`` and which of their hypotheses hold ``c`` from :meth:`~learning.lock_belief.LockBelief.held_masks`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from learning.belief import Belief
+from learning.lock_belief import LockBelief
 
 
 def kl_divergence(p: np.ndarray, q: np.ndarray) -> float:
@@ -19,7 +22,7 @@ def kl_divergence(p: np.ndarray, q: np.ndarray) -> float:
     return float(np.sum(p[mask] * (np.log(p[mask]) - np.log(q[mask]))))
 
 
-def expected_information_gain(belief: Belief, states: np.ndarray, component: int) -> float:
+def expected_information_gain(belief: LockBelief, states: np.ndarray, component: int) -> float:
     """Expected KL divergence between posterior and current belief for trying ``component`` [nats]."""
     block = belief.probs[component, int(states[component])]
     p_move = belief.probability_moves(states, component)
@@ -31,7 +34,7 @@ def expected_information_gain(belief: Belief, states: np.ndarray, component: int
     return max(gain, 0.0)  # rounding can leave -1e-17
 
 
-def information_values(belief: Belief, states: np.ndarray, threshold: float = 0.0) -> np.ndarray:
+def information_values(belief: LockBelief, states: np.ndarray, threshold: float = 0.0) -> np.ndarray:
     """``Q_info`` for every action; gains below ``threshold`` [nats] are set to 0 (the authors' release
     drops gains below (1 - gamma) * 1.01 so that near-certain beliefs stop driving exploration).
 
@@ -43,16 +46,13 @@ def information_values(belief: Belief, states: np.ndarray, threshold: float = 0.
     return gains
 
 
-def information_gains(belief: Belief, states: np.ndarray) -> np.ndarray:
+def information_gains(belief: LockBelief, states: np.ndarray) -> np.ndarray:
     """``(N,)`` expected information gain of trying each component in ``states`` [nats]."""
     n = belief.num_components
     states = np.asarray(states, dtype=np.int64)
     components = np.arange(n)
     blocks = belief.probs[components, states]  # (N, H): Z[c, x_c] for every c
-    # held[c, h]: hypothesis 1 + 2m + x_m holds c (m != c), as Belief.held_mask row by row
-    held = np.zeros(blocks.shape, dtype=bool)
-    held[:, 1 + 2 * components + states] = True
-    held[components, 1 + 2 * components + states] = False
+    held = belief.held_masks(states)  # held[c, h]: hypothesis h of Z[c, x_c] holds c in x
     eps, delta = belief.config.jam_probability, belief.config.false_move_probability
     free = np.clip(1.0 - np.where(held, blocks, 0.0).sum(axis=1), 0.0, 1.0)
     p_move = free * (1.0 - eps) + (1.0 - free) * delta

@@ -12,6 +12,12 @@ Above, :class:`learning.best_first.BestFirstPlanner` runs A* on int bitmask stat
 successor, expanding states lazily, with an admissible heuristic and the exact values of earlier
 searches' best paths. A search that ends within ``max_expansions`` is exact; one that reaches it
 (as the authors' release caps its Dijkstra) gives a lower bound on ``V``: the best path found so far.
+
+The belief is any :class:`learning.lock_belief.LockBelief`: the planner asks it for free probabilities
+(``free_table``, ``open_free_rows``, ``free_vector``, ``probability_free``) and never reads its
+hypotheses. For the one-locker :class:`learning.belief.Belief` these are the doubling constructions of
+:mod:`learning.locker_tables` and A* uses its additive heuristic; any other belief (sets of lockers,
+:class:`learning.multi_belief.MultiBelief`) gets :class:`learning.set_best_first.SetBestFirstPlanner`.
 """
 
 from __future__ import annotations
@@ -23,9 +29,11 @@ import numpy as np
 
 from learning.belief import Belief
 from learning.best_first import BestFirstPlanner
+from learning.lock_belief import LockBelief
+from learning.locker_tables import SMALL_N
+from learning.locker_tables import open_free_rows as open_free_rows  # re-exported: its home was here
+from learning.set_best_first import SetBestFirstPlanner
 
-SMALL_N = 10
-"""Up to this N, the free table is one fancy-indexed gather; above, the doubling construction."""
 EXACT_MAX_COMPONENTS = 18
 """Largest N planned by value iteration over all 2^N states (2^18 states x N floats: ~40 MB)."""
 
@@ -41,66 +49,10 @@ class PlannerConfig:
     that reaches it returns the best path found so far (a lower bound on V), else it is exact."""
 
 
-def free_table(belief: Belief) -> np.ndarray:
-    """``(N, 2^N)``: probability that component ``c`` is free in every joint state ``x``.
-
-    ``P(c held | x) = sum_m P(Z[c, x_c] = (m, x_m))`` is a sum of one term per bit of ``x``, so it is
-    built for all states by doubling — ``O(N * 2^N)`` work instead of ``O(N^2 * 2^N)``.
-    """
-    n = belief.num_components
-    locker_probs = belief.probs[:, :, 1:].reshape(n, 2, n, 2)  # [c, x_c, m, x_m]
-    size = 1 << n
-    index = np.arange(size)
-    if n <= SMALL_N:  # one gather over (state, c, m): cheapest when 2^N * N^2 is small
-        bits = (index[:, None] >> np.arange(n)) & 1
-        c_idx, m_idx = np.arange(n)[None, :, None], np.arange(n)[None, None, :]
-        held = locker_probs[c_idx, bits[:, :, None], m_idx, bits[:, None, :]].sum(axis=2)
-        return np.clip(1.0 - held.T, 0.0, 1.0)
-    # held[c, own, x]: one doubling per locker m for every (c, own) at once, in place; the sums run
-    # over m in the same order as one (c, own) at a time, so the table is bit for bit the same
-    held = np.zeros((n, 2, size))
-    for m in range(n):
-        k = 1 << m
-        held[:, :, k : 2 * k] = held[:, :, :k] + locker_probs[:, :, m, 1, None]
-        held[:, :, :k] += locker_probs[:, :, m, 0, None]
-    free = np.empty((n, size))
-    for c in range(n):  # component c's own bit picks its block: halves of stride 2^c
-        out, by_own = free[c].reshape(-1, 2, 1 << c), held[c].reshape(2, -1, 2, 1 << c)
-        np.subtract(1.0, by_own[0, :, 0], out=out[:, 0])
-        np.subtract(1.0, by_own[1, :, 1], out=out[:, 1])
-    return np.clip(free, 0.0, 1.0, out=free)
-
-
-def open_free_rows(locker_probs: np.ndarray, rows: np.ndarray, goal: int, goal_state: int) -> np.ndarray:
-    """Rows ``rows`` of :func:`free_table` on the non-goal states only, ``(len(rows), 2^(N-1))``, indexed
-    by :func:`open_index` (the goal's bit removed): all the value iteration needs, as the goal states'
-    values are 1. ``locker_probs`` is ``(N, 2, N, 2)`` (``[c, x_c, m, x_m]``).
-
-    The same doubling as :func:`free_table` with the goal's bit fixed (its term is added in its turn),
-    so every sum runs over ``m`` in the same order: the entries equal the full table's bit for bit.
-    """
-    n = locker_probs.shape[0]
-    lockers = locker_probs[rows]
-    size = 1 << (n - 1)
-    held = np.zeros((len(rows), 2, size))
-    k = 1
-    for m in range(n):
-        if m == goal:  # fixed at 1 - goal_state in every non-goal state
-            held += lockers[:, :, m, 1 - goal_state, None]
-            continue
-        held[:, :, k : 2 * k] = held[:, :, :k] + lockers[:, :, m, 1, None]
-        held[:, :, :k] += lockers[:, :, m, 0, None]
-        k *= 2
-    free = np.empty((len(rows), size))
-    for i, c in enumerate(rows.tolist()):
-        if c == goal:
-            np.subtract(1.0, held[i, 1 - goal_state], out=free[i])
-            continue
-        j = c if c < goal else c - 1  # c's bit in the open index
-        out, by_own = free[i].reshape(-1, 2, 1 << j), held[i].reshape(2, -1, 2, 1 << j)
-        np.subtract(1.0, by_own[0, :, 0], out=out[:, 0])
-        np.subtract(1.0, by_own[1, :, 1], out=out[:, 1])
-    return np.clip(free, 0.0, 1.0, out=free)
+def free_table(belief: LockBelief) -> np.ndarray:
+    """``(N, 2^N)``: probability that component ``c`` is free in every joint state ``x`` (the belief's own
+    construction: by doubling for one locker per block, :mod:`learning.locker_tables`)."""
+    return belief.free_table()
 
 
 def open_index(x: int | np.ndarray, goal: int) -> int | np.ndarray:
@@ -108,7 +60,7 @@ def open_index(x: int | np.ndarray, goal: int) -> int | np.ndarray:
     return (x & ((1 << goal) - 1)) | ((x >> (goal + 1)) << goal)
 
 
-def state_values(belief: Belief, goal: int, goal_state: int, gamma: float) -> np.ndarray:
+def state_values(belief: LockBelief, goal: int, goal_state: int, gamma: float) -> np.ndarray:
     """``V(x)`` for all ``2^N`` states by value iteration to the exact fixed point."""
     return value_iteration(free_table(belief), goal, goal_state, gamma)
 
@@ -181,7 +133,7 @@ class _StepCache:
         self.probs = np.empty(0)
         self.step = np.empty(0)
 
-    def get(self, belief: Belief, goal: int, goal_state: int, gamma: float) -> np.ndarray:
+    def get(self, belief: LockBelief, goal: int, goal_state: int, gamma: float) -> np.ndarray:
         n = belief.num_components
         probs = belief.probs
         if self.key != (goal, goal_state, gamma) or self.probs.shape != probs.shape:
@@ -190,17 +142,16 @@ class _StepCache:
         else:
             rows = np.flatnonzero(np.any((self.probs != probs).reshape(n, -1), axis=1))
         if rows.size:
-            locker_probs = probs[:, :, 1:].reshape(n, 2, n, 2)
-            self.step[rows] = gamma * open_free_rows(locker_probs, rows, goal, goal_state)
+            self.step[rows] = gamma * belief.open_free_rows(rows, goal, goal_state)
         self.key, self.probs = (goal, goal_state, gamma), probs.copy()
         return self.step
 
 
-_STEP_CACHES: weakref.WeakKeyDictionary[Belief, _StepCache] = weakref.WeakKeyDictionary()
+_STEP_CACHES: weakref.WeakKeyDictionary[LockBelief, _StepCache] = weakref.WeakKeyDictionary()
 
 
 def exploit_values(
-    belief: Belief, states: np.ndarray, goal: int, goal_state: int, config: PlannerConfig | None = None
+    belief: LockBelief, states: np.ndarray, goal: int, goal_state: int, config: PlannerConfig | None = None
 ) -> np.ndarray:
     """``Q_exploit`` for every action from joint state ``states`` (0/1 per component): value iteration
     up to :data:`EXACT_MAX_COMPONENTS`, A* per successor (:class:`BestFirstPlanner`) above."""
@@ -211,7 +162,9 @@ def exploit_values(
     return _best_first_values(belief, x, goal, goal_state, config)
 
 
-def _sweep_values(belief: Belief, states: np.ndarray, x: int, goal: int, goal_state: int, gamma: float) -> np.ndarray:
+def _sweep_values(
+    belief: LockBelief, states: np.ndarray, x: int, goal: int, goal_state: int, gamma: float
+) -> np.ndarray:
     n = belief.num_components
     if n <= SMALL_N:
         table = free_table(belief)
@@ -229,6 +182,8 @@ def _sweep_values(belief: Belief, states: np.ndarray, x: int, goal: int, goal_st
     return gamma * free * after
 
 
-def _best_first_values(belief: Belief, x: int, goal: int, goal_state: int, config: PlannerConfig) -> np.ndarray:
-    """``Q_exploit`` by best-first search alone, ``config.max_expansions`` per search (a lower bound)."""
-    return BestFirstPlanner(belief, goal, goal_state, config.gamma).exploit_values(x, config.max_expansions)
+def _best_first_values(belief: LockBelief, x: int, goal: int, goal_state: int, config: PlannerConfig) -> np.ndarray:
+    """``Q_exploit`` by best-first search alone, ``config.max_expansions`` per search (a lower bound). The
+    one-locker belief's additive structure gives a sharper heuristic; any other belief gets the generic one."""
+    search = BestFirstPlanner if isinstance(belief, Belief) else SetBestFirstPlanner
+    return search(belief, goal, goal_state, config.gamma).exploit_values(x, config.max_expansions)

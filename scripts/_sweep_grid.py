@@ -11,13 +11,16 @@ Format (paths relative to the sweep file)::
                                                         # absent: the profile's own (a new one per seed)
       "placement_seed": 0,
       "seeds": {"start": 1000, "count": 20},            # or a list of seeds
-      "agents": ["oracle", {"name": "memory", "memory": "memory.sqlite"}],
+      "agents": ["oracle", {"name": "memory", "memory": "memory.sqlite"},
+                 {"name": "memory", "memory": "memory.sqlite", "max_lockers": 2, "label": "memory-k2"}],
       "profiles": ["ideal", "realistic"],               # twin: reality profiles (names or JSON files)
       "calibrations": {"realistic": "calibration-realistic.json"},
       "max_actions": 30
     }
 
-A cell is one (spec, placement, agent, profile); its runs are the seeds.
+A cell is one (spec, placement, agent, profile); its runs are the seeds. An agent's ``max_lockers`` (symbolic
+memory and dual agents; default 1, the paper's belief) lets its belief hold a component with up to that many
+lockers (``learning.dual_controller.DualControllerConfig.max_lockers``).
 """
 
 from __future__ import annotations
@@ -32,6 +35,9 @@ import numpy as np
 from _trial_task import trial_task
 
 from learning import AGENT_NAMES
+from learning.agents.factory import BELIEF_AGENT_NAMES
+from learning.dual_controller import DualControllerConfig
+from learning.errors import ConfigError
 from learning.runner import Task
 from models import PuzzleSpec, load_spec
 from models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random
@@ -39,6 +45,9 @@ from models.spec import file_precision
 
 KEYS = {"sim", "specs", "generate", "placements", "placement_seed", "seeds", "agents", "profiles", "calibrations",
         "max_actions", "name"}  # fmt: skip
+
+
+AGENT_KEYS = {"name", "memory", "checkpoint", "label", "max_lockers"}
 
 
 class SweepError(ValueError):
@@ -127,6 +136,18 @@ def _agents(sweep: dict[str, Any], base: Path) -> list[dict[str, Any]]:
                     raise SweepError(f"agent {agent['name']}: no {key} file at {agent[key]}")
         if (agent["name"] == "memory") != bool(agent.get("memory")):
             raise SweepError("agent 'memory' needs a 'memory' file (and only it has one)")
+        unknown = sorted(set(agent) - AGENT_KEYS)
+        if unknown:
+            raise SweepError(f"agent {agent['name']}: unknown key(s) {unknown}; known: {sorted(AGENT_KEYS)}")
+        if agent.get("max_lockers", 1) != 1:
+            if sweep["sim"] != "symbolic" or agent["name"] not in BELIEF_AGENT_NAMES:
+                raise SweepError(
+                    f"agent {agent['name']}: 'max_lockers' is for the symbolic agents {list(BELIEF_AGENT_NAMES)}"
+                )
+            try:
+                DualControllerConfig(max_lockers=agent["max_lockers"])
+            except ConfigError as err:
+                raise SweepError(f"agent {agent['name']}: {err}") from None
         agent["label"] = agent.get("label") or agent["name"]
         agents.append(agent)
     labels = [a["label"] for a in agents]
@@ -184,6 +205,7 @@ def grid(sweep: dict[str, Any], base: Path) -> tuple[list[Task], dict[str, Cell]
                             memory=agent.get("memory"), checkpoint=agent.get("checkpoint"),
                             reality=reality.to_dict() if reality is not None else None,
                             calibration=calibration.to_dict() if calibration is not None else None,
+                            max_lockers=agent.get("max_lockers", 1),
                         ))  # fmt: skip
                         cells[key] = cell
     return tasks, cells

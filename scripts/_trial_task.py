@@ -47,9 +47,11 @@ def trial_task(
     calibration: dict[str, Any] | None = None,
     video: str | None = None,
     misreport_kind: bool = False,
+    max_lockers: int = 1,
 ) -> Task:
     """The task of one run (``reality`` and ``calibration`` as their ``to_dict()``; twin only;
-    ``misreport_kind``: one component's kind told wrong, drawn from the seed)."""
+    ``misreport_kind``: one component's kind told wrong, drawn from the seed; ``max_lockers``: the most
+    lockers the memory and dual agents' belief allows a component, symbolic only)."""
     settings = {
         "sim": sim, "spec": spec.to_dict(), "seed": seed, "agent": agent, "max_actions": max_actions,
         "memory": str(Path(memory).resolve()) if memory else None,
@@ -60,6 +62,8 @@ def trial_task(
     }  # fmt: skip
     if misreport_kind:  # only then: the settings (and hashes) of every other task stay as they were
         settings["misreport_kind"] = True
+    if max_lockers != 1:  # likewise: a k = 1 task is the task it was before k existed
+        settings["max_lockers"] = max_lockers
     return Task(key, run_trial, settings, context={"video": video} if video else None)
 
 
@@ -96,7 +100,9 @@ def _run(spec: PuzzleSpec, settings: Mapping[str, Any], video: str | None) -> di
                               Path(video) if video else None,
                               settings["checkpoint"], reality, calibration, on_action=_on_action,
                               misreport_kind=settings.get("misreport_kind", False))  # fmt: skip
-    agent = make_agent(settings["agent"], spec, memory, settings["checkpoint"])
+    agent = make_agent(
+        settings["agent"], spec, memory, settings["checkpoint"], max_lockers=settings.get("max_lockers", 1)
+    )
     world = SymbolicWorld(spec, settings["seed"])
     return run_episode(agent, world, spec.name, settings["seed"], settings["max_actions"], _on_action).to_dict()
 

@@ -5,6 +5,9 @@
 - agent decision latency: median and 90th percentile milliseconds per dual-controller decision on
   random lock graphs of N = 5, 10, 16, 32 components (beliefs as they evolve during real episodes;
   boxes beyond the robot's reach are generated for the symbolic simulator, as ``generate.py --anywhere``);
+- belief over sets of lockers: median and 90th percentile milliseconds per decision and belief update
+  (``choose`` + ``record``) of the dual agent on 8-component two-locker boxes, with ``max_lockers`` 1 (the
+  paper's belief) and 2 (sets of up to two lockers), one after the other in this run;
 - symbolic environment: steps per second of ``PuzzleEnv.step`` with random actions;
 - twin: scene build + compile time; bare ``mj_step`` rate on the compiled paper scene (one step per
   call, as a Python user steps, and ``nstep`` in C) beside the twin's rate on the same model, with
@@ -34,6 +37,7 @@ import numpy as np  # noqa: E402
 from _cli import fail, versions, write_json  # noqa: E402
 
 from learning import DualAgent, PuzzleEnv, PuzzleEnvConfig, SymbolicWorld  # noqa: E402
+from learning.dual_controller import DualControllerConfig  # noqa: E402
 from models.generator import RandomGraphConfig, generate_random  # noqa: E402
 from models.generator.chain import MAX_REACHABLE_COMPONENTS, BoxConfig  # noqa: E402
 
@@ -62,6 +66,36 @@ def decision_latency(n: int, episodes: int, max_decisions: int) -> dict[str, flo
             agent.record(index, result, observation)
     ms = 1000.0 * np.array(times)
     return {"median_ms": float(np.median(ms)), "p90_ms": float(np.percentile(ms, 90)), "decisions": len(ms)}
+
+
+def multi_locker_latency(n: int = 8, episodes: int = 5, max_decisions: int = 40) -> dict[str, dict[str, float]]:
+    """Milliseconds per decision and belief update (``choose`` + ``record``) of the dual agent on
+    two-locker random boxes of ``n`` components, per ``max_lockers`` (1 and 2), on the same boxes."""
+    out = {}
+    for k in (1, 2):
+        times = []
+        for episode in range(episodes):
+            spec = generate_random(RandomGraphConfig(n, multi_locker=True), seed=episode)
+            world = SymbolicWorld(spec, episode)
+            agent = DualAgent(DualControllerConfig(max_lockers=k))
+            observation = world.observe()
+            agent.begin_episode(observation, np.random.default_rng(episode))
+            for _ in range(max_decisions):
+                if observation.solved:
+                    break
+                start = time.perf_counter()
+                index = agent.choose(observation)
+                decided = time.perf_counter()
+                result = world.try_toggle(index)  # the world's step is not the agent's time
+                observation = world.observe()
+                resumed = time.perf_counter()
+                agent.record(index, result, observation)
+                times.append(decided - start + time.perf_counter() - resumed)
+        ms = 1000.0 * np.array(times)
+        out[f"max_lockers={k}"] = {
+            "median_ms": float(np.median(ms)), "p90_ms": float(np.percentile(ms, 90)), "decisions": len(ms)
+        }  # fmt: skip
+    return out
 
 
 def env_steps_per_second(seconds: float = 1.0) -> float:
@@ -165,6 +199,10 @@ def main(argv: list[str] | None = None) -> int:
         results["decision_latency"][f"N={n}"] = stats = decision_latency(n, episodes, max_decisions=3 * n)
         print(f"decision latency N={n:>2}: median {stats['median_ms']:.3f} ms, p90 {stats['p90_ms']:.3f} ms "
               f"over {stats['decisions']} decisions")  # fmt: skip
+    results["multi_locker_latency_n8"] = multi = multi_locker_latency(episodes=episodes)
+    for label, stats in multi.items():
+        print(f"decision + update N=8 two-locker boxes, {label}: median {stats['median_ms']:.3f} ms, "
+              f"p90 {stats['p90_ms']:.3f} ms over {stats['decisions']} decisions")  # fmt: skip
     results["symbolic_env_steps_per_s"] = rate = env_steps_per_second(0.3 if args.quick else 2.0)
     print(f"symbolic env: {rate:,.0f} steps/s")
     results["twin"] = twin = twin_figures(args.quick)

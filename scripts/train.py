@@ -1,11 +1,15 @@
 """Train the memory agent in the symbolic simulator or end to end in the twin, and write its memory.
 
-    python scripts/train.py --specs FILE... --episodes E --memory MEM.sqlite [--seed S] [--resume]
+    python scripts/train.py --specs FILE... --episodes E --memory MEM.sqlite [--seed S] [--max-lockers K] [--resume]
     python scripts/train.py --specs FILE... --episodes E --memory MEM.sqlite --sim twin \
         [--reality ideal|realistic|harsh|FILE.json] [--calibration FILE.json] [--seed S] [--resume]
     python scripts/train.py --specs FILE... --episodes E --agent DEEP --checkpoint FILE [--seed S]
 
 ``DEEP`` is one of dqn, model-based, mt-dqn, mt-model-based.
+
+``--max-lockers K`` (symbolic) trains the memory agent with a belief over sets of up to K lockers per component
+(default 1: the paper's one-locker belief); the memory stores each episode's graph in its one-locker form either
+way (``learning.multi_belief.MultiBelief.single_locker_probs``), so any agent can recall it.
 
 Episode ``e`` runs on ``specs[e % len(specs)]`` with world seed ``S + e``. The memory is written to
 SQLite after every episode (one transaction each, the episode's training-log row with it), so an
@@ -38,6 +42,7 @@ from _interrupt import StopRequests
 from tqdm import tqdm
 
 from learning import DEEP_AGENT_NAMES, MemoryAgent, SymbolicWorld, run_episode
+from learning.dual_controller import DualControllerConfig
 from learning.errors import LearningError
 from learning.memory import MemoryStore
 from models import SpecError, load_spec
@@ -55,6 +60,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sim", choices=("symbolic", "twin"), default="symbolic", help="where episodes run")
     parser.add_argument("--reality", default=None, help="twin reality profile: ideal, realistic, harsh or FILE.json")
     parser.add_argument("--calibration", default=None, help="twin: the cell's calibration file (calibrate.py)")
+    parser.add_argument(
+        "--max-lockers", type=int, default=1, metavar="K",
+        help="symbolic memory agent: believe in sets of up to K lockers per component (default 1: the paper's)",
+    )  # fmt: skip
     parser.add_argument("--resume", action="store_true", help="continue the latest run of this same command")
     args = parser.parse_args(argv)
     if args.episodes < 1 or args.max_actions < 1:
@@ -67,6 +76,14 @@ def main(argv: list[str] | None = None) -> int:
         fail(str(err))
     if args.sim == "symbolic" and (args.reality is not None or args.calibration is not None):
         fail("--reality and --calibration are for --sim twin")
+    controller = None
+    if args.max_lockers != 1:
+        if args.sim != "symbolic" or args.agent != "memory":
+            fail("--max-lockers is for the memory agent with --sim symbolic (the twin's keeps the one-locker belief)")
+        try:
+            controller = DualControllerConfig(max_lockers=args.max_lockers)
+        except LearningError as err:
+            fail(f"--max-lockers: {err}")
     twin = _twin_setup(args, specs) if args.sim == "twin" else None
     if args.agent != "memory":
         if twin is not None:
@@ -80,6 +97,8 @@ def main(argv: list[str] | None = None) -> int:
     memory_path = Path(args.memory)
     _check_writable(memory_path, "--memory")
     command = {key: value for key, value in vars(args).items() if key != "resume"}
+    if args.max_lockers == 1:  # the default leaves the command as it was before k existed (resumable)
+        del command["max_lockers"]
     try:
         store = MemoryStore(args.memory)
         run_id, done_seeds = _resumed_run(store, command) if args.resume else (None, set())
@@ -102,7 +121,7 @@ def main(argv: list[str] | None = None) -> int:
                 if stop.requested:
                     break
                 spec = specs[e % len(specs)]
-                agent = MemoryAgent(store, learn=True, config=None if twin is None else twin.controller)
+                agent = MemoryAgent(store, learn=True, config=controller if twin is None else twin.controller)
                 agent.episode_label, agent.episode_seed, agent.training_run = spec.name, args.seed + e, run_id
                 if twin is None:
                     result = run_episode(agent, SymbolicWorld(spec, args.seed + e), spec.name, args.seed + e,

@@ -1,7 +1,7 @@
 """Run seeded trials of an agent on puzzle specs and write ``DIR/results.json``.
 
     python scripts/trial.py --specs FILE... [--memory MEM.sqlite] --sim {symbolic,twin} --runs K --seed S \
-                            --max-actions M --out DIR [--agent NAME] [--video] \
+                            --max-actions M --out DIR [--agent NAME] [--max-lockers K] [--video] \
                             [--reality ideal|realistic|harsh|FILE.json] [--calibration FILE.json] [--wrong-kind] \
                             [--workers K | --ray auto|ADDRESS] [--resume | --force]
 
@@ -13,7 +13,10 @@ single run). ``--reality`` picks the twin's reality profile (sensor noise, calib
 friction, jams, slips, the box placed anywhere reachable; default ``ideal``), ``--calibration`` the
 cell's camera calibration made by ``scripts/calibrate.py`` (default: the nominal, datasheet
 calibration, exact only under ``ideal``); a calibration made for another cell (another profile,
-``cell_seed`` or box height) is refused. ``--wrong-kind`` tells the pipeline (skills and agent) one
+``cell_seed`` or box height) is refused. ``--max-lockers K`` (symbolic, memory and dual agents) lets the
+agent's belief hold a component with a set of up to K lockers (default 1: the paper's one-locker belief;
+2 for boxes made with ``generate.py random --multi-locker``). ``--wrong-kind`` tells the pipeline (skills
+and agent) one
 component's kind wrong in every run, drawn from the run's seed (the run's ``told_kinds``): the force limits
 must hold when a slide is pulled along a wheel's arc.
 
@@ -47,6 +50,8 @@ from _run_store import Periodic, RunStore
 from tqdm import tqdm
 
 from learning import AGENT_NAMES, LearningError, make_agent, summarise
+from learning.agents.factory import BELIEF_AGENT_NAMES
+from learning.dual_controller import DualControllerConfig
 from learning.memory import MemoryStore
 from learning.runner import InlineExecutor, RunnerError, make_executor, run_tasks
 from models import SpecError, load_spec
@@ -104,7 +109,7 @@ def _tasks(args, specs, reality, calibration, out: Path) -> list:
                 max_actions=args.max_actions, memory=args.memory, checkpoint=args.checkpoint,
                 reality=reality.to_dict() if reality is not None else None,
                 calibration=calibration.to_dict() if calibration is not None else None, video=video,
-                misreport_kind=args.wrong_kind,
+                misreport_kind=args.wrong_kind, max_lockers=args.max_lockers,
             ))  # fmt: skip
     return tasks
 
@@ -144,6 +149,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", required=True, help="output directory")
     parser.add_argument("--agent", default="memory", help=f"one of {list(AGENT_NAMES)} (default: memory)")
     parser.add_argument("--checkpoint", default=None, help="checkpoint from train.py (deep agents)")
+    parser.add_argument(
+        "--max-lockers", type=int, default=1, metavar="K",
+        help="symbolic memory/dual agents: believe in sets of up to K lockers per component (default 1: the paper's)",
+    )  # fmt: skip
     parser.add_argument("--video", action="store_true", help="record rollout videos (twin only)")
     parser.add_argument(
         "--wrong-kind", action="store_true",
@@ -172,6 +181,15 @@ def main(argv: list[str] | None = None) -> int:
         fail(f"unknown agent {args.agent!r}. Available agents: {sorted(AGENT_NAMES)}")
     if (args.agent == "memory") != (args.memory is not None):
         fail("--memory goes with --agent memory (and only with it): train one with scripts/train.py")
+    if args.max_lockers != 1:
+        if args.sim != "symbolic":
+            fail("--max-lockers needs --sim symbolic (the twin's agents keep the one-locker belief)")
+        if args.agent not in BELIEF_AGENT_NAMES:
+            fail(f"--max-lockers is for the agents {list(BELIEF_AGENT_NAMES)}, not {args.agent!r}")
+        try:
+            DualControllerConfig(max_lockers=args.max_lockers)
+        except LearningError as err:
+            fail(f"--max-lockers: {err}")
     if args.video and args.sim != "twin":
         fail("--video needs --sim twin")
     if args.sim != "twin" and (args.reality != "ideal" or args.calibration):
@@ -212,6 +230,8 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(args.out)
     not_results = ("out", "resume", "force", "workers", "ray")  # where and how it runs changes no record
     experiment = {"command": "trial", **{k: v for k, v in vars(args).items() if k not in not_results}}
+    if args.max_lockers == 1:  # the default leaves the configuration as it was before k existed (resumable)
+        del experiment["max_lockers"]
     # symbolic runs last less than a hand-over; a pool is started for no more twin runs than there are
     workers = args.workers or (min(os.cpu_count() or 1, len(specs) * args.runs) if args.sim == "twin" else 1)
     try:

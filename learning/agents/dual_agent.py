@@ -7,8 +7,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from learning.belief import Belief, default_prior
-from learning.dual_controller import Decision, DualControllerConfig, decide, max_entropy_for
+from learning.belief import default_prior
+from learning.dual_controller import Decision, DualControllerConfig, decide, max_entropy_for, new_belief
+from learning.lock_belief import LockBelief
 from learning.memory.keys import relative_pose_keys
 from learning.memory.prior import MemoryConfig, episode_record, recall_prior
 from learning.memory.store import MemoryStore
@@ -16,23 +17,29 @@ from models import SceneObservation, TryResult
 
 
 class DualAgent:
-    """The paper's dual controller starting every task from the uninformed prior."""
+    """The paper's dual controller starting every task from the uninformed prior.
+
+    The belief is over one locker per component and state (``config.max_lockers = 1``, the paper's) or over
+    sets of up to ``max_lockers`` (:func:`learning.dual_controller.new_belief`); the prior is given in the
+    one-locker form either way (:meth:`initial_prior`).
+    """
 
     name = "dual"
 
     def __init__(self, config: DualControllerConfig | None = None) -> None:
         self.config = config or DualControllerConfig()
-        self.belief: Belief | None = None
+        self.belief: LockBelief | None = None
         self.decisions: list[Decision] = []
         self._rng = np.random.default_rng(0)
         self._states = np.zeros(0, dtype=np.int64)
         self._h_max = 1.0
 
     def initial_prior(self, observation: SceneObservation) -> np.ndarray:
+        """The one-locker prior ``(N, 2, 1 + 2N)`` of a new task."""
         return default_prior(len(observation), self.config.belief.prior_independent)
 
     def begin_episode(self, observation: SceneObservation, rng: np.random.Generator) -> None:
-        self.belief = Belief(self.initial_prior(observation), self.config.belief)
+        self.belief = new_belief(self.initial_prior(observation), self.config)
         self._h_max = max_entropy_for(len(observation), self.config)
         self._rng = rng
         self.decisions = []
@@ -108,7 +115,8 @@ class MemoryAgent(DualAgent):
         if not self.learn or self.belief is None or self._observation is None:
             return
         observation = self._observation
-        pair_values, independence = episode_record(self.belief.probs)
+        # a belief over sets of lockers is stored as its one-locker view: the memory's format
+        pair_values, independence = episode_record(self.belief.single_locker_probs())
         keys = relative_pose_keys(observation.poses, self.store.position_scale)
         self.store.add_episode(
             observation.kinds,

@@ -15,6 +15,8 @@ from models import PuzzleSpec
 DEEP_AGENT_NAMES = ("dqn", "model-based", "mt-dqn", "mt-model-based")
 """The deep baselines (torch; ``learning.baselines``): DQN, the precondition planner, and their MT-OPT
 variants."""
+BELIEF_AGENT_NAMES = ("memory", "dual")
+"""The agents that act on a belief over the lock graph (the dual controller's)."""
 POSE_ENCODINGS = ("relative", "absolute")
 """Where the deep agents' graph network sees poses (``learning.baselines.GraphNetworkConfig.poses``)."""
 AGENT_NAMES = ("memory", "dual", "random", "oracle", *DEEP_AGENT_NAMES)
@@ -29,10 +31,17 @@ def make_agent(
     memory: MemoryStore | None = None,
     checkpoint: str | None = None,
     belief: BeliefConfig | None = None,
+    max_lockers: int = 1,
 ) -> Agent:
     """A fresh agent for one puzzle; :class:`UnknownAgent` lists the names that exist. ``belief`` is the
-    observation model of the belief-based agents (``memory``, ``dual``; default :class:`BeliefConfig`)."""
+    observation model of the belief-based agents (``memory``, ``dual``; default :class:`BeliefConfig`),
+    ``max_lockers`` the most lockers their belief allows one component (1: the paper's; see
+    :class:`DualControllerConfig`); the other agents take neither."""
     controller = DualControllerConfig(belief=belief) if belief is not None else None
+    if max_lockers != 1:  # k = 1 keeps the agents' own default config, as before k existed
+        if name not in BELIEF_AGENT_NAMES:
+            raise ConfigError(f"agent {name!r} has no belief; max_lockers is for {list(BELIEF_AGENT_NAMES)}")
+        controller = DualControllerConfig(belief=belief or BeliefConfig(), max_lockers=max_lockers)
     if name in DEEP_AGENT_NAMES:
         if checkpoint is None:
             raise ConfigError(f"agent {name!r} needs a checkpoint (train one with scripts/train.py --agent {name})")
