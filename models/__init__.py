@@ -31,6 +31,7 @@ from models.spec import (
     spec_from_dict,
     spec_from_json,
 )
+from models.toggle_log import ToggleLog, load_toggles, save_toggles
 from models.try_outcome import OUTCOMES, Outcome, TryResult
 from models.validation import validate_data
 from models.world import World
@@ -59,12 +60,15 @@ __all__ = [
     "SceneObservation",
     "SpecError",
     "SpecProblem",
+    "ToggleLog",
     "UnknownKindError",
     "World",
     "get_kind",
     "kind_code",
     "load_spec",
+    "load_toggles",
     "save_spec",
+    "save_toggles",
     "spec_from_dict",
     "spec_from_json",
     "validate_data",

@@ -7,6 +7,7 @@ the reality gap in the twin.
     python scripts/experiment.py faults --out DIR [--quick] [--runs R]
     python scripts/experiment.py twin-learning --out DIR [--quick] [--runs R] [--seeds S] [--workers W | --ray ...]
                                  [--agents memory,dqn,model-based]
+    python scripts/experiment.py sysid --out DIR [--workers W] [--quick]
 
 Writes ``DIR/<protocol>.json`` (every point, mean and std over training seeds and each seed's value,
 the settings), ``DIR/<protocol>.png`` (success and mean actions, like the paper's Fig. 3 panels) and
@@ -28,6 +29,11 @@ alone over σ; each profile's cell is calibrated from ChArUco images first. It w
 factor's level; the F/T noise at which outcome agreement drops below 99 %) and keeps every calibration and
 trial in ``DIR/calibrations/`` and ``DIR/trials/``: the same command resumes. ``--memory`` is the memory
 agent's store (default: trained into ``DIR/memory.sqlite`` on the paper training boxes).
+
+``sysid`` (``scripts/_sysid.py``) identifies the box's per-kind joint damping, joint friction and latch
+compliance from logged robot data of toggles (oracle trials in the twin under ``realistic``, three cells) and
+reports the nominal and the fitted twin's prediction errors of the wrench and the part's motion on held-out
+toggles: ``DIR/sysid.{json,md,png}``, every trial's log in ``DIR/logs/``; the same command resumes.
 
 ``faults`` (``scripts/_faults.py``) runs each fault class on purpose in real processes — ``trial.py``
 SIGKILLed at random moments and resumed (``--runs`` runs in the twin; ``--quick``: symbolic), concurrent
@@ -55,13 +61,14 @@ PLANNED = ("disassembly",)
 REALITY = "reality"
 FAULTS = "faults"
 TWIN_LEARNING = "twin-learning"
+SYSID = "sysid"
 ALL = "all"
 AGENTS = (*SYMBOLIC_AGENTS, *DEEP_AGENTS)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("protocol", choices=(*PROTOCOLS, ALL, REALITY, FAULTS, TWIN_LEARNING, *PLANNED))
+    parser.add_argument("protocol", choices=(*PROTOCOLS, ALL, REALITY, FAULTS, TWIN_LEARNING, SYSID, *PLANNED))
     parser.add_argument("--agents", default=None, help=f"comma-separated, from {list(AGENTS)} (reality: memory)")
     parser.add_argument("--out", required=True, help="output directory (also the resume cache of deep jobs)")
     parser.add_argument("--quick", action="store_true", help="CI size: few runs, one training seed, short schedules")
@@ -83,6 +90,8 @@ def main(argv: list[str] | None = None) -> int:
         return _faults(args)
     if args.protocol == TWIN_LEARNING:
         return _twin_learning(args)
+    if args.protocol == SYSID:
+        return _sysid(args)
     if args.memory is not None:
         fail("--memory is for the reality protocol (the symbolic protocols train their own)")
     if args.agents is None:
@@ -196,6 +205,26 @@ def _twin_learning(args: argparse.Namespace) -> int:
     except LearningError as err:
         fail(str(err))
     return _report(out, TWIN_LEARNING, summary)
+
+
+def _sysid(args: argparse.Namespace) -> int:
+    from _sysid import SysIdConfig, run_sysid
+
+    given = [f"--{name}" for name in ("agents", "runs", "seeds", "ray", "memory") if getattr(args, name) is not None]
+    if given:
+        fail(f"the sysid protocol takes only --out, --workers and --quick, got {' '.join(given)}")
+    if args.workers is not None and args.workers < 1:
+        fail(f"--workers must be >= 1, got {args.workers}")
+    config = SysIdConfig().quick() if args.quick else SysIdConfig()
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        fail(f"--out {out} is a file, not a directory")
+    _write_config(out, SYSID, args, sysid=asdict(config))
+    try:
+        summary = run_sysid(out, config, args.workers)
+    except LearningError as err:
+        fail(str(err))
+    return _report(out, SYSID, summary)
 
 
 def _faults(args: argparse.Namespace) -> int:

@@ -12,6 +12,7 @@ from skills.perception import (
     select_markers,
     upright_pose,
 )
+from skills.toggle_recorder import ToggleRecorder
 
 __all__ = [
     "JointModel",
@@ -20,6 +21,7 @@ __all__ = [
     "MarkersNotFound",
     "PerceptionConfig",
     "SkillError",
+    "ToggleRecorder",
     "UnknownMarker",
     "joint_model",
     "kind_of",

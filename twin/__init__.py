@@ -37,6 +37,12 @@ _LAZY = {
     "TwinSession": "twin.session",
     "TwinState": "twin.session",
     "sweep_open": "twin.scripted_sweep",
+    "KindScales": "twin.toggle_replay",
+    "ToggleReplay": "twin.toggle_replay",
+    "FitConfig": "twin.system_id",
+    "fit_kind": "twin.system_id",
+    "prepare": "twin.toggle_scoring",
+    "toggle_errors": "twin.toggle_scoring",
 }
 
 
@@ -49,7 +55,9 @@ def __getattr__(name: str) -> Any:
 __all__ = [
     "CommandError",
     "ComponentStates",
+    "FitConfig",
     "HysteresisConfig",
+    "KindScales",
     "PRESETS",
     "ProfileError",
     "RealityProfile",
@@ -61,10 +69,14 @@ __all__ = [
     "TwinConfig",
     "TwinError",
     "TwinSession",
+    "ToggleReplay",
     "TwinState",
     "UnknownCamera",
     "VideoError",
     "VideoWriter",
+    "fit_kind",
     "load_profile",
+    "prepare",
     "sweep_open",
+    "toggle_errors",
 ]

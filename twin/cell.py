@@ -5,10 +5,17 @@ session's model, as a real cell is built (and calibrated) once.
 - each camera's mounting error, in ``model.cam_pos`` / ``model.cam_quat`` (relative to the body it is
   fixed to: the world for the overview camera, the gripper for the wrist camera);
 - the TCP bias: the physical gripper shifted on the flange (the gripper's mount body moved in the
-  flange frame) while the arm's kinematics keep reporting the nominal TCP.
+  flange frame) while the arm's kinematics keep reporting the nominal TCP;
+- the box's hardware per component kind: one joint damping, one joint friction (frictionloss) and one
+  latch compliance (``solref[0]``) factor per kind, in the order of ``models.kinds.KIND_NAMES`` (door,
+  slide, wheel). The session multiplies each component's per-trial factors
+  (:mod:`twin.physics_draws`) by its kind's: a real cell's hinges, slides and bearings have the friction
+  they have, trial after trial, and differ from the CAD-nominal model systematically per kind.
 
-Draws are made in a fixed order (cameras in the order given, then the TCP bias) and always, even for
-zero magnitudes, so one error's draw does not depend on whether another is zero.
+Draws are made in a fixed order (cameras in the order given, then the TCP bias, then the kind factors:
+damping, friction, latch compliance, each for every kind) and always, even for zero magnitudes or identity
+ranges, so one error's draw does not depend on whether another is zero. The kind factors come after
+everything drawn before them existed, which therefore stays bit-identical.
 """
 
 from __future__ import annotations
@@ -19,6 +26,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from models.kinds import KIND_NAMES
 from twin.reality import RealityProfile
 from twin.sensors.random_vectors import random_vector
 
@@ -48,15 +56,46 @@ class CameraErrors:
 
 
 @dataclass(frozen=True)
+class KindFactors:
+    """One cell's box hardware: a factor per component kind (``models.kinds.KIND_NAMES``) [-]."""
+
+    joint_damping: dict[str, float]
+    """Multiplier of the joint damping of every component of a kind."""
+    joint_friction: dict[str, float]
+    """Multiplier of the joint dry friction (frictionloss) of every component of a kind."""
+    latch_compliance: dict[str, float]
+    """Multiplier of the latch time constant (``solref[0]``) of every component of a kind."""
+
+    def per_component(self, kinds: list[str] | tuple[str, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(damping, friction, latch)`` factors of components of ``kinds``, in that order [-]."""
+
+        def column(table: dict[str, float]) -> np.ndarray:
+            return np.array([table[k] for k in kinds], dtype=float)
+
+        return column(self.joint_damping), column(self.joint_friction), column(self.latch_compliance)
+
+    def to_dict(self) -> dict[str, dict[str, float]]:
+        """Plain JSON-ready dict (for reports: the truth a system identification is scored against)."""
+        return {
+            "joint_damping": dict(self.joint_damping),
+            "joint_friction": dict(self.joint_friction),
+            "latch_compliance": dict(self.latch_compliance),
+        }
+
+
+@dataclass(frozen=True)
 class CellImperfections:
     """Everything fixed about one cell."""
 
     cameras: dict[str, CameraErrors]
     tcp_bias: np.ndarray
     """Offset of the physical gripper from the nominal one, in the flange frame [m]."""
+    kinds: KindFactors
+    """The box hardware's per-kind physics factors (evaluation only: never for skills)."""
 
 
 def draw_cell(profile: RealityProfile, camera_names: tuple[str, ...]) -> CellImperfections:
+    """The cell of ``profile`` (its ``cell_seed``), with cameras ``camera_names`` (see the module docstring)."""
     rng = np.random.default_rng(np.random.SeedSequence(profile.cell_seed))
     c = profile.camera
     cameras = {}
@@ -68,7 +107,14 @@ def draw_cell(profile: RealityProfile, camera_names: tuple[str, ...]) -> CellImp
         translation = random_vector(rng, c.mount_translation)
         rotation = random_vector(rng, math.radians(c.mount_rotation))
         cameras[name] = CameraErrors(focal, principal, np.array([k1, k2, p1, p2, 0.0]), translation, rotation)
-    return CellImperfections(cameras, random_vector(rng, profile.arm.tcp_bias))
+    tcp_bias = random_vector(rng, profile.arm.tcp_bias)
+    physics = profile.physics
+    tables = []
+    for scale in (physics.kind_joint_damping_scale, physics.kind_joint_friction_scale,
+                  physics.kind_latch_compliance_scale):  # fmt: skip
+        factors = np.asarray(scale.draw(rng, len(KIND_NAMES)), dtype=float)
+        tables.append({kind: float(f) for kind, f in zip(KIND_NAMES, factors, strict=True)})
+    return CellImperfections(cameras, tcp_bias, KindFactors(*tables))
 
 
 def apply_cell(model: mujoco.MjModel, cell: CellImperfections, gripper_body: int) -> bool:

@@ -1,10 +1,11 @@
 """Per-trial physics: the profile's friction, damping, mass, latch-compliance and grip draws applied to
 the session's model (:class:`~twin.reality.PhysicsReality`), one factor per component from the
-session's seed."""
+session's seed. The damping, joint friction and latch compliance applied are these factors times the
+cell's factor of the component's kind (:class:`~twin.cell.KindFactors`, :meth:`PhysicsDraw.times`)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import mujoco
 import numpy as np
@@ -21,6 +22,16 @@ class PhysicsDraw:
     joint_friction: np.ndarray
     mass: np.ndarray
     latch_compliance: np.ndarray
+
+    def times(self, joint_damping: np.ndarray, joint_friction: np.ndarray, latch_compliance: np.ndarray) -> PhysicsDraw:
+        """These factors with the damping, joint friction and latch compliance multiplied by the given ones (one
+        per component, e.g. the cell's kind factors): what is applied to the model."""
+        return replace(
+            self,
+            joint_damping=self.joint_damping * joint_damping,
+            joint_friction=self.joint_friction * joint_friction,
+            latch_compliance=self.latch_compliance * latch_compliance,
+        )
 
 
 def draw_physics(config: PhysicsReality, n: int, rng: np.random.Generator) -> PhysicsDraw:

@@ -4,11 +4,13 @@ A :class:`RealityProfile` is applied only inside the twin (DESIGN.md, "Layers"):
 sees its effects (noisy wrenches, distorted images, a grasp that slips, a component that jams) but
 never the profile. It has two kinds of randomness:
 
-- the cell's *fixed* imperfections (camera intrinsic, distortion and mounting errors, the TCP bias)
-  are drawn once from :attr:`RealityProfile.cell_seed`: a cell is built and calibrated once, and every
-  trial in it meets the same errors;
+- the cell's *fixed* imperfections (camera intrinsic, distortion and mounting errors, the TCP bias, and
+  one joint damping, joint friction and latch compliance factor per component kind) are drawn once from
+  :attr:`RealityProfile.cell_seed`: a cell is built and calibrated once, its box's hinges, slides and wheel
+  bearings have the friction they have, and every trial in it meets the same errors;
 - the *per-trial* randomness (sensor noise, F/T bias and drift, physics draws, jams, command stalls,
-  the box placement) is drawn from the session's seed.
+  the box placement) is drawn from the session's seed. A component's joint damping, joint friction and
+  latch compliance are its kind's cell factor times its own per-trial factor.
 
 Presets (:data:`PRESETS`): ``ideal`` (no imperfection: the nominal world), ``realistic`` and ``harsh``,
 whose values trace to the rows of ``REALITY_NOTES.md`` (its "Presets" table and sections 1-6) as the
@@ -69,7 +71,7 @@ def _probability(obj: Any, *names: str) -> None:
 
 @dataclass(frozen=True)
 class ScaleRange:
-    """A random multiplier of a nominal value, drawn once per trial."""
+    """A random multiplier of a nominal value, drawn once per trial (or once per cell, for the cell's fields)."""
 
     low: float = 1.0
     """Smallest factor [-]."""
@@ -215,7 +217,8 @@ class ArmReality:
 
 @dataclass(frozen=True)
 class PhysicsReality:
-    """How the box and the grasp differ from the nominal model (drawn per trial)."""
+    """How the box and the grasp differ from the nominal model (drawn per trial, but for the ``kind_*`` factors:
+    per cell)."""
 
     friction_scale: ScaleRange = IDENTITY
     """Multiplier of the handle/pad contact friction μ, drawn per component [-]."""
@@ -234,6 +237,16 @@ class PhysicsReality:
     """Multiplier of each component's mass and inertia [-]."""
     latch_compliance_scale: ScaleRange = IDENTITY
     """Multiplier of each latch constraint's time constant (``solref[0]``): > 1 is a softer latch with play [-]."""
+    kind_joint_damping_scale: ScaleRange = IDENTITY
+    """Multiplier of the joint damping of every component of a kind, one factor per kind (door, slide, wheel:
+    ``models.kinds.KIND_NAMES``) drawn once per cell from ``cell_seed``: how the box's hardware differs from its
+    CAD-nominal model systematically, trial after trial. It multiplies :attr:`joint_damping_scale` [-]."""
+    kind_joint_friction_scale: ScaleRange = IDENTITY
+    """As :attr:`kind_joint_damping_scale`, for the joint dry friction (frictionloss); multiplies
+    :attr:`joint_friction_scale` [-]."""
+    kind_latch_compliance_scale: ScaleRange = IDENTITY
+    """As :attr:`kind_joint_damping_scale`, for the latch time constant (``solref[0]``); multiplies
+    :attr:`latch_compliance_scale` [-]."""
     jam_probability: float = 0.0
     """Probability that a free component jams on a try: held where it stands until the gripper has let
     go of its handle for :attr:`jam_release_after` [-]."""
@@ -377,10 +390,14 @@ REALISTIC = RealityProfile(
         friction_scale=ScaleRange(0.8, 1.2),  # Presets "μ" ×(0.8-1.2) (§5, D1/D2)
         pad_friction=0.4,  # Presets "grip force, pad μ" 0.4 (§5 grasp hold, P1)
         grip_force_scale=0.5,  # Presets "grip force, pad μ" 15 N of the gripper's 30 N max (§5, U14)
-        joint_damping_scale=ScaleRange(0.7, 1.5),  # Presets "joint damping" ×(0.7-1.5) (§5, D2)
-        joint_friction_scale=ScaleRange(0.7, 1.5),  # E: as the damping (§5 sim joint friction ×0.3-3, P3)
+        joint_damping_scale=ScaleRange(0.95, 1.05),  # E: trial-to-trial variation of one box (temperature, wear)
+        joint_friction_scale=ScaleRange(0.95, 1.05),  # E: trial-to-trial variation of one box (temperature, wear)
         mass_scale=ScaleRange(0.95, 1.05),  # Presets "mass" ×(0.95-1.05) (§5 mass ±5 %, E)
-        latch_compliance_scale=ScaleRange(1.0, 2.0),  # E: a plastic latch with some play
+        latch_compliance_scale=ScaleRange(1.0, 1.1),  # E: trial-to-trial variation of one box (temperature, wear)
+        # one box's hardware, per kind and per cell: its hinges, slides and bearings differ from the CAD model
+        kind_joint_damping_scale=ScaleRange(0.7, 1.5),  # Presets "joint damping" ×(0.7-1.5) (§5, D2)
+        kind_joint_friction_scale=ScaleRange(0.7, 1.5),  # E: as the damping (§5 sim joint friction ×0.3-3, P3)
+        kind_latch_compliance_scale=ScaleRange(1.0, 2.0),  # E: a plastic latch with some play
         jam_probability=0.02,  # E: an occasional sticky part
     ),
     placement=PlacementRange(),  # issue "reality gap": the box anywhere in the reachable workspace

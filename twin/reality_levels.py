@@ -49,6 +49,9 @@ FACTORS: dict[str, tuple[tuple[str, str], ...]] = {
             "joint_friction_scale",
             "mass_scale",
             "latch_compliance_scale",
+            "kind_joint_damping_scale",
+            "kind_joint_friction_scale",
+            "kind_latch_compliance_scale",
         )
     ),  # fmt: skip
     "jams": (("physics", "jam_probability"),),
@@ -126,6 +129,8 @@ def _value_at(section: str, name: str, level: float) -> Any:
 
 
 def _lerp(a: float, b: float, t: float) -> float:
+    if t == 1.0:  # exactly the preset at its own level (0.95 + (0.3 - 0.95) is 0.30000000000000004)
+        return b
     return a + (b - a) * t
 
 

@@ -3,10 +3,11 @@ cell's imperfections (a :class:`~twin.reality.RealityProfile`) built into its mo
 
 A :class:`TwinSession` is a pure function of (spec, seed, profile, commands): two sessions given the
 same spec, seed, reality profile and command sequence produce bit-identical trajectories, readings and
-images. The profile's fixed imperfections come from its ``cell_seed``; everything drawn per trial
-(placement, physics factors, sensor noise, bias and drift, command stalls, jams, frame effects) comes
-from ``seed``, each concern from its own stream (:class:`numpy.random.SeedSequence` children) so that,
-say, capturing one more image does not change the F/T noise. MuJoCo's autoreset is disabled in the
+images. The profile's fixed imperfections (the box hardware's per-kind physics factors among them) come from
+its ``cell_seed``; everything drawn per trial (placement, physics factors, sensor noise, bias and drift,
+command stalls, jams, frame effects) comes from ``seed``, each concern from its own stream
+(:class:`numpy.random.SeedSequence` children) so that, say, capturing one more image does not change the F/T
+noise. MuJoCo's autoreset is disabled in the
 model, and every MuJoCo warning raised while stepping becomes :class:`~twin.errors.SimulationDiverged`
 naming it: a session never resets itself silently.
 
@@ -145,10 +146,13 @@ class TwinSession:
             self.reality.physics, len(spec.components), np.random.default_rng(self._streams["physics"])
         )
         """This trial's physics factors (evaluation only)."""
+        kind_factors = self.cell.kinds.per_component([c.kind for c in spec.components])
+        self.applied_physics = self.physics_draw.times(*kind_factors)
+        """The physics factors built into the model: this trial's times its cell's kind factors (evaluation only)."""
         changed |= apply_physics(
             m,
             self.reality.physics,
-            self.physics_draw,
+            self.applied_physics,
             handle_geoms,
             np.array([m.joint(c.joint).dofadr[0] for c in component_names], dtype=np.int64),
             np.array([m.body(c.body).id for c in component_names], dtype=np.int64),

@@ -164,3 +164,23 @@ def test_quick_twin_learning_trains_each_start_in_the_twin_measures_its_checkpoi
     ):
         bad = experiment("twin-learning", "--out", tmp_path / "bad", *args)
         assert bad.returncode == 2 and words in bad.stderr and "Traceback" not in bad.stderr, bad.stderr
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (("--runs", "3"), "takes only --out, --workers and --quick"),
+        (("--agents", "memory"), "takes only --out, --workers and --quick"),
+        (("--workers", "0"), "--workers must be >= 1"),
+    ],
+)
+def test_sysid_command_line_mistakes_are_one_line_and_exit_2(tmp_path, args, message):
+    result = experiment("sysid", "--out", tmp_path / "out", *args)
+    assert result.returncode == 2 and message in result.stderr, result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr
+
+
+def test_sysid_refuses_an_output_that_is_a_file(tmp_path):
+    (tmp_path / "taken").write_text("")
+    result = experiment("sysid", "--out", tmp_path / "taken", "--quick")
+    assert result.returncode == 2 and "is a file" in result.stderr and len(result.stderr.strip().splitlines()) == 1

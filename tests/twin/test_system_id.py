@@ -1,0 +1,81 @@
+"""System identification: the nominal twin replays a logged toggle as the world did, and fitting it to logs of a
+box whose hardware is known recovers that hardware, from robot data alone."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from toggle_logs import known_hardware, record
+
+from twin.system_id import FitConfig, fit_kind
+from twin.toggle_replay import NOMINAL, KindScales
+from twin.toggle_scoring import prepare, toggle_errors
+
+PARTS = ("door-0", "slide-1", "door-2", "slide-3", "door-4")
+FIT = FitConfig(max_nfev=12)
+
+
+@pytest.fixture(scope="module")
+def ideal_logs():
+    return record("ideal", PARTS)
+
+
+@pytest.fixture(scope="module")
+def known_logs():
+    """The box's doors and slides with 1.5 times the nominal joint damping and 0.7 times its friction."""
+    return record(known_hardware(damping=1.5, friction=0.7), PARTS)
+
+
+def test_the_nominal_twin_replays_an_ideal_world_toggle_as_it_happened(ideal_logs):
+    ready, skipped = prepare(ideal_logs)
+    assert not skipped and {t.log.kind for t in ready} == {"door", "slide"}
+    for toggle in ready:
+        errors = toggle_errors(toggle)
+        # newtons of joint load, against 0.3 N (slides) and 0.5-2 N (doors) loads; doors opened after a neighbour
+        # read ~0.1 N off in the replay (door-2, door-4; door-0 0.04 N), a mismatch not traced to its cause
+        assert errors.load_rms < (0.02 if toggle.log.kind == "slide" else 0.15), errors
+        assert errors.force_rms < 1.0, errors  # the whole force vector, against 5-10 N across a door's path
+        assert errors.motion_rms < 0.001, errors  # the part's path against the world's (truth), metres
+
+
+def test_a_stiffer_replayed_joint_loads_the_wrist_more(ideal_logs):
+    (door, *_), _ = prepare(ideal_logs[:1])
+
+    def mean_load(scales: KindScales) -> float:
+        load = door.predict(scales)[0]
+        return float(load[door.mask[: len(load)]].mean())
+
+    assert mean_load(KindScales(friction=2.0)) > mean_load(NOMINAL) + 0.2  # 0.02 N·m more at 7.5 cm
+
+
+def test_identification_recovers_the_joint_friction_and_door_damping_of_a_known_box(known_logs):
+    ready, _ = prepare(known_logs)
+    door, slide = fit_kind("door", ready, FIT), fit_kind("slide", ready, FIT)
+    assert slide.scales.friction == pytest.approx(0.7, rel=0.05)
+    assert slide.rms_after < 0.1 * slide.rms_before
+    assert door.scales.damping == pytest.approx(1.5, rel=0.15)
+    # the doors' ~0.1 N replay mismatch (above) costs their friction: it comes out 20-25 % low
+    assert door.scales.friction == pytest.approx(0.7, rel=0.3) and door.scales.friction < 0.85
+    assert door.rms_after < door.rms_before
+    # a slide's damping is 1 N·s/m at the toggle's 2 cm/s: 0.02 N of its 0.3 N load, not identified here
+    assert door.scales.latch == slide.scales.latch == 1.0  # no latched toggle: nothing to fit it on
+
+
+def test_a_fit_to_ideal_world_logs_stays_near_the_nominal_model(ideal_logs):
+    ready, _ = prepare(ideal_logs)
+    slide, door = fit_kind("slide", ready, FIT), fit_kind("door", ready, FIT)
+    assert slide.scales.friction == pytest.approx(1.0, rel=0.05), slide
+    assert door.scales.damping == pytest.approx(1.0, rel=0.25), door
+    assert door.scales.friction == pytest.approx(1.0, rel=0.3), door  # the doors' replay mismatch, as above
+
+
+def test_the_fit_reads_no_simulator_truth(known_logs):
+    blinded = [dataclasses.replace(log, truth={"joint": [np.nan] * log.ticks, "kind_factors": "withheld"})
+               for log in known_logs]  # fmt: skip
+    with_truth, _ = prepare(known_logs)
+    without, _ = prepare(blinded)
+    quick = dataclasses.replace(FIT, max_nfev=3)
+    a, b = fit_kind("slide", with_truth, quick), fit_kind("slide", without, quick)
+    assert a.scales == b.scales and a.rms_after == b.rms_after
