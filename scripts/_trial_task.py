@@ -99,7 +99,8 @@ def _run(spec: PuzzleSpec, settings: Mapping[str, Any], video: str | None) -> di
         return run_twin_trial(spec, settings["seed"], settings["agent"], memory, settings["max_actions"],
                               Path(video) if video else None,
                               settings["checkpoint"], reality, calibration, on_action=_on_action,
-                              misreport_kind=settings.get("misreport_kind", False))  # fmt: skip
+                              misreport_kind=settings.get("misreport_kind", False),
+                              max_lockers=settings.get("max_lockers", 1))  # fmt: skip
     agent = make_agent(
         settings["agent"], spec, memory, settings["checkpoint"], max_lockers=settings.get("max_lockers", 1)
     )

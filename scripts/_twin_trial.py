@@ -179,13 +179,14 @@ def run_twin_trial(
     calibration: CellCalibration | None = None,
     on_action: Callable[[Any], None] | None = None,
     misreport_kind: bool = False,
+    max_lockers: int = 1,
 ) -> dict[str, Any]:
     """One end-to-end trial; returns the contract's run entry plus a ``timeline`` and figures.
 
     ``reality`` is the twin's reality profile (default ``ideal``); ``calibration`` the cell's camera
     calibration (default: the twin's nominal, datasheet calibration — exact only under ``ideal``);
     ``misreport_kind``: the pipeline is told one component's kind wrong (:func:`wrong_kind`; in the entry as
-    ``told_kinds``)."""
+    ``told_kinds``); ``max_lockers``: the most lockers the agent's belief allows one component (1: the paper's)."""
     wall = time.perf_counter()
     by_marker = {c.marker: i for i, c in enumerate(spec.components)}
     with TwinSession(spec, seed=seed, reality=reality) as session:
@@ -207,7 +208,7 @@ def run_twin_trial(
             for c in spec.components:  # perceived closed pose against the simulator's (evaluation only)
                 truth = session.data.site(session.scene.names.components[c.name].frame_site).xpos
                 pose_errors[c.name] = float(np.linalg.norm(world.closed_poses[c.marker][:2] - truth[:2]))
-            agent = make_agent(agent_name, spec, memory, checkpoint, belief=CELL_BELIEF)
+            agent = make_agent(agent_name, spec, memory, checkpoint, belief=CELL_BELIEF, max_lockers=max_lockers)
             result = run_episode(agent, world, spec.name, seed, max_actions, on_action)
         except (SkillError, SimulationDiverged) as err:  # the cell could not run this trial: say why
             result = RunResult(spec.name, seed, False, len(world.log) if world else 0, 0.0,

@@ -13,7 +13,7 @@ single run). ``--reality`` picks the twin's reality profile (sensor noise, calib
 friction, jams, slips, the box placed anywhere reachable; default ``ideal``), ``--calibration`` the
 cell's camera calibration made by ``scripts/calibrate.py`` (default: the nominal, datasheet
 calibration, exact only under ``ideal``); a calibration made for another cell (another profile,
-``cell_seed`` or box height) is refused. ``--max-lockers K`` (symbolic, memory and dual agents) lets the
+``cell_seed`` or box height) is refused. ``--max-lockers K`` (memory and dual agents, in either sim) lets the
 agent's belief hold a component with a set of up to K lockers (default 1: the paper's one-locker belief;
 2 for boxes made with ``generate.py random --multi-locker``). ``--wrong-kind`` tells the pipeline (skills
 and agent) one
@@ -182,8 +182,6 @@ def main(argv: list[str] | None = None) -> int:
     if (args.agent == "memory") != (args.memory is not None):
         fail("--memory goes with --agent memory (and only with it): train one with scripts/train.py")
     if args.max_lockers != 1:
-        if args.sim != "symbolic":
-            fail("--max-lockers needs --sim symbolic (the twin's agents keep the one-locker belief)")
         if args.agent not in BELIEF_AGENT_NAMES:
             fail(f"--max-lockers is for the agents {list(BELIEF_AGENT_NAMES)}, not {args.agent!r}")
         try:
