@@ -71,6 +71,15 @@ def default_prior(num_components: int, prior_independent: float = 0.7) -> np.nda
     return probs
 
 
+def normalised_blocks(probs: np.ndarray) -> np.ndarray:
+    """``probs`` with every block (last axis) scaled to sum to one; :class:`ConfigError` if a block has negative,
+    non-finite or no mass."""
+    totals = probs.sum(axis=-1, keepdims=True)
+    if np.any(totals <= 0.0) or np.any(probs < 0.0) or not np.all(np.isfinite(probs)):
+        raise ConfigError("every belief block needs non-negative, finite mass")
+    return probs / totals
+
+
 def state_bits(x: int, num_components: int) -> np.ndarray:
     """The 0/1 state vector ``(N,)`` of bitmask ``x`` (bit ``c`` = state of component ``c``)."""
     return (x >> np.arange(num_components, dtype=np.int64)) & 1
@@ -97,10 +106,7 @@ class Belief:
             raise ConfigError(f"belief must have shape (N, 2, 1 + 2N), got {probs.shape}")
         for c in range(n):
             probs[c, :, 1 + 2 * c : 3 + 2 * c] = 0.0  # nothing holds itself
-        totals = probs.sum(axis=-1, keepdims=True)
-        if np.any(totals <= 0.0) or np.any(probs < 0.0) or not np.all(np.isfinite(probs)):
-            raise ConfigError("every belief block needs non-negative, finite mass")
-        self.probs = probs / totals
+        self.probs = normalised_blocks(probs)
         self.config = config or BeliefConfig()
 
     @classmethod

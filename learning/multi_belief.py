@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from learning.belief import BeliefConfig, block_entropy, default_prior, state_bits
+from learning.belief import BeliefConfig, block_entropy, default_prior, normalised_blocks, state_bits
 from learning.errors import ConfigError
 from learning.locker_sets import LockerSets, locker_sets
 from learning.set_prior import set_prior
@@ -45,11 +45,7 @@ class MultiBelief:
                 f"a belief over sets of up to {max_lockers} lockers of {n} components has shape "
                 f"{(n, 2, self.sets.count)}, got {probs.shape}"
             )
-        probs = np.where(self.sets.possible[:, None, :], probs, 0.0)  # nothing holds itself
-        totals = probs.sum(axis=-1, keepdims=True)
-        if np.any(totals <= 0.0) or np.any(probs < 0.0) or not np.all(np.isfinite(probs)):
-            raise ConfigError("every belief block needs non-negative, finite mass")
-        self.probs = probs / totals
+        self.probs = normalised_blocks(np.where(self.sets.possible[:, None, :], probs, 0.0))  # nothing holds itself
         self.config = config or BeliefConfig()
 
     @classmethod

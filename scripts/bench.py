@@ -44,6 +44,32 @@ from models.generator.chain import MAX_REACHABLE_COMPONENTS, BoxConfig  # noqa: 
 SIZES = (5, 10, 16, 32)
 
 
+def _timed_episode(agent: DualAgent, spec, episode: int, max_decisions: int, with_update: bool) -> list[float]:
+    """Seconds of each decision of ``agent`` over one episode of ``spec`` (seed ``episode``): ``choose``, plus the
+    belief update (``record``) if ``with_update`` — never the world's own step."""
+    world = SymbolicWorld(spec, episode)
+    observation = world.observe()
+    agent.begin_episode(observation, np.random.default_rng(episode))
+    times = []
+    for _ in range(max_decisions):
+        if observation.solved:
+            break
+        start = time.perf_counter()
+        index = agent.choose(observation)
+        spent = time.perf_counter() - start
+        result = world.try_toggle(index)
+        observation = world.observe()
+        start = time.perf_counter()
+        agent.record(index, result, observation)
+        times.append(spent + (time.perf_counter() - start if with_update else 0.0))
+    return times
+
+
+def _latency(times: list[float]) -> dict[str, float]:
+    ms = 1000.0 * np.array(times)
+    return {"median_ms": float(np.median(ms)), "p90_ms": float(np.percentile(ms, 90)), "decisions": len(ms)}
+
+
 def decision_latency(n: int, episodes: int, max_decisions: int) -> dict[str, float]:
     """Time every ``choose`` of the dual agent over a few episodes on random N-component graphs."""
     times = []
@@ -51,21 +77,8 @@ def decision_latency(n: int, episodes: int, max_decisions: int) -> dict[str, flo
         # past the robot's reach only the layout check differs; smaller boxes keep their seeds' graphs
         box = BoxConfig(fit_reach=False) if n > MAX_REACHABLE_COMPONENTS else None
         spec = generate_random(RandomGraphConfig(n, multi_locker=n >= 4), seed=episode, box=box)
-        world = SymbolicWorld(spec, episode)
-        agent = DualAgent()
-        observation = world.observe()
-        agent.begin_episode(observation, np.random.default_rng(episode))
-        for _ in range(max_decisions):
-            if observation.solved:
-                break
-            start = time.perf_counter()
-            index = agent.choose(observation)
-            times.append(time.perf_counter() - start)
-            result = world.try_toggle(index)
-            observation = world.observe()
-            agent.record(index, result, observation)
-    ms = 1000.0 * np.array(times)
-    return {"median_ms": float(np.median(ms)), "p90_ms": float(np.percentile(ms, 90)), "decisions": len(ms)}
+        times += _timed_episode(DualAgent(), spec, episode, max_decisions, with_update=False)
+    return _latency(times)
 
 
 def multi_locker_latency(n: int = 8, episodes: int = 5, max_decisions: int = 40) -> dict[str, dict[str, float]]:
@@ -76,25 +89,9 @@ def multi_locker_latency(n: int = 8, episodes: int = 5, max_decisions: int = 40)
         times = []
         for episode in range(episodes):
             spec = generate_random(RandomGraphConfig(n, multi_locker=True), seed=episode)
-            world = SymbolicWorld(spec, episode)
-            agent = DualAgent(DualControllerConfig(max_lockers=k))
-            observation = world.observe()
-            agent.begin_episode(observation, np.random.default_rng(episode))
-            for _ in range(max_decisions):
-                if observation.solved:
-                    break
-                start = time.perf_counter()
-                index = agent.choose(observation)
-                decided = time.perf_counter()
-                result = world.try_toggle(index)  # the world's step is not the agent's time
-                observation = world.observe()
-                resumed = time.perf_counter()
-                agent.record(index, result, observation)
-                times.append(decided - start + time.perf_counter() - resumed)
-        ms = 1000.0 * np.array(times)
-        out[f"max_lockers={k}"] = {
-            "median_ms": float(np.median(ms)), "p90_ms": float(np.percentile(ms, 90)), "decisions": len(ms)
-        }  # fmt: skip
+            times += _timed_episode(DualAgent(DualControllerConfig(max_lockers=k)), spec, episode, max_decisions,
+                                    with_update=True)  # fmt: skip
+        out[f"max_lockers={k}"] = _latency(times)
     return out
 
 
