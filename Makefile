@@ -44,9 +44,9 @@ demo: $(STAMP)
 	$(BIN)/python scripts/train.py --specs runs/demo/specs/paper-train-*.json --episodes 9 \
 		--memory runs/demo/memory.sqlite --seed 0
 	$(BIN)/python scripts/trial.py --specs runs/demo/specs/paper-test-0.json --sim twin --agent memory \
-		--memory runs/demo/memory.sqlite --runs 1 --seed 0 --max-actions 30 --out runs/demo --video
+		--memory runs/demo/memory.sqlite --runs 1 --seed 0 --max-actions 30 --out runs/demo --video --force
 	$(BIN)/python scripts/trial.py --specs runs/demo/specs/paper-test-*.json --sim symbolic --agent dual \
-		--runs 10 --seed 0 --max-actions 30 --out runs/demo/symbolic-dual
+		--runs 10 --seed 0 --max-actions 30 --out runs/demo/symbolic-dual --force
 
 clean:
 	rm -rf $(VENV) runs .pytest_cache .ruff_cache
