@@ -17,7 +17,8 @@ import numpy as np
 from gymnasium import spaces
 
 from learning.errors import ConfigError, InvalidAction
-from models import KIND_NAMES, PUZZLE_KINDS, LockTable, PuzzleSpec, kind_code
+from models import LockTable, PuzzleSpec
+from models.disassembly_kinds import family_kind_names
 
 
 @dataclass(frozen=True)
@@ -63,8 +64,9 @@ class PuzzleEnv(gym.Env[dict[str, Any], np.int64]):
     The puzzle is :attr:`puzzle` (``spec`` is gymnasium's registration record).
 
     Observation (a ``Dict``): ``states`` (N,) 0/1; ``kinds`` (N,) kind codes (index in
-    ``models.KIND_NAMES``); ``poses`` (N, D) component poses in the world frame — ``[x, y, yaw]``
-    [m, m, rad] for planar puzzles, the box placed at ``box.pose`` (identity when absent);
+    :attr:`kind_names`: ``models.KIND_NAMES`` for puzzle boxes); ``poses`` (N, D) component poses in the
+    world frame — ``[x, y, yaw]`` [m, m, rad] for planar puzzles, the box placed at ``box.pose`` (identity
+    when absent), ``[x, y, z, roll, pitch, yaw]`` for disassembly scenes;
     ``goal`` the index of the goal component. Info: ``moved`` (bool) and ``num_actions``.
     """
 
@@ -82,12 +84,15 @@ class PuzzleEnv(gym.Env[dict[str, Any], np.int64]):
         self.render_mode = render_mode
         self.table = LockTable.from_spec(spec)
         self._true_poses = spec.poses_in_world()
-        self._true_kinds = np.array([kind_code(c.kind) for c in spec.components], dtype=np.int64)
+        self.kind_names = family_kind_names(spec.kinds)
+        """The kind family of the spec: observed kind codes are indices here (``models.KIND_NAMES`` for
+        puzzle boxes, ``models.disassembly_kinds.DISASSEMBLY_KIND_NAMES`` for disassembly scenes)."""
+        self._true_kinds = np.array([self.kind_names.index(c.kind) for c in spec.components], dtype=np.int64)
         self.action_space = spaces.Discrete(n)
         self.observation_space = spaces.Dict(
             {
                 "states": spaces.MultiBinary(n),
-                "kinds": spaces.MultiDiscrete(np.full(n, len(KIND_NAMES))),
+                "kinds": spaces.MultiDiscrete(np.full(n, len(self.kind_names))),
                 "poses": _pose_space(self._true_poses.shape),
                 "goal": spaces.Discrete(n),
             }
@@ -110,9 +115,9 @@ class PuzzleEnv(gym.Env[dict[str, Any], np.int64]):
         self.order = rng.permutation(n) if self.config.shuffle else np.arange(n)
         self._kinds = self._true_kinds.copy()
         if faults.misreported_kinds:
-            puzzle_codes = [kind_code(k) for k in PUZZLE_KINDS]
+            family_codes = list(range(len(self.kind_names)))  # puzzle boxes: door, slide, wheel as before
             for j in rng.choice(n, size=faults.misreported_kinds, replace=False):
-                others = [c for c in puzzle_codes if c != self._true_kinds[j]]
+                others = [c for c in family_codes if c != self._true_kinds[j]]
                 self._kinds[j] = others[int(rng.integers(len(others)))]
         self._poses = self._true_poses.copy()
         if faults.position_noise_std > 0.0:
@@ -168,7 +173,7 @@ class PuzzleEnv(gym.Env[dict[str, Any], np.int64]):
         for i in range(len(self.order)):
             goal = " (goal)" if i == obs["goal"] else ""
             x, y = obs["poses"][i][:2]
-            kind = KIND_NAMES[obs["kinds"][i]]
+            kind = self.kind_names[obs["kinds"][i]]
             lines.append(f"  [{i}] {kind:<6} at ({x:+.3f}, {y:+.3f}) m  state {obs['states'][i]}{goal}")
         return "\n".join(lines)
 

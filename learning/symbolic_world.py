@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from learning.puzzle_env import PuzzleEnv, PuzzleEnvConfig
-from models import KIND_NAMES, ComponentObservation, PuzzleSpec, SceneObservation, TryResult
+from models import ComponentObservation, PuzzleSpec, SceneObservation, TryResult
 
 
 class SymbolicWorld:
@@ -20,7 +20,7 @@ class SymbolicWorld:
     def observe(self) -> SceneObservation:
         obs = self._obs
         components = tuple(
-            ComponentObservation(KIND_NAMES[int(k)], pose.copy(), int(s))
+            ComponentObservation(self.env.kind_names[int(k)], pose.copy(), int(s))
             for k, pose, s in zip(obs["kinds"], obs["poses"], obs["states"], strict=True)
         )
         return SceneObservation(components, goal_index=int(obs["goal"]), goal_state=self.env.table.goal_state)

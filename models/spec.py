@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from models.atomic import write_text_atomically
+from models.disassembly_kinds import DISASSEMBLY_FAMILY, DISASSEMBLY_KINDS, PUZZLE_BOX_FAMILY
 from models.errors import SpecError, SpecProblem
 from models.geometry import compose, wrap_angle
 
@@ -90,6 +91,14 @@ class PuzzleSpec:
     @property
     def kinds(self) -> tuple[str, ...]:
         return tuple(c.kind for c in self.components)
+
+    @property
+    def family(self) -> str:
+        """The spec's kind family: ``"disassembly"`` for a disassembly scene (no box, disassembly kinds,
+        6-DOF poses), else ``"puzzle-box"`` (see :mod:`models.disassembly_kinds`)."""
+        if self.box is None and any(k in DISASSEMBLY_KINDS for k in self.kinds):
+            return DISASSEMBLY_FAMILY
+        return PUZZLE_BOX_FAMILY
 
     def index_of(self, name: str) -> int:
         """Index of a component in :attr:`components`; ``KeyError`` lists the names that exist."""

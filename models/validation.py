@@ -1,5 +1,12 @@
 """Validation of puzzle spec files: every problem at once, each naming the field or component.
 
+Two kind families exist (SPEC.md extended, issue 14): puzzle boxes (``box`` required, kinds door / slide /
+wheel, planar poses ``[x, y, yaw]``, footprints inside the lid and not overlapping) and disassembly
+scenes (no ``box``, kinds of :mod:`models.disassembly_kinds`, 6-DOF poses ``[x, y, z, roll, pitch, yaw]``,
+no footprint rules). A spec without a box that has a disassembly kind is a disassembly scene; one
+family's kind in the other's spec is a problem naming the component. The generic rules (names, locks,
+goal, reachability) apply to both.
+
 :func:`validate_data` takes the parsed JSON value (anything ``json.loads`` may return) and never
 raises on bad input: it returns the list of problems, empty for a valid spec.
 """
@@ -9,6 +16,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from models.disassembly_kinds import DISASSEMBLY_KIND_NAMES, DISASSEMBLY_KINDS, DISASSEMBLY_POSE_SIZE
 from models.errors import ReachabilityUndecided, SpecProblem
 from models.geometry import polygon_gap
 from models.kinds import KIND_NAMES, PUZZLE_KINDS, get_kind
@@ -45,6 +53,49 @@ def _number_list(value: Any, lengths: tuple[int, ...]) -> bool:
     return isinstance(value, list) and len(value) in lengths and all(_is_number(v) for v in value)
 
 
+def is_disassembly_data(data: Any) -> bool:
+    """Whether a parsed spec is a disassembly scene: no ``box`` and some component of a disassembly kind."""
+    if not isinstance(data, dict) or data.get("box") is not None or not isinstance(data.get("components"), list):
+        return False
+    return any(isinstance(c, dict) and c.get("kind") in DISASSEMBLY_KINDS for c in data["components"])
+
+
+def _known_kinds(disassembly: bool) -> str:
+    puzzle, other = f"puzzle-box kinds {list(KIND_NAMES)}", f"disassembly kinds {list(DISASSEMBLY_KIND_NAMES)}"
+    return f"{other}; {puzzle}" if disassembly else f"{puzzle}; {other}"
+
+
+def _check_pose(pose: Any, kind: Any, where: str, problem: Any) -> bool:
+    """The pose's length follows its kind's family: ``[x, y, yaw]`` for puzzle-box kinds, ``[x, y, z, roll,
+    pitch, yaw]`` for disassembly kinds (either for an unknown kind, already reported)."""
+    bound = f"finite numbers within +-{MAX_MAGNITUDE:g} [m, rad]"
+    if isinstance(kind, str) and kind in PUZZLE_KINDS:
+        if _number_list(pose, (3,)):
+            return True
+        if isinstance(pose, list) and len(pose) == DISASSEMBLY_POSE_SIZE:
+            problem(
+                f"{where}.pose",
+                f"6-DOF pose on puzzle-box kind {kind!r}: a {kind} takes a planar pose [x, y, yaw] (3 {bound}); "
+                "6-DOF poses [x, y, z, roll, pitch, yaw] are for disassembly scenes",
+            )
+        else:
+            problem(f"{where}.pose", f"must be a planar pose [x, y, yaw]: a list of 3 {bound}")
+        return False
+    if isinstance(kind, str) and kind in DISASSEMBLY_KINDS:
+        if _number_list(pose, (DISASSEMBLY_POSE_SIZE,)):
+            return True
+        got = f"a list of {len(pose)}" if isinstance(pose, list) else type(pose).__name__
+        problem(
+            f"{where}.pose",
+            f"disassembly kind {kind!r} takes a 6-DOF pose [x, y, z, roll, pitch, yaw]: a list of 6 {bound}; got {got}",
+        )
+        return False
+    if not _number_list(pose, (3, 6)):
+        problem(f"{where}.pose", f"must be a list of 3 or 6 {bound}")
+        return False
+    return True
+
+
 def validate_data(data: Any) -> list[SpecProblem]:
     """All problems of a parsed spec; an empty list means valid."""
     problems: list[SpecProblem] = []
@@ -72,6 +123,7 @@ def validate_data(data: Any) -> list[SpecProblem]:
         components = []
     elif len(components) > MAX_COMPONENTS:
         problem("components", f"{len(components)} components; at most {MAX_COMPONENTS} are supported")
+    disassembly = is_disassembly_data(data)
     markers: dict[int, str] = {}
     for k, comp in enumerate(components):
         where = f"components[{k}]"
@@ -91,15 +143,26 @@ def validate_data(data: Any) -> list[SpecProblem]:
             names.add(name)
         kind = comp.get("kind")
         if not isinstance(kind, str):
-            problem(f"{where}.kind", f"missing or not a string; known kinds: {list(KIND_NAMES)}")
+            problem(f"{where}.kind", f"missing or not a string; known kinds: {_known_kinds(disassembly)}")
             ok = False
-        elif kind not in KIND_NAMES:
-            problem(f"{where}.kind", f"unknown kind {kind!r}; known kinds: {list(KIND_NAMES)}")
+        elif kind not in KIND_NAMES and kind not in DISASSEMBLY_KINDS:
+            problem(f"{where}.kind", f"unknown kind {kind!r}; known kinds: {_known_kinds(disassembly)}")
             ok = False
-        pose_lengths = (3,) if isinstance(kind, str) and kind in PUZZLE_KINDS else (3, 6)
-        if not _number_list(comp.get("pose"), pose_lengths):
-            shape = " or ".join(str(n) for n in pose_lengths)
-            problem(f"{where}.pose", f"must be a list of {shape} finite numbers within +-{MAX_MAGNITUDE:g} [m, rad]")
+        elif disassembly and kind in PUZZLE_KINDS:
+            problem(
+                f"{where}.kind",
+                f"puzzle-box kind {kind!r} in a disassembly scene (no box, disassembly kinds); a spec has one "
+                f"kind family: disassembly kinds are {list(DISASSEMBLY_KIND_NAMES)}",
+            )
+            ok = False
+        elif not disassembly and kind in DISASSEMBLY_KINDS:
+            problem(
+                f"{where}.kind",
+                f"disassembly kind {kind!r} in a puzzle-box spec (it has a box); a disassembly scene has no box "
+                f"and 6-DOF poses; puzzle-box kinds are {list(KIND_NAMES)}",
+            )
+            ok = False
+        if not _check_pose(comp.get("pose"), kind, where, problem):
             ok = False
         marker = comp.get("marker")
         if marker is not None:

@@ -31,8 +31,10 @@ class OracleAgent:
                 f"oracle for {self.spec.name!r} knows {len(self.spec.components)} components, "
                 f"the world shows {len(observation)}"
             )
-        true_xy = self.spec.poses_in_world()[:, :2]
-        seen_xy = observation.poses[:, :2]
+        true_poses = self.spec.poses_in_world()
+        position_size = 2 if true_poses.shape[1] == 3 else 3  # planar [x, y, yaw]; 6-DOF [x, y, z, ...]
+        true_xy = true_poses[:, :position_size]
+        seen_xy = observation.poses[:, :position_size]
         cost = np.linalg.norm(seen_xy[:, None, :] - true_xy[None, :, :], axis=2)
         true_kinds = np.array(self.spec.kinds)
         cost += KIND_MISMATCH_COST * (np.array(observation.kinds)[:, None] != true_kinds[None, :])

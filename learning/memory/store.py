@@ -387,6 +387,10 @@ class MemoryStore:
             self._cache[("all-pairs",)] = Bucket(np.stack([k for k, _ in entries]), np.stack([v for _, v in entries]))
         return self._cache[("all-pairs",)]
 
+    def key_sizes(self) -> set[int]:
+        """The lengths of the stored pair keys: ``{4}`` planar poses, ``{9}`` 6-DOF poses, empty when none."""
+        return {int(key.size) for bucket in self._pairs.values() for key, _ in bucket}
+
     def independence_values(self, kind: str) -> np.ndarray | None:
         """``(M, 2)`` stored independence probabilities of a kind, or None if never seen."""
         entries = self._independence.get(kind)
