@@ -40,6 +40,7 @@ from learning import DualAgent, PuzzleEnv, PuzzleEnvConfig, SymbolicWorld  # noq
 from learning.dual_controller import DualControllerConfig  # noqa: E402
 from models.generator import RandomGraphConfig, generate_random  # noqa: E402
 from models.generator.chain import MAX_REACHABLE_COMPONENTS, BoxConfig  # noqa: E402
+from models.spec import load_spec  # noqa: E402
 
 SIZES = (5, 10, 16, 32)
 
@@ -89,6 +90,26 @@ def multi_locker_latency(n: int = 8, episodes: int = 5, max_decisions: int = 40)
         times = []
         for episode in range(episodes):
             spec = generate_random(RandomGraphConfig(n, multi_locker=True), seed=episode)
+            times += _timed_episode(DualAgent(DualControllerConfig(max_lockers=k)), spec, episode, max_decisions,
+                                    with_update=True)  # fmt: skip
+        out[f"max_lockers={k}"] = _latency(times)
+    return out
+
+
+DISASSEMBLY_SCENE = Path(__file__).resolve().parents[2] / "shared" / "data" / "disassembly" / "lab-computer-b.json"
+"""The 8-component disassembly scene of the paper's second domain (``../shared/data``), when present."""
+
+
+def disassembly_latency(episodes: int = 5, max_decisions: int = 24) -> dict[str, dict[str, float]] | None:
+    """As :func:`multi_locker_latency`, on the disassembly scene :data:`DISASSEMBLY_SCENE` (seeds shuffle its
+    order); None when the data is not there."""
+    if not DISASSEMBLY_SCENE.is_file():
+        return None
+    spec = load_spec(DISASSEMBLY_SCENE)
+    out = {}
+    for k in (1, 2):
+        times = []
+        for episode in range(episodes):
             times += _timed_episode(DualAgent(DualControllerConfig(max_lockers=k)), spec, episode, max_decisions,
                                     with_update=True)  # fmt: skip
         out[f"max_lockers={k}"] = _latency(times)
@@ -199,6 +220,10 @@ def main(argv: list[str] | None = None) -> int:
     results["multi_locker_latency_n8"] = multi = multi_locker_latency(episodes=episodes)
     for label, stats in multi.items():
         print(f"decision + update N=8 two-locker boxes, {label}: median {stats['median_ms']:.3f} ms, "
+              f"p90 {stats['p90_ms']:.3f} ms over {stats['decisions']} decisions")  # fmt: skip
+    results["disassembly_latency"] = scene = disassembly_latency(episodes=episodes)
+    for label, stats in (scene or {}).items():
+        print(f"decision + update, disassembly scene (lab-computer-b), {label}: median {stats['median_ms']:.3f} ms, "
               f"p90 {stats['p90_ms']:.3f} ms over {stats['decisions']} decisions")  # fmt: skip
     results["symbolic_env_steps_per_s"] = rate = env_steps_per_second(0.3 if args.quick else 2.0)
     print(f"symbolic env: {rate:,.0f} steps/s")
