@@ -337,7 +337,8 @@ class Toggler(DoorPushing):
         """Horizontal vector (base frame) along which the gripper leans over the part of the toggle in progress,
         by ``lean_angle`` times its length (``toggle(lean=...)``), or None: upright."""
         self._lean_drift = np.zeros(3)
-        """Horizontal motion of the TCP per metre it rises along its leaning approach axis [m/m] (zero upright)."""
+        """Horizontal motion of the TCP per metre it rises along the approach axis of its last descent [m/m]
+        (zero upright; set by :meth:`_descend_to`)."""
 
     # -- force -------------------------------------------------------------------------------------
     def reset_force_watch(self) -> None:
@@ -495,7 +496,6 @@ class Toggler(DoorPushing):
         wall = time.perf_counter()
         self.cautious = cautious
         self.lean = lean
-        self._lean_drift = np.zeros(3)
         start_time = self.robot.time
         self.reset_force_watch()
         c = self.config
@@ -586,6 +586,9 @@ class Toggler(DoorPushing):
         c = self.config
         above = target.copy()
         above[:3, 3] -= c.approach_height * target[:3, 2]  # back along the approach axis (up, when upright)
+        # the lift off this part goes back the same way: a pinch's lean, not a push's upright pads after it
+        self._lean_drift = target[:3, 2] / target[2, 2]
+        self._lean_drift[2] = 0.0
         self.robot.command_gripper(c.pregrasp_closure)
         self.phase = "approaching"
         self.travel_to(above, c.approach_time)
@@ -754,7 +757,6 @@ class Toggler(DoorPushing):
         axis = np.cross((0.0, 0.0, 1.0), across)  # turning +z towards ``across``
         leaning = upright.copy()
         leaning[:3, :3] = Rotation.from_rotvec(axis * angle).as_matrix() @ upright[:3, :3]
-        self._lean_drift = math.tan(angle) * across
         return leaning
 
     def _pose_along(self, jm: JointModel, fraction: float, at_grasp: np.ndarray, begin: float) -> np.ndarray:
