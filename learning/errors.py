@@ -24,9 +24,3 @@ class ConfigError(LearningError, ValueError):
 
 class MemoryFileError(LearningError):
     """A memory file that cannot be used: missing, truncated, corrupted, foreign or of another schema."""
-
-
-class UnsupportedPoses(LearningError, ValueError):
-    """Poses a component cannot use yet: e.g. a memory holding planar ``[x, y, yaw]`` keys asked about a
-    disassembly scene's 6-DOF poses, or the reverse (one memory per pose size until SE(3) keys, issue 14
-    part 3)."""

@@ -9,9 +9,8 @@ import numpy as np
 
 from learning.belief import default_prior
 from learning.dual_controller import Decision, DualControllerConfig, decide, max_entropy_for, new_belief
-from learning.errors import UnsupportedPoses
 from learning.lock_belief import LockBelief
-from learning.memory.keys import PLANAR_KEY_SIZE, SPATIAL_KEY_SIZE, key_size, relative_pose_keys
+from learning.memory.keys import se3_pose_keys
 from learning.memory.prior import MemoryConfig, episode_record, recall_prior
 from learning.memory.store import MemoryStore
 from models import SceneObservation, TryResult
@@ -106,25 +105,7 @@ class MemoryAgent(DualAgent):
         """Reads the simulated robot time the episode has taken so far [s] (twin episodes): stored with it."""
         self._observation: SceneObservation | None = None
 
-    def _check_pose_size(self, observation: SceneObservation) -> None:
-        """Refuse a task whose poses make keys of another size than the memory's (planar puzzle boxes give
-        4-number keys, 6-DOF disassembly scenes 9): they cannot be compared until SE(3) keys (issue 14
-        part 3) give one key for both."""
-        wanted = key_size(observation.poses.shape[1])
-        stored = self.store.key_sizes()
-        if stored and stored != {wanted}:
-            have = {frozenset({PLANAR_KEY_SIZE}): "planar [x, y, yaw]", frozenset({SPATIAL_KEY_SIZE}): "6-DOF"}.get(
-                frozenset(stored), "planar and 6-DOF"
-            )
-            raise UnsupportedPoses(
-                f"memory agent: the memory holds keys of {have} poses (key sizes {sorted(stored)}), the task has "
-                f"{observation.poses.shape[1]}-number poses (key size {wanted}); one memory cannot mix planar puzzle "
-                "boxes and 6-DOF disassembly scenes yet: missing SE(3) memory keys (issue 14 part 3). Use one memory "
-                "file per domain."
-            )
-
     def initial_prior(self, observation: SceneObservation) -> np.ndarray:
-        self._check_pose_size(observation)
         self._observation = observation
         return recall_prior(
             self.store, observation.kinds, observation.poses, self.memory_config, self.config.belief.prior_independent
@@ -136,7 +117,7 @@ class MemoryAgent(DualAgent):
         observation = self._observation
         # a belief over sets of lockers is stored as its one-locker view: the memory's format
         pair_values, independence = episode_record(self.belief.single_locker_probs())
-        keys = relative_pose_keys(observation.poses, self.store.position_scale)
+        keys = se3_pose_keys(observation.poses, self.store.position_scale, self.store.rotation_weight)
         self.store.add_episode(
             observation.kinds,
             keys,

@@ -57,7 +57,7 @@ def _progress(items: Sequence[Any], desc: str) -> Any:
 
 
 def _trained_store(variants: Sequence[int], episodes: int, seed: int, config: ProtocolConfig) -> MemoryStore:
-    store = MemoryStore(position_scale=config.memory.position_scale)
+    store = MemoryStore(position_scale=config.memory.position_scale, rotation_weight=config.memory.rotation_weight)
     if variants and episodes:
         train_memory(store, variants, range(episodes), seed, config)
     return store
@@ -103,7 +103,9 @@ def run_episodes(agents: Sequence[str], config: ProtocolConfig, quick: bool = Fa
     per_seed: dict[int, list[Score]] = {e: [] for e in checkpoints}
     if "memory" in agents:
         for t in range(config.training_seeds):
-            store = MemoryStore(position_scale=config.memory.position_scale)
+            store = MemoryStore(
+                position_scale=config.memory.position_scale, rotation_weight=config.memory.rotation_weight
+            )
             done = 0
             for e in _progress(checkpoints, f"episodes (seed {t})"):
                 train_memory(store, TRAIN_INDICES, range(done, e), t, config)

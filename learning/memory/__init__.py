@@ -1,6 +1,6 @@
 """Memory-based learning: past dependency graphs, keyed by relative pose, recalled as priors."""
 
-from learning.memory.keys import relative_pose_keys
+from learning.memory.keys import relative_pose_keys, se3_pose_keys
 from learning.memory.prior import MemoryConfig, episode_record, recall_prior
 from learning.memory.store import MEMORY_FORMAT, SCHEMA_VERSION, MemoryStore
 
@@ -12,4 +12,5 @@ __all__ = [
     "episode_record",
     "recall_prior",
     "relative_pose_keys",
+    "se3_pose_keys",
 ]

@@ -16,8 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from learning.belief import block_entropy, default_prior, hypothesis_count
-from learning.memory.keys import relative_pose_keys
+from learning.memory.keys import se3_pose_keys
 from learning.memory.store import MemoryStore
+from models.disassembly_kinds import kind_family
 
 KEY_DECIMALS = 9
 """Distances in key space are ranked at this resolution (key units ~ 2 cm / 1 rad)."""
@@ -49,7 +50,10 @@ class MemoryConfig:
     uniform_mass: float = 0.01
     """Added to every hypothesis before renormalising (the authors' release: 0.01)."""
     position_scale: float = 0.02
-    """Length weighing like one unit of sin/cos in keys [m] (used when creating a memory)."""
+    """Length that weighs like one key unit [m] (used when creating a memory)."""
+    rotation_weight: float = 1.0
+    """Key units per unit of chord ``2 sin(theta/2)`` of a relative rotation, about per radian (used when
+    creating a memory; :mod:`learning.memory.keys`): 1.0 weighs a planar yaw as the paper's sin/cos did."""
     training_entropy_scale: float | None = 0.5
     """The controller's ``entropy_scale`` while learning (training episodes); None keeps the controller's.
     A smaller h_max explores more, and only failed tries confirm a lock, so training episodes that
@@ -68,9 +72,10 @@ def recall_prior(
     """The ``(N, 2, 1 + 2N)`` prior for a task with these kinds and poses (any common frame)."""
     n = len(kinds)
     fallback = default_prior(n, prior_independent)
-    if store.num_episodes == 0 or n < 2:
+    family = kind_family(kinds[0]) if n else ""
+    if n < 2 or not store.holds_family(family):  # a memory of puzzle boxes knows nothing of computers
         return fallback
-    keys = relative_pose_keys(poses, store.position_scale)
+    keys = se3_pose_keys(poses, store.position_scale, store.rotation_weight)
     weights = np.zeros((n, 2, hypothesis_count(n)))
     for j in range(n):
         independence = store.independence_values(kinds[j])
@@ -80,7 +85,7 @@ def recall_prior(
                 continue
             bucket = store.pair_bucket(kinds[i], kinds[j])
             if bucket is None and config.back_off:
-                bucket = store.all_pairs_bucket()
+                bucket = store.all_pairs_bucket(family)
             if bucket is None:
                 weights[j, :, 1 + 2 * i : 3 + 2 * i] = fallback[j, :, 1 + 2 * i : 3 + 2 * i]
                 continue

@@ -19,6 +19,14 @@ simulator; ``twin``: end to end in the MuJoCo twin, writing only what the robot 
 profile, and how much simulated robot time it took [s]; :meth:`MemoryStore.provenance` sums them up.
 Episodes of schema 1 and 2 files, which only the symbolic simulator could write, count as ``symbolic``.
 
+Keys are SE(3) (schema 4, :mod:`learning.memory.keys`): j's full rigid pose in i's frame, 12 numbers, with the
+``rotation_weight`` the file was created with in its meta table, so planar puzzle boxes and 6-DOF disassembly
+scenes share one memory. Files of schemas 1-3 hold compact keys (4 numbers planar, 9 for 6-DOF Euler angles):
+they are read by converting each key to its SE(3) form (:func:`~learning.memory.keys.se3_key_from_legacy`,
+rotation weight 1.0, which keeps every planar distance as it was) and migrated in place — keys rewritten,
+schema raised, in one transaction — the first time they are trained further (or by ``scripts/memory.py
+--migrate``).
+
 A file that is not a puzzlebox memory (not SQLite, another application's database, a newer schema)
 or that is damaged (truncated, failed integrity check, malformed rows) raises
 :class:`~learning.errors.MemoryFileError`; it is never read as an empty memory.
@@ -40,12 +48,22 @@ from pathlib import Path
 import numpy as np
 
 from learning.errors import MemoryFileError
+from learning.memory.keys import (
+    DEFAULT_ROTATION_WEIGHT,
+    PLANAR_KEY_SIZE,
+    SE3_KEY_SIZE,
+    SPATIAL_KEY_SIZE,
+    se3_key_from_legacy,
+)
+from models.disassembly_kinds import kind_family
 
 MEMORY_FORMAT = "puzzlebox-memory"
 PAIR_VALUE_SIZE = 6
 """Per stored pair: 4 probabilities [s_j, s_i] and the confidence of j's two blocks."""
-SCHEMA_VERSION = 3
-READABLE_SCHEMAS = ("1", "2", "3")
+SCHEMA_VERSION = 4
+READABLE_SCHEMAS = ("1", "2", "3", "4")
+LEGACY_KEY_SCHEMAS = ("1", "2", "3")
+"""Schemas whose pair keys are compact (4 or 9 numbers), converted to SE(3) keys when read."""
 SOURCES = ("symbolic", "twin")
 """Where an episode was experienced: the symbolic simulator, or end to end in the twin."""
 
@@ -99,16 +117,28 @@ class MemoryStore:
     independence values are ``[P(indep | s=0), P(indep | s=1)]``.
     """
 
-    def __init__(self, path: str | Path | None = None, position_scale: float = 0.02) -> None:
+    def __init__(
+        self,
+        path: str | Path | None = None,
+        position_scale: float = 0.02,
+        rotation_weight: float = DEFAULT_ROTATION_WEIGHT,
+    ) -> None:
         """Open (or create) a memory. ``path=None`` keeps it in RAM only.
 
         Args:
-            path: SQLite file; created with ``position_scale`` when absent.
-            position_scale: length that weighs like one unit of sin/cos in keys [m]. An existing file
-                keeps the scale it was created with.
+            path: SQLite file; created with ``position_scale`` and ``rotation_weight`` when absent.
+            position_scale: length that weighs like one key unit [m]. An existing file keeps the scale it
+                was created with.
+            rotation_weight: key units per unit of chord ``2 sin(theta/2)`` of a relative rotation
+                (:mod:`learning.memory.keys`). An existing file keeps its own (1.0 for files before schema 4).
         """
+        if not (math.isfinite(position_scale) and position_scale > 0.0):
+            raise ValueError(f"position_scale must be a finite length > 0 [m], got {position_scale}")
+        if not (math.isfinite(rotation_weight) and rotation_weight >= 0.0):
+            raise ValueError(f"rotation_weight must be finite and >= 0, got {rotation_weight}")
         self.path = Path(path) if path is not None else None
         self.position_scale = position_scale
+        self.rotation_weight = rotation_weight
         self._pairs: dict[tuple[str, str], list[tuple[np.ndarray, np.ndarray]]] = defaultdict(list)
         self._independence: dict[str, list[np.ndarray]] = defaultdict(list)
         self._cache: dict[tuple[str, ...], Bucket] = {}
@@ -145,6 +175,7 @@ class MemoryStore:
                         ("format", MEMORY_FORMAT),
                         ("schema_version", str(SCHEMA_VERSION)),
                         ("position_scale", repr(self.position_scale)),
+                        ("rotation_weight", repr(self.rotation_weight)),
                     ],
                 )
             conn.close()
@@ -194,10 +225,21 @@ class MemoryStore:
             ) from None
         if not (math.isfinite(self.position_scale) and self.position_scale > 0.0):
             raise MemoryFileError(f"{path} has a position_scale that is not a finite length > 0: {self.position_scale}")
+        if self._schema in LEGACY_KEY_SCHEMAS:
+            self.rotation_weight = DEFAULT_ROTATION_WEIGHT  # what the conversion of its compact keys uses
+            return
+        try:
+            self.rotation_weight = float(meta["rotation_weight"])
+        except (KeyError, ValueError):
+            raise MemoryFileError(
+                f"{path} has no valid rotation_weight in its meta table ({meta.get('rotation_weight')!r})"
+            ) from None
+        if not (math.isfinite(self.rotation_weight) and self.rotation_weight >= 0.0):
+            raise MemoryFileError(f"{path} has a rotation_weight that is not finite and >= 0: {self.rotation_weight}")
 
     def _load(self, conn: sqlite3.Connection, path: Path) -> None:
         self.num_episodes = conn.execute("SELECT COUNT(*) FROM episodes").fetchone()[0]
-        if self._schema == "3":
+        if self._schema in ("3", "4"):
             rows = conn.execute("SELECT source, profile, robot_time FROM episodes ORDER BY id").fetchall()
             self._provenance = [(source or "symbolic", profile, robot_time) for source, profile, robot_time in rows]
         else:
@@ -206,10 +248,18 @@ class MemoryStore:
             "SELECT kind_i, kind_j, key, value FROM pair_entries ORDER BY rowid"
         ):
             key_arr, value_arr = _decode(key, path), _decode(value, path)
-            if value_arr.size != PAIR_VALUE_SIZE or key_arr.size not in (4, 9):
+            legacy = self._schema in LEGACY_KEY_SCHEMAS
+            key_sizes = (PLANAR_KEY_SIZE, SPATIAL_KEY_SIZE) if legacy else (SE3_KEY_SIZE,)
+            if value_arr.size != PAIR_VALUE_SIZE or key_arr.size not in key_sizes:
                 raise MemoryFileError(
-                    f"{path} has a malformed pair entry ({key_arr.size} key, {value_arr.size} values)"
+                    f"{path} has a malformed pair entry ({key_arr.size} key, {value_arr.size} values; schema "
+                    f"{self._schema} keys have {' or '.join(map(str, key_sizes))} numbers)"
                 )
+            if legacy:
+                try:
+                    key_arr = se3_key_from_legacy(key_arr, self.rotation_weight)
+                except ValueError as err:
+                    raise MemoryFileError(f"{path} has a malformed pair key ({kind_i} -> {kind_j}): {err}") from None
             _check_probabilities(value_arr, f"{path} has a pair entry ({kind_i} -> {kind_j})")
             self._pairs[(kind_i, kind_j)].append((key_arr, value_arr))
         for kind, value in conn.execute("SELECT kind, value FROM independence_entries ORDER BY rowid"):
@@ -225,9 +275,19 @@ class MemoryStore:
             self._conn = None
 
     # -- the training log ----------------------------------------------------------------------------
+    @property
+    def schema(self) -> str:
+        """The schema version of the file as it is now (a memory in RAM: the current one)."""
+        return self._schema
+
+    def migrate(self) -> None:
+        """Bring an older file to the current schema in place (see :meth:`_upgrade`); nothing for a current one."""
+        self._upgrade()
+
     def _upgrade(self) -> None:
-        """Add the training log (schema 1) and the provenance columns (schema 1 and 2) to an older file (once,
-        whichever trainer gets there first)."""
+        """Bring an older file to the current schema (once, whichever trainer gets there first, in one
+        transaction): add the training log (schema 1), the provenance columns (schemas 1 and 2), and rewrite
+        every compact pair key as its SE(3) key (schemas 1 to 3)."""
         if self._conn is None or self._schema == str(SCHEMA_VERSION):
             return
         conn = self._conn
@@ -235,9 +295,17 @@ class MemoryStore:
         try:
             schema = conn.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()[0]
             missing = {"1": _LOG_SCHEMA + _PROVENANCE_SCHEMA, "2": _PROVENANCE_SCHEMA}.get(schema, "")
-            if missing:
-                for statement in filter(str.strip, missing.split(";")):
-                    conn.execute(statement)
+            for statement in filter(str.strip, missing.split(";")):
+                conn.execute(statement)
+            if schema in LEGACY_KEY_SCHEMAS:
+                rows = conn.execute("SELECT rowid, key FROM pair_entries").fetchall()
+                conn.executemany(
+                    "UPDATE pair_entries SET key = ? WHERE rowid = ?",
+                    [(se3_key_from_legacy(_decode(key, self.path), self.rotation_weight).tobytes(), rowid)
+                     for rowid, key in rows],
+                )  # fmt: skip
+                conn.execute("INSERT INTO meta VALUES ('rotation_weight', ?)", (repr(self.rotation_weight),))
+            if schema != str(SCHEMA_VERSION):
                 conn.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", (str(SCHEMA_VERSION),))
             conn.commit()
         except BaseException:
@@ -308,7 +376,8 @@ class MemoryStore:
 
         Args:
             kinds: kind of each component ``(N,)``.
-            keys: ``(N, N, K)`` relative-pose keys (``[i, j]``: j seen from i).
+            keys: ``(N, N, 12)`` SE(3) keys (``[i, j]``: j seen from i; :func:`~learning.memory.keys.se3_pose_keys`
+                with this memory's ``position_scale`` and ``rotation_weight``).
             pair_values: ``(N, N, 6)`` — ``[i, j]`` the block of "i holds j" (see the class docstring).
             independence: ``(N, 2)`` probability that each component is independent, per state.
             spec, solved, num_actions, seed: the episode's outcome, for the training log.
@@ -321,6 +390,8 @@ class MemoryStore:
         if robot_time is not None and not (math.isfinite(robot_time) and robot_time >= 0.0):
             raise ValueError(f"robot_time must be a finite time >= 0 [s], got {robot_time}")
         n = len(kinds)
+        if keys.shape != (n, n, SE3_KEY_SIZE):
+            raise ValueError(f"keys must be (N, N, {SE3_KEY_SIZE}) SE(3) keys for N = {n}, got {keys.shape}")
         pairs = [
             (kinds[i], kinds[j], keys[i, j].astype(np.float64), pair_values[i, j].astype(np.float64))
             for i in range(n)
@@ -378,18 +449,25 @@ class MemoryStore:
             self._cache[cache_key] = Bucket(np.stack([k for k, _ in entries]), np.stack([v for _, v in entries]))
         return self._cache[cache_key]
 
-    def all_pairs_bucket(self) -> Bucket | None:
-        """Every stored pair, whatever its kinds (for kind pairs the memory has never seen)."""
-        if not self._pairs:
-            return None
-        if ("all-pairs",) not in self._cache:
-            entries = [entry for bucket in self._pairs.values() for entry in bucket]
-            self._cache[("all-pairs",)] = Bucket(np.stack([k for k, _ in entries]), np.stack([v for _, v in entries]))
-        return self._cache[("all-pairs",)]
+    def all_pairs_bucket(self, family: str) -> Bucket | None:
+        """Every stored pair of a kind family (``models.disassembly_kinds.kind_family``), whatever its kinds (for
+        kind pairs the memory has never seen): a computer's screws never recall a puzzle box's doors."""
+        cache_key = ("all-pairs", family)
+        if cache_key not in self._cache:
+            entries = [
+                entry
+                for (kind_i, _), bucket in self._pairs.items()
+                if kind_family(kind_i) == family
+                for entry in bucket
+            ]
+            if not entries:
+                return None
+            self._cache[cache_key] = Bucket(np.stack([k for k, _ in entries]), np.stack([v for _, v in entries]))
+        return self._cache[cache_key]
 
-    def key_sizes(self) -> set[int]:
-        """The lengths of the stored pair keys: ``{4}`` planar poses, ``{9}`` 6-DOF poses, empty when none."""
-        return {int(key.size) for bucket in self._pairs.values() for key, _ in bucket}
+    def holds_family(self, family: str) -> bool:
+        """Whether any stored episode is of the kind family ``family`` (``models.disassembly_kinds.kind_family``)."""
+        return any(kind_family(kind) == family for kind, entries in self._independence.items() if entries)
 
     def independence_values(self, kind: str) -> np.ndarray | None:
         """``(M, 2)`` stored independence probabilities of a kind, or None if never seen."""
@@ -403,6 +481,8 @@ class MemoryStore:
             "pair_buckets": {f"{a}->{b}": len(v) for (a, b), v in sorted(self._pairs.items())},
             "independence_buckets": {k: len(v) for k, v in sorted(self._independence.items())},
             "position_scale": self.position_scale,
+            "rotation_weight": self.rotation_weight,
+            "schema": self._schema,
         }
 
     def __repr__(self) -> str:

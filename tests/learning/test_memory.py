@@ -21,7 +21,9 @@ from learning.memory import (
     episode_record,
     recall_prior,
     relative_pose_keys,
+    se3_pose_keys,
 )
+from learning.memory.keys import se3_key_from_legacy
 from models.generator import TEST_INDICES, TRAIN_INDICES, paper_variant
 
 KINDS = ("door", "slide", "wheel")
@@ -141,7 +143,7 @@ def fill(store, seed, episodes=6, spatial=False):
     for e in range(episodes):
         n = int(rng.integers(2, 6))
         kinds, poses, pair_values, independence = random_episode(rng, n, spatial)
-        keys = relative_pose_keys(poses, store.position_scale)
+        keys = se3_pose_keys(poses, store.position_scale, store.rotation_weight)
         store.add_episode(kinds, keys, pair_values, independence, spec=f"ep{e}", solved=bool(e % 2), num_actions=e)
 
 
@@ -355,7 +357,12 @@ def test_a_new_memory_file_records_format_version_and_scale(tmp_path):
     conn = sqlite3.connect(path)
     meta = dict(conn.execute("SELECT key, value FROM meta").fetchall())
     conn.close()
-    assert meta == {"format": MEMORY_FORMAT, "schema_version": str(SCHEMA_VERSION), "position_scale": "0.03"}
+    assert meta == {
+        "format": MEMORY_FORMAT,
+        "schema_version": str(SCHEMA_VERSION),
+        "position_scale": "0.03",
+        "rotation_weight": "1.0",
+    }
 
 
 # -- recalled priors ------------------------------------------------------------------------------------------
@@ -403,9 +410,10 @@ def store_with_two_tied_memories():
         probs[1, 0] = 0.0
         probs[1, 0, 1 + locker_state] = 1.0
         pair_values, independence = episode_record(Belief(probs).probs)
-        keys = np.zeros((2, 2, 4))
-        keys[..., 3] = 1.0
-        keys[0, 1, 1], keys[1, 0, 1] = y, -y
+        compact = np.zeros((2, 2, 4))  # (x, y, sin, cos)
+        compact[..., 3] = 1.0
+        compact[0, 1, 1], compact[1, 0, 1] = y, -y
+        keys = np.apply_along_axis(se3_key_from_legacy, -1, compact)
         store.add_episode(("door", "slide"), keys, pair_values, independence)
     return store
 
@@ -471,7 +479,7 @@ def test_unseen_kind_pair_falls_back_to_the_uninformed_prior():
     probs = default_prior(2)
     probs[1, 0] = [0.0, 1.0, 0.0, 0.0, 0.0]  # "door in state 0 holds slide in state 0", resolved
     pair_values, independence = episode_record(Belief(probs).probs)
-    store.add_episode(("door", "slide"), relative_pose_keys(poses, 0.02), pair_values, independence)
+    store.add_episode(("door", "slide"), se3_pose_keys(poses, 0.02), pair_values, independence)
     config = MemoryConfig(uniform_mass=0.0, back_off=False)
     recalled = recall_prior(store, ("door", "slide"), poses, config)
     assert recalled[1, 0, 1] > 0.5  # the same pose recalls the lock
@@ -487,7 +495,7 @@ def test_memory_recalls_which_locker_state_at_the_pose_it_was_learned_and_not_fa
     probs = default_prior(2)
     probs[1, 0] = [0.0, 1.0, 0.0, 0.0, 0.0]
     pair_values, independence = episode_record(Belief(probs).probs)
-    store.add_episode(("door", "slide"), relative_pose_keys(poses, 0.02), pair_values, independence)
+    store.add_episode(("door", "slide"), se3_pose_keys(poses, 0.02), pair_values, independence)
     near = recall_prior(store, ("door", "slide"), poses, MemoryConfig())
     far_poses = np.array([[0.0, 0.0, 0.0], [0.0, 0.4, 2.0]])
     far = recall_prior(store, ("door", "slide"), far_poses, MemoryConfig())

@@ -13,16 +13,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from legacy_memory import make_legacy
 
 from learning.errors import MemoryFileError
-from learning.memory import SCHEMA_VERSION, MemoryStore
+from learning.memory import SCHEMA_VERSION, MemoryStore, se3_pose_keys
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _episode(store: MemoryStore, **log) -> None:
     n = 2
-    keys = np.zeros((n, n, 4))
+    keys = se3_pose_keys(np.array([[0.0, 0.0, 0.0], [0.05, 0.02, 1.0]]), 0.02)
     pair_values = np.full((n, n, 6), 0.5)
     store.add_episode(("door", "slide"), keys, pair_values, np.full((n, 2), 0.5), **log)
 
@@ -50,13 +51,7 @@ def test_a_schema_1_file_is_read_as_it_is_and_upgraded_when_trained(tmp_path):
     store = MemoryStore(path)
     _episode(store, spec="old", num_actions=3)
     store.close()
-    conn = sqlite3.connect(path)  # make it the schema 1 file an earlier version wrote
-    with conn:
-        conn.execute("DROP TABLE training_runs")
-        for column in ("training_run", "seed", "source", "profile", "robot_time"):
-            conn.execute(f"ALTER TABLE episodes DROP COLUMN {column}")
-        conn.execute("UPDATE meta SET value = '1' WHERE key = 'schema_version'")
-    conn.close()
+    make_legacy(path, 1)  # the schema 1 file an earlier version wrote
     store = MemoryStore.open_existing(path)
     assert [[e["spec"] for e in r["episodes"]] for r in store.training_log()] == [["old"]]
     run = store.begin_training_run({"episodes": 1})
@@ -64,7 +59,7 @@ def test_a_schema_1_file_is_read_as_it_is_and_upgraded_when_trained(tmp_path):
     log = store.training_log()
     assert [(r["id"], [e["spec"] for e in r["episodes"]]) for r in log] == [(None, ["old"]), (run, ["new"])]
     meta = dict(sqlite3.connect(path).execute("SELECT key, value FROM meta").fetchall())
-    assert meta["schema_version"] == str(SCHEMA_VERSION) == "3"
+    assert meta["schema_version"] == str(SCHEMA_VERSION) == "4"
     assert store.provenance()["symbolic"] == {"episodes": 2}  # what a schema 1 file held was symbolic
 
 
@@ -73,12 +68,7 @@ def test_a_schema_2_file_counts_its_episodes_symbolic_and_takes_twin_episodes_wi
     store = MemoryStore(path)
     _episode(store, spec="old", num_actions=3)
     store.close()
-    conn = sqlite3.connect(path)  # the schema 2 file the previous version wrote
-    with conn:
-        for column in ("source", "profile", "robot_time"):
-            conn.execute(f"ALTER TABLE episodes DROP COLUMN {column}")
-        conn.execute("UPDATE meta SET value = '2' WHERE key = 'schema_version'")
-    conn.close()
+    make_legacy(path, 2)  # the schema 2 file an earlier version wrote
     store = MemoryStore.open_existing(path)
     assert store.provenance()["symbolic"] == {"episodes": 1} and store.provenance()["twin"]["episodes"] == 0
     _episode(store, spec="a", source="twin", profile="realistic", robot_time=1800.0)

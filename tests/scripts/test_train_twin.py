@@ -20,7 +20,7 @@ from _twin_training import TwinTraining  # noqa: E402  (scripts/ is not a packag
 
 from learning import MemoryAgent  # noqa: E402
 from learning.memory import MemoryStore  # noqa: E402
-from learning.memory.keys import relative_pose_keys  # noqa: E402
+from learning.memory.keys import se3_pose_keys  # noqa: E402
 from models import load_spec  # noqa: E402
 from twin.reality import load_profile  # noqa: E402
 
@@ -51,10 +51,10 @@ def test_a_twin_episode_stores_the_poses_the_robot_perceived_not_the_simulators(
     assert result.num_actions == 3
     n = len(spec.components)
     off_diagonal = ~np.eye(n, dtype=bool)
-    perceived = relative_pose_keys(agent._observation.poses, store.position_scale)[off_diagonal]
+    perceived = se3_pose_keys(agent._observation.poses, store.position_scale)[off_diagonal]
     stored = np.stack([key for bucket in store._pairs.values() for key, _ in bucket])
     assert sorted(map(tuple, stored)) == sorted(map(tuple, perceived))
-    truth = relative_pose_keys(spec.poses_in_world(), store.position_scale)[off_diagonal]  # (relative: placement-free)
+    truth = se3_pose_keys(spec.poses_in_world(), store.position_scale)[off_diagonal]  # (relative: placement-free)
     assert 1e-4 < np.abs(np.sort(stored, axis=0) - np.sort(truth, axis=0)).max()
     provenance = store.provenance()["twin"]
     assert provenance["episodes"] == 1 and provenance["profiles"] == {"realistic": 1}
