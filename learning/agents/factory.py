@@ -47,7 +47,7 @@ def make_agent(
             raise ConfigError(f"agent {name!r} needs a checkpoint (train one with scripts/train.py --agent {name})")
         from learning.baselines.checkpoint import load_checkpoint  # torch only when asked
 
-        return load_checkpoint(checkpoint, expected_agent=name)
+        return load_checkpoint(checkpoint, expected_agent=name, scene=spec)
     if checkpoint is not None:
         raise ConfigError(
             f"agent {name!r} takes no checkpoint; --checkpoint is for the deep agents {list(DEEP_AGENT_NAMES)}"

@@ -3,7 +3,7 @@ DQN on it, the model-based precondition planner, and their MT-OPT variants (``re
 
 from learning.baselines.checkpoint import CheckpointError, load_checkpoint, save_checkpoint
 from learning.baselines.dqn import DQNAgent, DQNConfig
-from learning.baselines.graph_network import GraphNetwork, GraphNetworkConfig, observation_tensors
+from learning.baselines.graph_network import GraphNetwork, GraphNetworkConfig, SceneMismatch, observation_tensors
 from learning.baselines.model_based import ModelBasedAgent, ModelBasedConfig
 from learning.baselines.registry import LEARNERS, make_learner
 
@@ -16,6 +16,7 @@ __all__ = [
     "LEARNERS",
     "ModelBasedAgent",
     "ModelBasedConfig",
+    "SceneMismatch",
     "load_checkpoint",
     "make_learner",
     "observation_tensors",

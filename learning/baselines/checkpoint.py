@@ -1,6 +1,8 @@
 """Checkpoints of the deep baselines: the network's ``state_dict`` (``FILE``) and a JSON beside it
 (``FILE.json``) with the agent's name, its resolved config, training progress and package versions,
-so a checkpoint can be reloaded — and its result re-run — exactly.
+so a checkpoint can be reloaded — and its result re-run — exactly. The config records the network's
+kind family and pose size (``GraphNetworkConfig.kinds``, ``pose_size``); checkpoints saved before those
+fields existed are of the puzzle-box family, which their defaults rebuild.
 """
 
 from __future__ import annotations
@@ -15,10 +17,12 @@ from pathlib import Path
 import torch
 
 from learning.baselines.dqn import DQNAgent, DQNConfig
-from learning.baselines.graph_network import GraphNetworkConfig
+from learning.baselines.graph_network import GraphNetworkConfig, SceneMismatch, family_name
 from learning.baselines.model_based import ModelBasedAgent, ModelBasedConfig
 from learning.errors import LearningError
+from models import PuzzleSpec
 from models.atomic import write_atomically, write_text_atomically
+from models.disassembly_kinds import family_kind_names
 
 CHECKPOINT_FORMAT = "puzzlebox-baseline/2"
 """/2: GN blocks apply the edge MLP's first layer per part (``GNBlock``); MT-OPT flags in the config."""
@@ -57,8 +61,12 @@ def one_line(err: BaseException) -> str:
     return " ".join(str(err).split())[:300]
 
 
-def load_checkpoint(path: str | Path, expected_agent: str | None = None) -> DQNAgent | ModelBasedAgent:
-    """The agent of a checkpoint, ready to evaluate (``training = False``)."""
+def load_checkpoint(
+    path: str | Path, expected_agent: str | None = None, scene: PuzzleSpec | None = None
+) -> DQNAgent | ModelBasedAgent:
+    """The agent of a checkpoint, ready to evaluate (``training = False``). With ``scene``, refuse
+    (:class:`CheckpointError` naming both families) a network built for another kind family or pose
+    size than the scene's, rather than fail on its first observation."""
     path = Path(path)
     meta_path = Path(str(path) + ".json")
     if not path.is_file() or not meta_path.is_file():
@@ -78,6 +86,8 @@ def load_checkpoint(path: str | Path, expected_agent: str | None = None) -> DQNA
         agent = agent_cls(config_cls(**raw))
     except (KeyError, TypeError, ValueError) as err:
         raise CheckpointError(f"{meta_path} records no valid {meta['agent']} config: {err}") from None
+    if scene is not None:
+        _check_scene(path, agent.config.network, scene)
     try:
         state = torch.load(path, weights_only=True)
     except (pickle.UnpicklingError, EOFError, RuntimeError, OSError, ValueError) as err:
@@ -89,6 +99,22 @@ def load_checkpoint(path: str | Path, expected_agent: str | None = None) -> DQNA
     agent.episodes = int(meta.get("episodes", 0))
     agent.training = False
     return agent
+
+
+def _check_scene(path: Path, network: GraphNetworkConfig, scene: PuzzleSpec) -> None:
+    pose_size = int(scene.poses_in_world().shape[1])
+    try:
+        network.check_scene(scene.kinds, pose_size)
+    except SceneMismatch:
+        try:
+            scene_family = family_name(family_kind_names(scene.kinds))
+        except (ValueError, KeyError):  # mixed or unknown kinds: name them instead
+            scene_family = f"kinds {sorted(set(scene.kinds))}"
+        raise CheckpointError(
+            f"{path} holds a network of the {network.family} family (kinds {list(network.kinds)}, pose size "
+            f"{network.pose_size}); scene {scene.name!r} is of the {scene_family} family (kinds "
+            f"{sorted(set(scene.kinds))}, pose size {pose_size}): train a network on that family"
+        ) from None
 
 
 def _version(package: str) -> str:

@@ -3,7 +3,9 @@
 Q(s, n) is the network's output at component n. Replay memory, a target network updated softly
 (tau), epsilon-greedy exploration decaying per episode to a floor, Huber loss, Adam. The authors'
 release: replay 1e5, batch 16, gamma 0.99, lr 3e-4, tau = lr, epsilon x0.999 per episode down to 0.2,
-evaluation with epsilon 0.1. Rewards: +1 on reaching the goal, ``step_reward`` per other action.
+evaluation with epsilon 0.1. Rewards: +1 on reaching the goal, ``step_reward`` per other action,
+plus the optional dense ``progress_reward`` for removing a component (the paper's deep agents needed
+dense rewards on computer disassembly; 0, the default, is the sparse reward of the puzzle boxes).
 
 ``mt-dqn`` (MT-OPT, Kalashnikov et al. 2021) adds cross-task data sharing — each finished episode is
 relabelled for the task "bring component g to its goal" for every g (``multitask.py``) — and
@@ -21,7 +23,7 @@ from torch import nn
 
 from learning.baselines.graph_network import GraphNetwork
 from learning.baselines.learner import EpsilonGreedyLearner, LearnerConfig
-from learning.baselines.multitask import RelabelledStep, Step, relabel_episode
+from learning.baselines.multitask import RelabelledStep, Step, progress, relabel_episode
 from models import SceneObservation
 
 
@@ -35,6 +37,9 @@ class DQNConfig(LearnerConfig):
     """Soft target update rate per gradient step (the release: tau = learning rate)."""
     goal_reward: float = 1.0
     step_reward: float = -0.05
+    progress_reward: float = 0.0
+    """Dense reward added to a non-final action that removes (opens) a component, state 0 -> 1, and
+    taken back for one that puts a component back, 1 -> 0 (so a cycle earns nothing). 0: sparse."""
 
 
 class DQNAgent(EpsilonGreedyLearner):
@@ -67,14 +72,18 @@ class DQNAgent(EpsilonGreedyLearner):
             self._episode.append(Step(nodes, edges, index, next_nodes, next_edges))
             return
         done = observation.solved
-        reward = self.config.goal_reward if done else self.config.step_reward
+        c, column = self.config, self.config.network.state_column
+        reward = (
+            c.goal_reward if done else c.step_reward + c.progress_reward * progress(nodes, next_nodes, index, column)
+        )
         self.store(RelabelledStep(nodes, edges, index, reward, next_nodes, next_edges, done), len(nodes), done)
 
     def finish_episode(self, solved: bool) -> None:
         """MT-OPT: relabel the episode for every task and file it as a success or a failure of each."""
         c = self.config
+        columns = (c.network.state_column, c.network.goal_column)
         for _, steps, success in relabel_episode(
-            self._episode, *self._goal, c.goal_reward, c.step_reward, all_tasks=c.share_across_tasks
+            self._episode, *self._goal, c.goal_reward, c.step_reward, c.share_across_tasks, c.progress_reward, columns
         ):
             for step in steps:
                 self.store(step, len(step.nodes), success)

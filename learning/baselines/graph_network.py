@@ -1,39 +1,71 @@
 """A graph network over puzzle components (Battaglia et al. 2018, "Relational inductive biases"):
 GN blocks with edge, node and global updates, on a fully connected graph of the components.
 
-Node features: kind one-hot, state (0/1), goal flag. Edge features (i -> j): the pose of j in i's frame
-(the memory's relative-pose key: x, y / scale, sin and cos of the relative yaw), so the network sees
-what the memory agent sees. Everything is permutation-equivariant by construction: shuffling the
-components permutes the per-node outputs the same way (aggregations are sums and means over nodes).
-The authors' release used 5 blocks of 64 hidden units.
+Node features: kind one-hot (over the network's kind family, ``GraphNetworkConfig.kinds``), state
+(0/1), goal flag. Edge features (i -> j): the pose of j in i's frame (the memory's relative-pose key,
+``learning.memory.keys``: x, y / scale, sin and cos of the relative yaw for planar poses; x, y, z /
+scale and sin, cos of relative roll, pitch, yaw for 6-DOF poses), so the network sees what the memory
+agent sees. Everything is permutation-equivariant by construction: shuffling the components permutes
+the per-node outputs the same way (aggregations are sums and means over nodes). The authors' release
+used 5 blocks of 64 hidden units.
+
+A network is built for one kind family and pose size — puzzle boxes (``models.KIND_NAMES``, planar
+``[x, y, yaw]``, the default) or disassembly scenes (``DISASSEMBLY_KIND_NAMES``, 6-DOF poses; see
+:meth:`GraphNetworkConfig.for_spec`); an observation of another family raises :class:`SceneMismatch`.
 
 ``poses="absolute"`` is the ablation closer to the authors' release, whose components carried their
 own pose (x, y, sin, cos): the pose goes into the node features instead (position relative to the
 components' centroid, over ``position_scale``; yaw in the world frame) and the edge features are zero,
-so the network must learn relative geometry itself.
+so the network must learn relative geometry itself. It exists for planar poses only.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 import torch
 from torch import nn
 
 from learning.agents.factory import POSE_ENCODINGS
-from learning.errors import ConfigError
-from learning.memory.keys import relative_pose_keys
-from models import KIND_NAMES, SceneObservation
+from learning.errors import ConfigError, LearningError
+from learning.memory.keys import key_size, relative_pose_keys
+from models import KIND_NAMES, PuzzleSpec, SceneObservation
+from models.disassembly_kinds import (
+    DISASSEMBLY_FAMILY,
+    DISASSEMBLY_KIND_NAMES,
+    DISASSEMBLY_POSE_SIZE,
+    PUZZLE_BOX_FAMILY,
+    family_kind_names,
+)
 
 NODE_FEATURES = len(KIND_NAMES) + 2
-"""Kind one-hot, state, goal flag (plus 4 pose features with ``poses="absolute"``)."""
+"""Puzzle-box family: kind one-hot, state, goal flag (plus 4 pose features with ``poses="absolute"``);
+other families: :attr:`GraphNetworkConfig.node_features`."""
 EDGE_FEATURES = 4
+"""Puzzle-box family (planar relative-pose keys); other pose sizes: :attr:`GraphNetworkConfig.edge_features`."""
+PLANAR_POSE_SIZE = 3
+"""A puzzle-box component's pose ``[x, y, yaw]`` [m, m, rad]."""
+POSE_SIZES = (PLANAR_POSE_SIZE, DISASSEMBLY_POSE_SIZE)
+ABSOLUTE_POSE_FEATURES = 4
+"""Node pose features of ``poses="absolute"``: x, y / scale around the centroid, sin and cos of the yaw."""
+
+
+class SceneMismatch(LearningError, ValueError):
+    """An observation (or a scene) of a kind family or pose size the network was not built for; the
+    message names the network's kinds and pose size and the scene's."""
+
+
+def family_name(kinds: Sequence[str]) -> str:
+    """``puzzle-box``, ``disassembly``, or the kinds themselves for a custom tuple (for messages)."""
+    names = {tuple(KIND_NAMES): PUZZLE_BOX_FAMILY, tuple(DISASSEMBLY_KIND_NAMES): DISASSEMBLY_FAMILY}
+    return names.get(tuple(kinds), f"kinds {list(kinds)}")
 
 
 @dataclass(frozen=True)
 class GraphNetworkConfig:
-    """Size of the network."""
+    """Size of the network, and the scenes it is built for (kind family and pose size)."""
 
     blocks: int = 5
     """GN blocks (the authors' release: 5)."""
@@ -43,29 +75,78 @@ class GraphNetworkConfig:
     """Metres per unit of the pose features' positions (as the memory keys)."""
     poses: str = "relative"
     """Where poses enter: ``relative`` (edge i -> j: pose of j in i's frame) or ``absolute`` (per node)."""
+    kinds: tuple[str, ...] = field(default=tuple(KIND_NAMES))
+    """The kind family, in one-hot order (default: the puzzle boxes'; checkpoints saved before this
+    field existed load with it)."""
+    pose_size: int = PLANAR_POSE_SIZE
+    """Numbers per component pose: 3 planar ``[x, y, yaw]`` or 6 ``[x, y, z, roll, pitch, yaw]``."""
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "kinds", tuple(self.kinds))  # a JSON list (checkpoints) -> a tuple
         if self.poses not in POSE_ENCODINGS:
             raise ConfigError(f"unknown pose encoding {self.poses!r}; available: {list(POSE_ENCODINGS)}")
+        if self.pose_size not in POSE_SIZES:
+            raise ConfigError(f"pose_size must be one of {list(POSE_SIZES)}, got {self.pose_size}")
+        if self.poses == "absolute" and self.pose_size != PLANAR_POSE_SIZE:
+            raise ConfigError(f"poses='absolute' needs planar poses (pose_size 3), got pose_size {self.pose_size}")
+        if not self.kinds or len(set(self.kinds)) != len(self.kinds):
+            raise ConfigError(f"kinds must be distinct and non-empty, got {list(self.kinds)}")
+
+    @classmethod
+    def for_spec(cls, spec: PuzzleSpec, **overrides: object) -> GraphNetworkConfig:
+        """The config for ``spec``'s kind family and pose size (other fields: ``overrides`` or defaults)."""
+        pose_size = int(spec.poses_in_world().shape[1])
+        return cls(**{"kinds": family_kind_names(spec.kinds), "pose_size": pose_size, **overrides})
+
+    @property
+    def family(self) -> str:
+        """The kind family's name (``puzzle-box``, ``disassembly``) for messages."""
+        return family_name(self.kinds)
+
+    @property
+    def state_column(self) -> int:
+        """Node-feature column of the component state (0/1)."""
+        return len(self.kinds)
+
+    @property
+    def goal_column(self) -> int:
+        """Node-feature column of the goal flag."""
+        return len(self.kinds) + 1
 
     @property
     def node_features(self) -> int:
-        return NODE_FEATURES + (4 if self.poses == "absolute" else 0)
+        return len(self.kinds) + 2 + (ABSOLUTE_POSE_FEATURES if self.poses == "absolute" else 0)
+
+    @property
+    def edge_features(self) -> int:
+        return key_size(self.pose_size)
+
+    def check_scene(self, kinds: Sequence[str], pose_size: int) -> None:
+        """Raise :class:`SceneMismatch` unless every kind is in the family and the pose size matches."""
+        unknown = sorted(set(kinds) - set(self.kinds))
+        if unknown or pose_size != self.pose_size:
+            raise SceneMismatch(
+                f"the graph network was built for the {self.family} family (kinds {list(self.kinds)}, "
+                f"pose size {self.pose_size}); this scene has kinds {sorted(set(kinds))} "
+                f"(unknown: {unknown}) and pose size {pose_size}"
+            )
 
 
 def observation_tensors(observation: SceneObservation, config: GraphNetworkConfig) -> tuple[np.ndarray, np.ndarray]:
-    """Node ``(N, config.node_features)`` and edge ``(N, N, EDGE_FEATURES)`` features of an observation."""
+    """Node ``(N, config.node_features)`` and edge ``(N, N, config.edge_features)`` features of an
+    observation; :class:`SceneMismatch` for a scene outside the config's family or pose size."""
     n = len(observation)
+    poses = np.asarray(observation.poses, dtype=float)
+    config.check_scene(observation.kinds, poses.shape[1])
     nodes = np.zeros((n, config.node_features), dtype=np.float32)
     for i, component in enumerate(observation.components):
-        nodes[i, KIND_NAMES.index(component.kind)] = 1.0
-        nodes[i, len(KIND_NAMES)] = component.state
-    nodes[observation.goal_index, len(KIND_NAMES) + 1] = 1.0
-    poses = np.asarray(observation.poses, dtype=float)
+        nodes[i, config.kinds.index(component.kind)] = 1.0
+        nodes[i, config.state_column] = component.state
+    nodes[observation.goal_index, config.goal_column] = 1.0
     if config.poses == "absolute":
         xy = (poses[:, :2] - poses[:, :2].mean(axis=0)) / config.position_scale
-        nodes[:, NODE_FEATURES:] = np.column_stack([xy, np.sin(poses[:, 2]), np.cos(poses[:, 2])])
-        return nodes, np.zeros((n, n, EDGE_FEATURES), dtype=np.float32)
+        nodes[:, config.goal_column + 1 :] = np.column_stack([xy, np.sin(poses[:, 2]), np.cos(poses[:, 2])])
+        return nodes, np.zeros((n, n, config.edge_features), dtype=np.float32)
     edges = relative_pose_keys(poses, config.position_scale).astype(np.float32)
     return nodes, edges
 
@@ -118,12 +199,12 @@ class GraphNetwork(nn.Module):
         self.config = config or GraphNetworkConfig()
         h = self.config.hidden
         self.encode_nodes = nn.Linear(self.config.node_features, h)
-        self.encode_edges = nn.Linear(EDGE_FEATURES, h)
+        self.encode_edges = nn.Linear(self.config.edge_features, h)
         self.blocks = nn.ModuleList(GNBlock(h, h, h, h) for _ in range(self.config.blocks))
         self.head = nn.Sequential(nn.Linear(h, h), nn.ReLU(), nn.Linear(h, 1))
 
     def forward(self, nodes: torch.Tensor, edges: torch.Tensor) -> torch.Tensor:
-        """``nodes`` (B, N, node_features), ``edges`` (B, N, N, EDGE_FEATURES) -> (B, N) outputs."""
+        """``nodes`` (B, N, node_features), ``edges`` (B, N, N, edge_features) -> (B, N) outputs."""
         b, n, _ = nodes.shape
         mask = 1.0 - torch.eye(n, dtype=nodes.dtype, device=nodes.device)[None].expand(b, n, n)
         x, e = self.encode_nodes(nodes), self.encode_edges(edges) * mask[..., None]

@@ -24,7 +24,7 @@ from torch import nn
 
 from learning.baselines.graph_network import GraphNetwork
 from learning.baselines.learner import EpsilonGreedyLearner, LearnerConfig
-from learning.baselines.multitask import STATE_COLUMN, with_goal
+from learning.baselines.multitask import with_goal
 from learning.planner import bitmask, value_iteration
 from models import SceneObservation
 
@@ -62,7 +62,7 @@ class ModelBasedAgent(EpsilonGreedyLearner):
         n = len(nodes)
         bits = ((np.arange(1 << n)[:, None] >> np.arange(n)) & 1).astype(np.float32)
         batch = np.repeat(nodes[None], len(bits), axis=0)
-        batch[:, :, STATE_COLUMN] = bits
+        batch[:, :, self.config.network.state_column] = bits
         with torch.no_grad():
             logits = self.net(torch.from_numpy(batch), torch.from_numpy(edges)[None].expand(len(bits), -1, -1, -1))
         return torch.sigmoid(logits).numpy().T
@@ -78,7 +78,7 @@ class ModelBasedAgent(EpsilonGreedyLearner):
         nodes, edges = self._last
         goals = range(len(nodes)) if self.config.share_across_tasks else [None]
         for goal in goals:
-            example_nodes = nodes if goal is None else with_goal(nodes, goal)
+            example_nodes = nodes if goal is None else with_goal(nodes, goal, self.config.network.goal_column)
             self.store(_Example(example_nodes, edges, index, moved), len(nodes), moved)
 
     def learn(self, batch: list[_Example]) -> float:

@@ -19,16 +19,18 @@ import numpy as np
 from models import KIND_NAMES
 
 STATE_COLUMN = len(KIND_NAMES)
-"""Node-feature column of the component state (0/1)."""
+"""Node-feature column of the component state (0/1) for the puzzle-box family; in general
+``GraphNetworkConfig.state_column`` (the columns follow the network's kinds)."""
 GOAL_COLUMN = len(KIND_NAMES) + 1
-"""Node-feature column of the goal flag."""
+"""Node-feature column of the goal flag for the puzzle-box family (``GraphNetworkConfig.goal_column``)."""
 
 
-def with_goal(nodes: np.ndarray, goal: int) -> np.ndarray:
-    """A copy of node features ``(N, F)`` with the goal flag on component ``goal`` only."""
+def with_goal(nodes: np.ndarray, goal: int, goal_column: int = GOAL_COLUMN) -> np.ndarray:
+    """A copy of node features ``(N, F)`` with the goal flag (column ``goal_column``) on component
+    ``goal`` only."""
     relabelled = nodes.copy()
-    relabelled[:, GOAL_COLUMN] = 0.0
-    relabelled[goal, GOAL_COLUMN] = 1.0
+    relabelled[:, goal_column] = 0.0
+    relabelled[goal, goal_column] = 1.0
     return relabelled
 
 
@@ -63,14 +65,19 @@ def relabel_episode(
     goal_reward: float,
     step_reward: float,
     all_tasks: bool = True,
+    progress_reward: float = 0.0,
+    columns: tuple[int, int] = (STATE_COLUMN, GOAL_COLUMN),
 ) -> list[tuple[int, list[RelabelledStep], bool]]:
     """Per task ``g``: the episode's steps as seen by task g, cut after g reached its goal, and whether
     it did (a success episode for that task). The true task keeps ``goal_state``; every other
     component's goal is the opposite of its state at the start (a task never starts solved).
-    ``all_tasks=False`` returns the true task only (no sharing)."""
+    ``all_tasks=False`` returns the true task only (no sharing). ``progress_reward`` is added to a
+    non-final step that moved its component (:func:`progress`); ``columns`` are the network's
+    ``(state_column, goal_column)``."""
     if not steps:
         return []
-    start = steps[0].nodes[:, STATE_COLUMN]
+    state_column, goal_column = columns
+    start = steps[0].nodes[:, state_column]
     tasks = range(len(start)) if all_tasks else [goal_index]
     relabelled = []
     for g in tasks:
@@ -79,14 +86,15 @@ def relabel_episode(
             continue
         episode: list[RelabelledStep] = []
         for step in steps:
-            done = bool(step.next_nodes[g, STATE_COLUMN] == target)
+            done = bool(step.next_nodes[g, state_column] == target)
+            shaping = progress_reward * progress(step.nodes, step.next_nodes, step.action, state_column)
             episode.append(
                 RelabelledStep(
-                    with_goal(step.nodes, g),
+                    with_goal(step.nodes, g, goal_column),
                     step.edges,
                     step.action,
-                    goal_reward if done else step_reward,
-                    with_goal(step.next_nodes, g),
+                    goal_reward if done else step_reward + shaping,
+                    with_goal(step.next_nodes, g, goal_column),
                     step.next_edges,
                     done,
                 )
@@ -95,3 +103,10 @@ def relabel_episode(
                 break
         relabelled.append((g, episode, episode[-1].done))
     return relabelled
+
+
+def progress(nodes: np.ndarray, next_nodes: np.ndarray, action: int, state_column: int) -> int:
+    """+1 if the try removed (opened) component ``action`` (state 0 -> 1), -1 if it put it back
+    (1 -> 0), 0 if it did not move. Paying the dense reward with this sign, not on every move, makes
+    a remove-and-reinsert cycle earn nothing, so the agent cannot farm it."""
+    return int(next_nodes[action, state_column]) - int(nodes[action, state_column])
