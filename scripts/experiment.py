@@ -8,6 +8,8 @@ the reality gap in the twin.
     python scripts/experiment.py twin-learning --out DIR [--quick] [--runs R] [--seeds S] [--workers W | --ray ...]
                                  [--agents memory,dqn,model-based]
     python scripts/experiment.py sysid --out DIR [--workers W] [--quick]
+    python scripts/experiment.py disassembly --agents memory,dual,dqn,model-based --out DIR [--quick] [--runs R]
+                                 [--seeds S] [--workers W | --ray ...]
 
 Writes ``DIR/<protocol>.json`` (every point, mean and std over training seeds and each seed's value,
 the settings), ``DIR/<protocol>.png`` (success and mean actions, like the paper's Fig. 3 panels) and
@@ -35,6 +37,13 @@ compliance from logged robot data of toggles (oracle trials in the twin under ``
 reports the nominal and the fitted twin's prediction errors of the wrench and the part's motion on held-out
 toggles: ``DIR/sysid.{json,md,png}``, every trial's log in ``DIR/logs/``; the same command resumes.
 
+``disassembly`` (``learning/experiments/disassembly.py``) trains every agent on the measured ``lab-computer-a``
+and tests it on ``lab-computer-b`` and 10 variants of it (RAM sticks and GPU cables added or removed, every pose
+jittered; ``--runs`` runs per test scene, default 5): success = the motherboard removed within 24 actions,
+against training episodes (memory: 1-20, with the paper's one-locker belief and with sets of two lockers,
+``memory-k2``; the deep agents, with dense rewards: 0-200). It writes ``DIR/disassembly.{json,md,png}``; each
+(agent, training seed) is a task whose record is kept in ``DIR/records/``: the same command resumes.
+
 ``faults`` (``scripts/_faults.py``) runs each fault class on purpose in real processes — ``trial.py``
 SIGKILLed at random moments and resumed (``--runs`` runs in the twin; ``--quick``: symbolic), concurrent
 trainers on one memory, a memory truncated at every page, the ordinary command-line mistakes — and writes
@@ -57,7 +66,7 @@ from learning.experiments import PROTOCOLS, SYMBOLIC_AGENTS, ProtocolConfig, com
 from learning.experiments.deep_protocols import DEEP_AGENTS, DeepSchedule, jobs_for, merge_deep_points, run_jobs
 from learning.experiments.report import episodes_to_solve_table
 
-PLANNED = ("disassembly",)
+DISASSEMBLY = "disassembly"
 REALITY = "reality"
 FAULTS = "faults"
 TWIN_LEARNING = "twin-learning"
@@ -68,7 +77,7 @@ AGENTS = (*SYMBOLIC_AGENTS, *DEEP_AGENTS)
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("protocol", choices=(*PROTOCOLS, ALL, REALITY, FAULTS, TWIN_LEARNING, SYSID, *PLANNED))
+    parser.add_argument("protocol", choices=(*PROTOCOLS, ALL, REALITY, FAULTS, TWIN_LEARNING, SYSID, DISASSEMBLY))
     parser.add_argument("--agents", default=None, help=f"comma-separated, from {list(AGENTS)} (reality: memory)")
     parser.add_argument("--out", required=True, help="output directory (also the resume cache of deep jobs)")
     parser.add_argument("--quick", action="store_true", help="CI size: few runs, one training seed, short schedules")
@@ -92,12 +101,12 @@ def main(argv: list[str] | None = None) -> int:
         return _twin_learning(args)
     if args.protocol == SYSID:
         return _sysid(args)
+    if args.protocol == DISASSEMBLY:
+        return _disassembly(args)
     if args.memory is not None:
         fail("--memory is for the reality protocol (the symbolic protocols train their own)")
     if args.agents is None:
         fail(f"protocol {args.protocol!r} needs --agents (comma-separated, from {list(AGENTS)})")
-    if args.protocol in PLANNED:
-        fail(f"protocol {args.protocol!r} is not available yet; available: {sorted(PROTOCOLS)} and {ALL!r}")
     agents = [a.strip() for a in args.agents.split(",") if a.strip()]
     unknown = [a for a in agents if a not in AGENTS]
     if not agents or unknown:
@@ -225,6 +234,42 @@ def _sysid(args: argparse.Namespace) -> int:
     except LearningError as err:
         fail(str(err))
     return _report(out, SYSID, summary)
+
+
+def _disassembly(args: argparse.Namespace) -> int:
+    from learning.experiments.disassembly import AGENTS as DISASSEMBLY_AGENTS
+    from learning.experiments.disassembly import DisassemblyConfig, run_disassembly
+    from learning.experiments.disassembly_report import plot as plot_disassembly
+    from learning.experiments.disassembly_report import table as disassembly_table
+
+    if args.memory is not None:
+        fail("the disassembly protocol trains its own memories (no --memory)")
+    if args.agents is None:
+        fail(f"disassembly needs --agents (comma-separated, from {list(DISASSEMBLY_AGENTS)})")
+    agents = [a.strip() for a in args.agents.split(",") if a.strip()]
+    unknown = [a for a in agents if a not in DISASSEMBLY_AGENTS]
+    if not agents or unknown:
+        fail(f"unknown disassembly agents {unknown or agents}; available: {list(DISASSEMBLY_AGENTS)}")
+    if args.workers is not None and args.workers < 1:
+        fail(f"--workers must be >= 1, got {args.workers}")
+    config = _with_runs(DisassemblyConfig().quick() if args.quick else DisassemblyConfig(), args.runs,
+                        "runs_per_test", 1)  # fmt: skip
+    if args.seeds is not None:
+        if args.seeds < 1:
+            fail(f"--seeds must be >= 1, got {args.seeds}")
+        config = replace(config, training_seeds=args.seeds)
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        fail(f"--out {out} is a file, not a directory")
+    _write_config(out, DISASSEMBLY, args, disassembly=asdict(config))
+    try:
+        summary = run_disassembly(out, agents, config, args.workers, args.ray)
+    except LearningError as err:
+        fail(str(err))
+    write_json(out / f"{DISASSEMBLY}.json", summary)
+    plot_disassembly(summary, out / f"{DISASSEMBLY}.png")
+    (out / f"{DISASSEMBLY}.md").write_text(f"# Disassembly\n\n{disassembly_table(summary)}")
+    return _report(out, DISASSEMBLY, summary)
 
 
 def _faults(args: argparse.Namespace) -> int:

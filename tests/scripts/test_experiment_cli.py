@@ -40,11 +40,12 @@ def test_memory_after_nine_variants_beats_no_memory_in_the_variants_protocol(tmp
     assert points[9]["mean_actions"] < points[0]["mean_actions"]
 
 
-def test_unknown_agent_and_unbuilt_protocol_are_clear_errors(tmp_path):
+def test_unknown_agents_are_clear_errors(tmp_path):
     bad = experiment("variants", "--agents", "memory,genius", "--out", tmp_path, "--quick")
     assert bad.returncode == 2 and "genius" in bad.stderr and "Traceback" not in bad.stderr
-    later = experiment("disassembly", "--agents", "memory", "--out", tmp_path)
-    assert later.returncode == 2 and "not available yet" in later.stderr
+    oracle = experiment("disassembly", "--agents", "memory,oracle", "--out", tmp_path, "--quick")
+    assert oracle.returncode == 2 and "oracle" in oracle.stderr and "Traceback" not in oracle.stderr
+    assert "available: ['memory', 'dual', 'dqn', 'model-based']" in oracle.stderr
 
 
 def test_quick_all_runs_every_deep_agent_and_resumes_from_its_saved_jobs(tmp_path):

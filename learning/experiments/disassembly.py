@@ -1,0 +1,246 @@
+"""The paper's disassembly experiment (issue 14 part 4): learn on one measured computer, take apart another.
+
+Every agent trains on ``lab-computer-a`` (the symbolic world; a training episode ends when the motherboard is
+out or after ``train_max_actions``) and is tested on ``lab-computer-b`` and on ``variants`` variants of it
+(:func:`models.disassembly_variants.disassembly_variant`: RAM sticks and GPU cables added or removed, every
+pose jittered): ``runs_per_test`` seeded runs on each, success = the motherboard removed within
+``max_actions`` (24, the paper's). Agents:
+
+- ``memory``: the paper's memory-based agent, its memory trained ``e`` episodes for each ``e`` of
+  ``memory_episodes``; ``memory_max_lockers`` lists the beliefs run (1: the paper's one-locker belief; 2: sets
+  of up to two lockers, trained and tested with it, reported as ``memory-k2``).
+- ``dual``: the dual controller with the uninformed prior (no training: every point is the same agent).
+- ``dqn``, ``model-based``: the deep baselines (:mod:`learning.experiments.disassembly_deep`; dense rewards for
+  the model-free agent, as the paper had to), trained for each of ``deep_episodes``.
+
+Each (agent, training seed) is one task of :mod:`learning.runner` whose record (every point, per test scene)
+is written the moment it ends, so an interrupted run resumes where it stopped. :func:`summarise` pools the
+seeds: success rate and mean actions (unsolved runs count the budget) per training-episode count, mean and
+standard deviation over training seeds, and the mean optimum (the oracle's shortest solution) of the tests.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from learning.agents.dual_agent import DualAgent, MemoryAgent
+from learning.belief import BeliefConfig
+from learning.dual_controller import DualControllerConfig
+from learning.errors import ConfigError, LearningError
+from learning.memory.store import MemoryStore
+from learning.runner import RecordStore, Task, make_executor, run_tasks
+from learning.symbolic_world import SymbolicWorld
+from learning.trial import run_episode
+from models import LockTable, PuzzleSpec, load_spec, spec_from_dict
+from models.disassembly_variants import VariantConfig, disassembly_variant
+
+DATA_DIR = Path(__file__).resolve().parents[3] / "shared" / "data" / "disassembly"
+"""Where the two measured computers live (``../shared/data/disassembly`` beside the repository)."""
+AGENTS = ("memory", "dual", "dqn", "model-based")
+DEEP = ("dqn", "model-based")
+PAPER = {
+    "memory": {"after one episode": 20.0, "converged": 17.0, "converged by": 20},
+    "note": "memory-based: 100 % after one training episode in 20 actions, 17 after more training, converged "
+    "by 20 episodes; deep agents needed dense rewards and did not converge reliably (model-free briefly "
+    "100 % at ~150 episodes)",
+}
+"""The paper's disassembly numbers (PAPER_NOTES.md)."""
+TEST_SEED = 500
+"""World seed of test run 0 (run r: ``TEST_SEED + r``), the same for every agent and point."""
+
+
+@dataclass(frozen=True)
+class DisassemblyConfig:
+    """What ``experiment.py disassembly`` runs."""
+
+    data_dir: str = str(DATA_DIR)
+    train_scene: str = "lab-computer-a"
+    test_scene: str = "lab-computer-b"
+    variants: int = 10
+    """Variants of the test scene tested besides it."""
+    variant_seed: int = 1000
+    """Seed of variant 0 (variant v: ``variant_seed + v``)."""
+    variant: VariantConfig = field(default_factory=VariantConfig)
+    runs_per_test: int = 5
+    """Seeded runs on each test scene, per point."""
+    max_actions: int = 24
+    """Success: the motherboard removed within this many actions (the paper's 24)."""
+    train_max_actions: int = 50
+    """Budget of a training episode (``train.py``'s default)."""
+    training_seeds: int = 3
+    memory_episodes: tuple[int, ...] = (1, 2, 3, 5, 10, 20)
+    memory_max_lockers: tuple[int, ...] = (1, 2)
+    deep_episodes: tuple[int, ...] = (0, 25, 50, 100, 150, 200)
+    deep_runs_per_test: int = 3
+    """Runs per test scene of the deep agents' evaluations (each point of their curve costs a training)."""
+
+    def __post_init__(self) -> None:
+        for name in ("memory_episodes", "deep_episodes"):
+            points = getattr(self, name)
+            if not points or list(points) != sorted(set(points)) or points[0] < 0:
+                raise ConfigError(f"{name} must be increasing episode counts >= 0, got {points}")
+        if self.variants < 0 or self.runs_per_test < 1 or self.training_seeds < 1 or self.deep_runs_per_test < 1:
+            raise ConfigError("variants >= 0, runs_per_test, deep_runs_per_test and training_seeds >= 1")
+        if not set(self.memory_max_lockers) <= {1, 2, 3}:
+            raise ConfigError(f"memory_max_lockers must be within 1..3, got {self.memory_max_lockers}")
+
+    def quick(self) -> DisassemblyConfig:
+        """A CI-sized experiment (measures plumbing, not learning)."""
+        return replace(self, variants=2, runs_per_test=2, training_seeds=1, memory_episodes=(1, 2),
+                       deep_episodes=(0, 2), deep_runs_per_test=1)  # fmt: skip
+
+
+def scenes(config: DisassemblyConfig) -> tuple[PuzzleSpec, list[PuzzleSpec]]:
+    """The training scene and the test scenes (the test computer first, then its variants)."""
+    data = Path(config.data_dir)
+    paths = [data / f"{name}.json" for name in (config.train_scene, config.test_scene)]
+    missing = [str(p) for p in paths if not p.is_file()]
+    if missing:
+        raise ConfigError(f"the disassembly data is missing: {', '.join(missing)} (the measured computers ship in "
+                          "../shared/data/disassembly beside the repository)")  # fmt: skip
+    train, test = (load_spec(p) for p in paths)
+    variants = [disassembly_variant(test, config.variant_seed + v, config.variant) for v in range(config.variants)]
+    return train, [test, *variants]
+
+
+def _controller(max_lockers: int) -> DualControllerConfig | None:
+    return None if max_lockers == 1 else DualControllerConfig(belief=BeliefConfig(), max_lockers=max_lockers)
+
+
+def _evaluate(make: Any, tests: Sequence[PuzzleSpec], runs: int, max_actions: int) -> dict[str, Any]:
+    """One point: ``runs`` runs on every test scene with agents from ``make()``."""
+    per_test: dict[str, dict[str, float]] = {}
+    solved_all, actions_all = [], []
+    for spec in tests:
+        solved, actions = [], []
+        for r in range(runs):
+            result = run_episode(make(), SymbolicWorld(spec, TEST_SEED + r), spec.name, TEST_SEED + r, max_actions)
+            solved.append(bool(result.solved))
+            actions.append(result.num_actions if result.solved else max_actions)
+        per_test[spec.name] = {"solved": float(np.mean(solved)), "mean_actions": float(np.mean(actions))}
+        solved_all += solved
+        actions_all += actions
+    return {"solved": float(np.mean(solved_all)), "mean_actions": float(np.mean(actions_all)), "per_test": per_test}
+
+
+def symbolic_task(settings: dict[str, Any]) -> dict[str, Any]:
+    """One (memory or dual agent, training seed): its points (see the module docstring)."""
+    config = _config_from(settings["config"])
+    train, tests = spec_from_dict(settings["train"]), [spec_from_dict(t) for t in settings["tests"]]
+    seed, k, agent = settings["seed"], settings["max_lockers"], settings["agent"]
+    start = time.perf_counter()
+    points = []
+    if agent == "dual":
+        point = _evaluate(lambda: DualAgent(_controller(k)), tests, config.runs_per_test, config.max_actions)
+        points = [{"episodes": e, **point} for e in config.memory_episodes]
+    else:
+        store, trained = MemoryStore(), []
+        for episodes in config.memory_episodes:
+            while len(trained) < episodes:
+                world_seed = 10_000 * seed + len(trained)
+                learner = MemoryAgent(store, config=_controller(k), learn=True)
+                learner.episode_label = train.name
+                result = run_episode(learner, SymbolicWorld(train, world_seed), train.name, world_seed,
+                                     config.train_max_actions)  # fmt: skip
+                trained.append({"solved": bool(result.solved), "num_actions": result.num_actions})
+            point = _evaluate(lambda: MemoryAgent(store, config=_controller(k)), tests, config.runs_per_test,
+                              config.max_actions)  # fmt: skip
+            points.append({"episodes": episodes, **point})
+        return {"points": points, "training": trained, "wall_time_s": time.perf_counter() - start}
+    return {"points": points, "wall_time_s": time.perf_counter() - start}
+
+
+def deep_task(settings: dict[str, Any]) -> dict[str, Any]:
+    """One (deep agent, training seed): trained on the training scene, evaluated at every ``deep_episodes``."""
+    from learning.experiments.disassembly_deep import train_deep_on_scene  # torch only when asked
+
+    config = _config_from(settings["config"])
+    train, tests = spec_from_dict(settings["train"]), [spec_from_dict(t) for t in settings["tests"]]
+    start = time.perf_counter()
+    records = train_deep_on_scene(settings["agent"], train, tests, config.deep_episodes, settings["seed"],
+                                  runs_per_test=config.deep_runs_per_test, max_actions=config.max_actions)  # fmt: skip
+    points = [{"episodes": r["episodes"], "solved": r["solved"], "mean_actions": r["mean_actions"],
+               "per_test": r.get("per_test", {})} for r in records]  # fmt: skip
+    return {"points": points, "wall_time_s": time.perf_counter() - start}
+
+
+def _config_from(data: dict[str, Any]) -> DisassemblyConfig:
+    return DisassemblyConfig(**{**data, "variant": VariantConfig(**data["variant"]),
+                                **{k: tuple(data[k]) for k in ("memory_episodes", "memory_max_lockers",
+                                                               "deep_episodes")}})  # fmt: skip
+
+
+def curve_name(agent: str, max_lockers: int) -> str:
+    return agent if max_lockers == 1 else f"{agent}-k{max_lockers}"
+
+
+def tasks_for(agents: Sequence[str], config: DisassemblyConfig) -> list[Task]:
+    """Every (curve, training seed) task of the experiment."""
+    unknown = [a for a in agents if a not in AGENTS]
+    if unknown or not agents:
+        raise ConfigError(f"unknown disassembly agents {unknown or list(agents)}; available: {list(AGENTS)}")
+    train, tests = scenes(config)
+    common = {"config": asdict(config), "train": train.to_dict(), "tests": [t.to_dict() for t in tests]}
+    tasks = []
+    for agent in agents:
+        lockers = config.memory_max_lockers if agent == "memory" else (1,)  # the dual agent decides alike at k = 2
+        seeds = 1 if agent == "dual" else config.training_seeds  # the dual agent learns nothing across runs
+        for k in lockers:
+            for seed in range(seeds):
+                function = deep_task if agent in DEEP else symbolic_task
+                settings = {**common, "agent": agent, "seed": seed, "max_lockers": k}
+                tasks.append(Task(f"{curve_name(agent, k)}-s{seed}", function, settings))
+    return tasks
+
+
+def run_disassembly(out: Path, agents: Sequence[str], config: DisassemblyConfig, workers: int | None = None,
+                    ray: str | None = None) -> dict[str, Any]:  # fmt: skip
+    """Run (or resume) the experiment into ``out``; returns the summary (also ``out/disassembly.json``)."""
+    start = time.perf_counter()
+    tasks = tasks_for(agents, config)
+    with make_executor(workers, ray) as executor:
+        report = run_tasks(tasks, RecordStore(out / "records"), executor, desc="disassembly")
+    if report.failures:
+        key, error = next(iter(report.failures.items()))
+        raise LearningError(f"{len(report.failures)} task(s) failed, the others kept; {key}: {error.splitlines()[0]}")
+    if report.stopped:
+        raise LearningError(f"interrupted: {len(report.records)} finished task(s) kept; run the same command again")
+    train, tests = scenes(config)
+    summary = summarise(report.records, config, tests)
+    summary.update({"wall_time_s": time.perf_counter() - start, "config": asdict(config), "agents": list(agents),
+                    "tasks": {"computed": len(report.computed), "reused": len(report.reused)}})  # fmt: skip
+    return summary
+
+
+def summarise(records: dict[str, dict[str, Any]], config: DisassemblyConfig, tests: Sequence[PuzzleSpec]) -> dict:
+    """Pool the training seeds of every curve: mean and std of success and mean actions per episode count."""
+    curves: dict[str, dict[int, list[dict[str, Any]]]] = {}
+    for key, record in sorted(records.items()):
+        curve = key.rsplit("-s", 1)[0]
+        for point in record["points"]:
+            curves.setdefault(curve, {}).setdefault(point["episodes"], []).append(point)
+    out: dict[str, Any] = {"curves": {}}
+    order = {name: i for i, name in enumerate(("memory", "memory-k2", "memory-k3", "dual", *DEEP))}
+    for curve, points in sorted(curves.items(), key=lambda item: (order.get(item[0], len(order)), item[0])):
+        rows = []
+        for episodes, seeds in sorted(points.items()):
+            solved = np.array([p["solved"] for p in seeds])
+            actions = np.array([p["mean_actions"] for p in seeds])
+            per_test = {name: float(np.mean([p["per_test"][name]["mean_actions"] for p in seeds if p["per_test"]]))
+                        for name in (seeds[0]["per_test"] or {})}  # fmt: skip
+            rows.append({"episodes": episodes, "success_rate": float(solved.mean()),
+                         "success_rate_std": float(solved.std()), "mean_actions": float(actions.mean()),
+                         "mean_actions_std": float(actions.std()), "seeds": len(seeds),
+                         "mean_actions_per_test": per_test})  # fmt: skip
+        out["curves"][curve] = rows
+    optimum = {t.name: len(LockTable.from_spec(t).shortest_solution()) for t in tests}
+    out["optimum"] = {"per_test": optimum, "mean": float(np.mean(list(optimum.values())))}
+    out["tests"] = [{"name": t.name, "components": len(t.components), "kinds": list(t.kinds)} for t in tests]
+    out["paper"] = PAPER
+    return out
