@@ -28,12 +28,12 @@ def test_the_tests_are_the_measured_computer_then_its_variants_the_same_for_ever
 
 
 def test_a_memory_trained_on_one_computer_beats_no_memory_on_the_other_and_a_rerun_reuses_every_record(tmp_path):
-    config = replace(QUICK, memory_max_lockers=(1,))
+    config = replace(QUICK, memory_max_lockers=(2,))
     first = run_disassembly(tmp_path, ["memory", "dual"], config, workers=1)
     assert first["tasks"] == {"computed": 2, "reused": 0}
-    memory, dual = first["curves"]["memory"][0], first["curves"]["dual"][0]
-    assert memory["episodes"] == 1 and memory["success_rate"] == 1.0
-    assert memory["mean_actions"] < dual["mean_actions"]
+    memory, dual = first["curves"]["memory-k2"][0], first["curves"]["dual"][0]
+    assert memory["episodes"] == 1 and memory["success_rate"] > dual["success_rate"]
+    assert memory["mean_actions"] < dual["mean_actions"] - 4
     assert first["optimum"]["per_test"]["lab-computer-b"] == 8
     again = run_disassembly(tmp_path, ["memory", "dual"], config, workers=1)
     assert again["tasks"] == {"computed": 0, "reused": 2}
