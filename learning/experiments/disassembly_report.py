@@ -35,6 +35,9 @@ def plot(summary: dict[str, Any], path: Path) -> Path:
                     markersize=11, label="paper, memory (1 and 20 episodes)")  # fmt: skip
     for ax, label in ((ax_success, "success [%]"), (ax_actions, "mean actions (unsolved: budget)")):
         ax.set_xscale("log")
+        ticks = [0.5, 1, 2, 5, 10, 20, 50, 100, 200]
+        ax.set_xticks(ticks, ["0", "1", "2", "5", "10", "20", "50", "100", "200"])
+        ax.minorticks_off()
         ax.set_xlabel("training episodes on lab-computer-a")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
