@@ -64,13 +64,12 @@ def table(summary: dict[str, Any]) -> str:
     lines += ["", f"Optimum (the oracle's shortest solution): {optimum['mean']:.2f} actions on average "
               f"({', '.join(f'{k} {v}' for k, v in optimum['per_test'].items())}).", ""]  # fmt: skip
     lines += ["| | paper | ours |", "|---|---|---|"]
-    memory = summary["curves"].get("memory", [])
-    by_episodes = {r["episodes"]: r for r in memory}
-    for label, episodes, paper in (("memory after 1 episode", 1, "100 %, 20 actions"),
-                                   ("memory after 20 episodes", 20, "100 %, 17 actions")):  # fmt: skip
-        ours = by_episodes.get(episodes)
-        text = f"{100 * ours['success_rate']:.1f} %, {ours['mean_actions']:.2f} actions" if ours else "not run"
-        lines.append(f"| {label} | {paper} | {text} |")
+    for curve in (c for c in summary["curves"] if c.startswith("memory")):
+        by_episodes = {r["episodes"]: r for r in summary["curves"][curve]}
+        for episodes, paper in ((1, "100 %, 20 actions"), (20, "100 %, 17 actions")):
+            ours = by_episodes.get(episodes)
+            text = f"{100 * ours['success_rate']:.1f} %, {ours['mean_actions']:.2f} actions" if ours else "not run"
+            lines.append(f"| {curve} after {episodes} episode{'s' * (episodes > 1)} | {paper} | {text} |")
     for deep, paper in (("dqn", "dense rewards; briefly 100 % at ~150 episodes, not reliably"),
                         ("model-based", "dense rewards; did not converge reliably")):  # fmt: skip
         rows = summary["curves"].get(deep)
