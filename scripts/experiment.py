@@ -105,12 +105,7 @@ def main(argv: list[str] | None = None) -> int:
         return _disassembly(args)
     if args.memory is not None:
         fail("--memory is for the reality protocol (the symbolic protocols train their own)")
-    if args.agents is None:
-        fail(f"protocol {args.protocol!r} needs --agents (comma-separated, from {list(AGENTS)})")
-    agents = [a.strip() for a in args.agents.split(",") if a.strip()]
-    unknown = [a for a in agents if a not in AGENTS]
-    if not agents or unknown:
-        fail(f"unknown agents {unknown or agents}; available: {list(AGENTS)}")
+    agents = _agents(args, AGENTS)
     config, schedule = ProtocolConfig(), DeepSchedule()
     if args.quick:
         config, schedule = config.quick(), schedule.quick()
@@ -244,12 +239,7 @@ def _disassembly(args: argparse.Namespace) -> int:
 
     if args.memory is not None:
         fail("the disassembly protocol trains its own memories (no --memory)")
-    if args.agents is None:
-        fail(f"disassembly needs --agents (comma-separated, from {list(DISASSEMBLY_AGENTS)})")
-    agents = [a.strip() for a in args.agents.split(",") if a.strip()]
-    unknown = [a for a in agents if a not in DISASSEMBLY_AGENTS]
-    if not agents or unknown:
-        fail(f"unknown disassembly agents {unknown or agents}; available: {list(DISASSEMBLY_AGENTS)}")
+    agents = _agents(args, DISASSEMBLY_AGENTS)
     if args.workers is not None and args.workers < 1:
         fail(f"--workers must be >= 1, got {args.workers}")
     config = _with_runs(DisassemblyConfig().quick() if args.quick else DisassemblyConfig(), args.runs,
@@ -282,6 +272,17 @@ def _faults(args: argparse.Namespace) -> int:
     out = Path(args.out)
     _write_config(out, "faults", args, faults=asdict(config))
     return _report(out, "faults", run_faults(out, config))
+
+
+def _agents(args: argparse.Namespace, available: tuple[str, ...]) -> list[str]:
+    """The ``--agents`` of a protocol that needs them, each one of ``available`` (else one line, exit 2)."""
+    if args.agents is None:
+        fail(f"protocol {args.protocol!r} needs --agents (comma-separated, from {list(available)})")
+    agents = [a.strip() for a in args.agents.split(",") if a.strip()]
+    unknown = [a for a in agents if a not in available]
+    if not agents or unknown:
+        fail(f"unknown agents {unknown or agents} for {args.protocol!r}; available: {list(available)}")
+    return agents
 
 
 def _with_runs(config: Any, runs: int | None, field: str, minimum: int, why: str = "") -> Any:

@@ -217,25 +217,11 @@ class MemoryStore:
                 f"{path} has memory schema {meta.get('schema_version')}; this version reads {list(READABLE_SCHEMAS)}"
             )
         self._schema = meta["schema_version"]
-        try:
-            self.position_scale = float(meta["position_scale"])
-        except (KeyError, ValueError):
-            raise MemoryFileError(
-                f"{path} has no valid position_scale in its meta table ({meta.get('position_scale')!r})"
-            ) from None
-        if not (math.isfinite(self.position_scale) and self.position_scale > 0.0):
-            raise MemoryFileError(f"{path} has a position_scale that is not a finite length > 0: {self.position_scale}")
+        self.position_scale = _meta_number(meta, "position_scale", path, "a finite length > 0", positive=True)
         if self._schema in LEGACY_KEY_SCHEMAS:
             self.rotation_weight = DEFAULT_ROTATION_WEIGHT  # what the conversion of its compact keys uses
             return
-        try:
-            self.rotation_weight = float(meta["rotation_weight"])
-        except (KeyError, ValueError):
-            raise MemoryFileError(
-                f"{path} has no valid rotation_weight in its meta table ({meta.get('rotation_weight')!r})"
-            ) from None
-        if not (math.isfinite(self.rotation_weight) and self.rotation_weight >= 0.0):
-            raise MemoryFileError(f"{path} has a rotation_weight that is not finite and >= 0: {self.rotation_weight}")
+        self.rotation_weight = _meta_number(meta, "rotation_weight", path, "finite and >= 0", positive=False)
 
     def _load(self, conn: sqlite3.Connection, path: Path) -> None:
         self.num_episodes = conn.execute("SELECT COUNT(*) FROM episodes").fetchone()[0]
@@ -487,6 +473,17 @@ class MemoryStore:
 
     def __repr__(self) -> str:
         return f"MemoryStore({json.dumps(self.summary())})"
+
+
+def _meta_number(meta: dict[str, str], name: str, path: Path, rule: str, positive: bool) -> float:
+    """The number ``meta[name]`` of a memory file's meta table, finite and > 0 (``positive``) or >= 0."""
+    try:
+        value = float(meta[name])
+    except (KeyError, ValueError):
+        raise MemoryFileError(f"{path} has no valid {name} in its meta table ({meta.get(name)!r})") from None
+    if not (math.isfinite(value) and (value > 0.0 if positive else value >= 0.0)):
+        raise MemoryFileError(f"{path} has a {name} that is not {rule}: {value}")
+    return value
 
 
 def _check_probabilities(values: np.ndarray, where: str) -> None:
