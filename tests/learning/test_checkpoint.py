@@ -21,6 +21,7 @@ from learning.baselines import (  # noqa: E402
     load_checkpoint,
     save_checkpoint,
 )
+from learning.errors import ConfigError  # noqa: E402
 from models.generator import generate_chain  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -65,7 +66,7 @@ def test_bad_checkpoints_are_clear_errors(tmp_path):
     (tmp_path / "dqn.pt.json").write_text("{not json")
     with pytest.raises(CheckpointError, match="JSON"):
         load_checkpoint(path)
-    with pytest.raises(Exception, match="needs a checkpoint"):
+    with pytest.raises(ConfigError, match="needs a checkpoint"):
         make_agent("dqn", generate_chain(["door", "slide"], seed=0))
 
 

@@ -143,8 +143,10 @@ def test_training_on_a_scene_is_deterministic(lab_a, lab_b, name):
     records = [train_deep_on_scene(name, lab_a, [lab_b], (0, 3), seed=1, runs_per_test=2) for _ in range(2)]
     assert records[0] == records[1]
     assert [r["episodes"] for r in records[0]] == [0, 3]
+    untrained = records[0][0]  # 24 tries of an untrained network never take a motherboard out: 8 must come first
+    assert untrained["solved"] == 0.0 and untrained["mean_actions"] == 24.0
     for record in records[0]:
-        assert 0.0 <= record["solved"] <= 1.0 and record["mean_actions"] <= 24
+        assert record["solved"] in (0.0, 0.5, 1.0)  # a fraction of the 2 runs
         assert set(record["per_test"]) == {lab_b.name}
 
 

@@ -18,7 +18,9 @@ def test_dqn_learns_a_two_component_box_within_two_hundred_episodes():
         epsilon_decay=0.98, epsilon_min=0.05, epsilon_eval=0.0,
     )  # fmt: skip
     agent = DQNAgent(config)
-    untrained = [run_episode(DQNAgent(config), SymbolicWorld(spec, s), "", s, 10) for s in range(5)]
+    fresh = DQNAgent(config)
+    fresh.training = False  # acting only: an evaluation of the untrained network
+    untrained = [run_episode(fresh, SymbolicWorld(spec, 1000 + s), "", 1000 + s, 10) for s in range(20)]
     for episode in range(200):
         run_episode(agent, SymbolicWorld(spec, episode), spec.name, episode, 10)
     agent.training = False
@@ -28,7 +30,9 @@ def test_dqn_learns_a_two_component_box_within_two_hundred_episodes():
         [run_episode(RandomAgent(), SymbolicWorld(spec, s), "", s, 10).num_actions for s in range(20)]
     )
     assert random_mean > 2.5 and agent.epsilon < 0.1
-    assert untrained  # an untrained network runs without learning anything (no replay needed)
+    # the untrained network acts without learning anything (no replay needed), and worse than the trained one
+    assert fresh.replay_size() == 0 and fresh.episodes == 0
+    assert np.mean([r.num_actions for r in untrained]) > np.mean([r.num_actions for r in greedy]) == 2.0
 
 
 def test_replay_only_updates_once_a_batch_is_available():

@@ -29,7 +29,7 @@ def test_quick_protocol_writes_results_plot_and_paper_table(tmp_path, protocol):
     assert "| figure | agent | ours | paper |" in (tmp_path / f"{protocol}.md").read_text()
     for point in data["points"]:
         assert point["oracle"]["success_rate"] == 1.0 and point["oracle"]["mean_actions"] == 5.0
-        assert 0.0 <= point["memory"]["success_rate"] <= 1.0
+        assert point["memory"]["mean_actions"] >= 5.0  # no agent beats the optimum
 
 
 def test_memory_after_nine_variants_beats_no_memory_in_the_variants_protocol(tmp_path):
@@ -90,7 +90,7 @@ def test_quick_reality_sweep_calibrates_each_cell_runs_placed_boxes_and_resumes(
     data = json.loads((tmp_path / "reality.json").read_text())
     assert {(p["series"], p["level"]) for p in data["points"]} == {("force-torque", 0.0), ("force-torque", 1.0)}
     for point in data["points"]:
-        assert point["trials"] == 3 and 0.0 <= point["success_rate"] <= 1.0
+        assert point["trials"] == 3 and point["success_rate"] in (0.0, 1 / 3, 2 / 3, 1.0)
         assert point["calibration_reprojection_px"] < 0.5
         assert len(point["unsolved_reasons"]) == round(3 * (1 - point["success_rate"]))
     assert (tmp_path / "reality.png").read_bytes().startswith(b"\x89PNG")
@@ -128,7 +128,7 @@ def test_quick_twin_learning_trains_each_start_in_the_twin_measures_its_checkpoi
     points = {(p["start"], p["hours"]): p for p in data["points"]}
     assert set(points) == {("empty", 0.0), ("empty", 0.02), ("symbolic", 0.0), ("symbolic+twin", 0.0),
                            ("symbolic+twin", 0.02), ("dqn", 0.0)}  # fmt: skip
-    assert all(p["seeds"][0]["trials"] == 1 and 0.0 <= p["success_rate"] <= 1.0 for p in points.values())
+    assert all(p["seeds"][0]["trials"] == 1 and p["success_rate"] in (0.0, 1.0) for p in points.values())
     # the deep agent ran the same test trial from the network it trained in the symbolic simulator
     dqn_trial = json.loads((tmp_path / "trials" / "dqn-v9-s0-paper-test-0-p0.json").read_text())["record"]
     assert dqn_trial["spec"] == "paper-test-0" and dqn_trial["actions"], dqn_trial
