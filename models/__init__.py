@@ -19,18 +19,8 @@ from models.kinds import ALLOWED_NEIGHBOURS, KIND_NAMES, PUZZLE_KINDS, KindTempl
 from models.lock_table import LockTable
 from models.observation import ComponentObservation, SceneObservation
 from models.robot import CameraImage, Robot
-from models.spec import (
-    SPEC_FORMAT,
-    Box,
-    Component,
-    Goal,
-    LockRule,
-    PuzzleSpec,
-    load_spec,
-    save_spec,
-    spec_from_dict,
-    spec_from_json,
-)
+from models.spec import SPEC_FORMAT, Box, Component, Goal, LockRule, PuzzleSpec, save_spec
+from models.spec_loading import load_spec, spec_from_dict, spec_from_json
 from models.toggle_log import ToggleLog, load_toggles, save_toggles
 from models.try_outcome import OUTCOMES, Outcome, TryResult
 from models.validation import validate_data

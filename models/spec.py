@@ -1,7 +1,8 @@
 """Puzzle spec v1: the dataclasses of a puzzle and their JSON form (the contract in SPEC.md).
 
-A spec is immutable. :func:`load_spec` / :func:`spec_from_json` validate the whole file first and
-raise :class:`~models.errors.SpecError` listing every problem, so an invalid file is never half-loaded.
+A spec is immutable. Reading one is :mod:`models.spec_loading`'s (``load_spec`` / ``spec_from_json`` validate the
+whole file first and raise :class:`~models.errors.SpecError` listing every problem, so an invalid file is never
+half-loaded); :func:`save_spec` writes one.
 """
 
 from __future__ import annotations
@@ -15,7 +16,6 @@ import numpy as np
 
 from models.atomic import write_text_atomically
 from models.disassembly_kinds import DISASSEMBLY_FAMILY, DISASSEMBLY_KINDS, PUZZLE_BOX_FAMILY
-from models.errors import SpecError, SpecProblem
 from models.geometry import compose, wrap_angle
 
 SPEC_FORMAT = "puzzlebox-spec/1"
@@ -189,52 +189,6 @@ def _encode(obj: Any, depth: int) -> str:
             return "[" + ", ".join(_encode(v, depth) for v in obj) + "]"
         return "[\n" + ",\n".join(inner + _encode(v, depth + 1) for v in obj) + "\n" + pad + "]"
     return json.dumps(obj, ensure_ascii=False, allow_nan=False)
-
-
-def spec_from_dict(data: Any, source: str | None = None) -> PuzzleSpec:
-    """Validate a parsed JSON value and build the spec; :class:`SpecError` lists every problem."""
-    from models.validation import validate_data  # validation builds on the dataclasses above
-
-    problems = validate_data(data)
-    if problems:
-        raise SpecError(problems, source)
-    return build_from_valid_data(data)
-
-
-class _DuplicateKey(ValueError):
-    pass
-
-
-def _refuse_duplicate_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-    """``json.loads`` keeps the last of two equal keys silently; a spec with one is ambiguous."""
-    out: dict[str, Any] = {}
-    for key, value in pairs:
-        if key in out:
-            raise _DuplicateKey(key)
-        out[key] = value
-    return out
-
-
-def spec_from_json(text: str, source: str | None = None) -> PuzzleSpec:
-    """Parse and validate JSON text."""
-    try:
-        data = json.loads(text, object_pairs_hook=_refuse_duplicate_keys)
-    except json.JSONDecodeError as err:
-        problem = SpecProblem("file", f"not valid JSON: {err.msg} at line {err.lineno} column {err.colno}")
-        raise SpecError([problem], source) from None
-    except _DuplicateKey as err:
-        raise SpecError([SpecProblem("file", f"duplicate key {err.args[0]!r} in one JSON object")], source) from None
-    return spec_from_dict(data, source)
-
-
-def load_spec(path: str | Path) -> PuzzleSpec:
-    """Read, parse and validate a spec file."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as err:
-        raise SpecError([SpecProblem("file", f"cannot read: {err}")], str(path)) from None
-    return spec_from_json(text, str(path))
 
 
 def save_spec(spec: PuzzleSpec, path: str | Path) -> Path:

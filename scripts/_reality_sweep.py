@@ -35,7 +35,7 @@ from learning.memory import MemoryStore
 from learning.runner import RecordStore, RunReport, Task, make_executor, run_tasks
 from models.calibration import CellCalibration
 from models.generator import paper_family
-from models.spec import spec_from_dict
+from models.spec_loading import spec_from_dict
 from twin.reality import RealityProfile
 from twin.reality_levels import ALL, FACTORS, force_noise_profile, profile_at
 

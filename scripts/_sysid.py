@@ -42,7 +42,7 @@ from learning.runner import RecordStore, Task, make_executor, run_tasks
 from models.calibration import CellCalibration
 from models.generator import paper_family
 from models.kinds import KIND_NAMES
-from models.spec import spec_from_dict
+from models.spec_loading import spec_from_dict
 from models.toggle_log import load_toggles, save_toggles
 from twin.pose_error import PoseErrorConfig
 from twin.reality import RealityProfile, load_profile

@@ -17,7 +17,7 @@ from learning import SymbolicWorld, make_agent, run_episode
 from learning.memory import MemoryStore
 from learning.runner import Task
 from models import PuzzleSpec
-from models.spec import spec_from_dict
+from models.spec_loading import spec_from_dict
 
 TIMING_KEYS = ("wall_time", "wall_time_s", "wall_time_per_trial_s_max", "wall_time_per_trial_s_mean", "sim_over_wall")
 """Record and summary fields that measure this machine's speed, not the trial: the only ones that differ

@@ -40,7 +40,7 @@ from learning import DualAgent, PuzzleEnv, PuzzleEnvConfig, SymbolicWorld  # noq
 from learning.dual_controller import DualControllerConfig  # noqa: E402
 from models.generator import RandomGraphConfig, generate_random  # noqa: E402
 from models.generator.chain import MAX_REACHABLE_COMPONENTS, BoxConfig  # noqa: E402
-from models.spec import load_spec  # noqa: E402
+from models.spec_loading import load_spec  # noqa: E402
 
 SIZES = (5, 10, 16, 32)
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from learning.agent_names import AGENT_NAMES, BELIEF_AGENT_NAMES, DEEP_AGENT_NAMES, POSE_ENCODINGS
 from learning.agents.base import Agent
 from learning.agents.dual_agent import DualAgent, MemoryAgent
 from learning.agents.oracle_agent import OracleAgent
@@ -12,17 +13,7 @@ from learning.errors import ConfigError, UnknownAgent
 from learning.memory.store import MemoryStore
 from models import PuzzleSpec
 
-DEEP_AGENT_NAMES = ("dqn", "model-based", "mt-dqn", "mt-model-based")
-"""The deep baselines (torch; ``learning.baselines``): DQN, the precondition planner, and their MT-OPT
-variants."""
-BELIEF_AGENT_NAMES = ("memory", "dual")
-"""The agents that act on a belief over the lock graph (the dual controller's)."""
-POSE_ENCODINGS = ("relative", "absolute")
-"""Where the deep agents' graph network sees poses (``learning.baselines.GraphNetworkConfig.poses``)."""
-AGENT_NAMES = ("memory", "dual", "random", "oracle", *DEEP_AGENT_NAMES)
-"""``memory``: dual controller + memory prior (needs a memory); ``dual``: no memory; ``random``;
-``oracle``: knows the spec's locks and plays a shortest plan (the floor on actions); the deep
-baselines need a checkpoint."""
+__all__ = ["AGENT_NAMES", "BELIEF_AGENT_NAMES", "DEEP_AGENT_NAMES", "POSE_ENCODINGS", "make_agent"]
 
 
 def make_agent(

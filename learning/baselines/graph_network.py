@@ -28,7 +28,7 @@ import numpy as np
 import torch
 from torch import nn
 
-from learning.agents.factory import POSE_ENCODINGS
+from learning.agent_names import POSE_ENCODINGS
 from learning.errors import ConfigError, LearningError
 from learning.memory.keys import key_size, relative_pose_keys
 from models import KIND_NAMES, PuzzleSpec, SceneObservation

@@ -1,4 +1,4 @@
-"""The deep agents by name, with the paper's hyper-parameters (``learning.agents.DEEP_AGENT_NAMES``)."""
+"""The deep agents by name, with the paper's hyper-parameters (their names: ``learning.agent_names``)."""
 
 from __future__ import annotations
 

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from learning.agents.factory import DEEP_AGENT_NAMES
+from learning.agent_names import DEEP_AGENT_NAMES
 from learning.errors import ConfigError, LearningError
 from learning.experiments.protocol import (
     ProtocolConfig,

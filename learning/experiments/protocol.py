@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from learning.agent_names import SYMBOLIC_AGENT_NAMES
 from learning.agents.base import Agent
 from learning.agents.dual_agent import DualAgent, MemoryAgent
 from learning.agents.oracle_agent import OracleAgent
@@ -29,7 +30,7 @@ from models import PuzzleSpec
 from models.generator import TEST_INDICES, TRAIN_INDICES, paper_variant
 
 TRAIN_LAYOUT_BASE = 100_000
-SYMBOLIC_AGENTS = ("memory", "dual", "random", "oracle")
+SYMBOLIC_AGENTS = SYMBOLIC_AGENT_NAMES
 
 
 @dataclass(frozen=True)

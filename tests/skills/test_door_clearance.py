@@ -11,7 +11,7 @@ import pytest
 
 from models.kinds import DOOR_HALF
 from models.puzzle_box import build_puzzle_box
-from models.spec import spec_from_dict
+from models.spec_loading import spec_from_dict
 from skills.door_clearance import door_overhang, lean_away, near_open_door
 from skills.door_push import DoorPush
 from skills.joint_model import joint_model
