@@ -61,6 +61,16 @@ class LockTable:
             blocked |= locker_ok & locked_ok
         return ~blocked
 
+    def held(self, states: np.ndarray) -> np.ndarray:
+        """``(N,)`` bool: which components an active rule holds in the joint state ``states`` (``(N,)`` 0/1,
+        entry ``c`` the state of component ``c``): the complement of :meth:`movable`, for one state vector (the
+        twin's latches act on it)."""
+        states = np.asarray(states, dtype=np.int64)
+        active = (states[self.locker] == self.locker_state) & (states[self.locked] == self.locked_state)
+        held = np.zeros(self.num_components, dtype=bool)
+        held[self.locked[active]] = True
+        return held
+
     def is_goal(self, state: int) -> bool:
         return ((state >> self.goal) & 1) == self.goal_state
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from models import PuzzleSpec
+from models import LockTable, PuzzleSpec
 
 
 class Latches:
@@ -24,19 +24,12 @@ class Latches:
         self.model = model
         self.eq_ids = np.array([model.equality(name).id for name in latch_names], dtype=np.int64)
         self.joint_qpos = joint_qpos
-        index = {name: i for i, name in enumerate(spec.component_names)}
-        self.locker = np.array([index[r.locker] for r in spec.locks], dtype=np.int64)
-        self.locker_state = np.array([r.locker_state for r in spec.locks], dtype=np.int64)
-        self.locked = np.array([index[r.locked] for r in spec.locks], dtype=np.int64)
-        self.locked_state = np.array([r.locked_state for r in spec.locks], dtype=np.int64)
+        self.table = LockTable.from_spec(spec)  # the symbolic semantics itself: physics and symbols cannot drift
         self.engaged = np.zeros(len(latch_names), dtype=bool)
 
     def held(self, states: np.ndarray) -> np.ndarray:
         """Which components an active rule holds, for component states ``states`` (0/1 each)."""
-        active = (states[self.locker] == self.locker_state) & (states[self.locked] == self.locked_state)
-        held = np.zeros(len(self.eq_ids), dtype=bool)
-        held[self.locked[active]] = True
-        return held
+        return self.table.held(states)
 
     def apply(self, data: mujoco.MjData, states: np.ndarray, jammed: np.ndarray | None = None) -> None:
         """Engage newly held components where they stand and release the ones no rule holds (nor a

@@ -82,6 +82,14 @@ def test_vectorised_movable_agrees_with_the_scalar_rule():
         assert table.movable(states, j).tolist() == expected
 
 
+def test_held_is_exactly_what_cannot_move_in_every_joint_state():
+    rules = [(0, 0, 3, 0), (1, 1, 3, 0), (2, 0, 3, 1), (3, 1, 0, 1), (0, 1, 2, 0)]
+    table = LockTable.from_spec(make_spec(4, rules, goal=3))
+    for state in range(16):
+        bits = np.array([(state >> c) & 1 for c in range(4)])
+        assert table.held(bits).tolist() == [not table.can_move(state, c) for c in range(4)]
+
+
 def test_sparse_search_is_used_beyond_the_dense_limit_and_finds_the_chain():
     n = 30
     rules = [r for k in range(n - 1) for r in ((k, 0, k + 1, 0), (k + 1, 1, k, 1))]
