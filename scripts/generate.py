@@ -6,6 +6,11 @@
     python scripts/generate.py random|chain ... --count N --out DIR [--workers K | --ray auto|ADDRESS]
     python scripts/generate.py validate FILE...     # exit 1 and one line per problem if any is invalid
     python scripts/generate.py mjcf SPEC --out DIR  # DIR/scene.xml + assets, loadable by mujoco
+    python scripts/generate.py mesh SPEC --out DIR  # DIR/<name>.glb|.obj|.stl + <name>-<part>.stl
+
+``mesh`` exports the box as the MuJoCo model has it (at start, every component closed): one part per
+component plus ``box`` (the shell), in the lid frame (origin at the centre of the lid's top face, z up),
+in metres; STL has no part names, hence one STL per part beside the merged one (``models.mesh_export``).
 
 ``--plot`` on paper/chain/random also writes a top view of each layout (PNG beside the JSON).
 Generated boxes stand where the robot reaches every handle (at most 28 components fit); ``--anywhere``
@@ -25,7 +30,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from _cli import fail
+from _cli import fail, one_line
 from tqdm import tqdm
 
 from models import LockTable, ModelsError, PuzzleSpec, SpecError, load_spec, save_spec
@@ -111,6 +116,19 @@ def _mjcf(args: argparse.Namespace) -> None:
     print(f"wrote {path} and its assets ({len(list(Path(args.out).iterdir())) - 1} files)")
 
 
+def _mesh(args: argparse.Namespace) -> None:
+    from models.mesh_export import export_meshes  # MuJoCo and trimesh only when asked
+
+    try:
+        spec = load_spec(args.spec)
+    except SpecError as err:
+        fail(one_line(err))
+    if spec.box is None:
+        fail(f"{args.spec}: spec {spec.name!r} is a disassembly scene (no box); only puzzle boxes export as meshes")
+    paths = export_meshes(spec, args.out)
+    print(f"wrote {len(paths)} files in {args.out}: {', '.join(p.name for p in paths[:3])} and one STL per part")
+
+
 def _validate(args: argparse.Namespace) -> int:
     invalid = 0
     for file in args.files:
@@ -178,6 +196,11 @@ def main(argv: list[str] | None = None) -> int:
     scene.add_argument("spec", help="puzzle spec file")
     scene.add_argument("--out", required=True, help="output directory")
     scene.set_defaults(run=_mjcf)
+
+    mesh = verbs.add_parser("mesh", help="the box as meshes: DIR/<name>.glb, .obj, .stl and one STL per part")
+    mesh.add_argument("spec", help="puzzle spec file")
+    mesh.add_argument("--out", required=True, help="output directory")
+    mesh.set_defaults(run=_mesh)
 
     validate = verbs.add_parser("validate", help="check spec files; exit 1 if any is invalid")
     validate.add_argument("files", nargs="+")
