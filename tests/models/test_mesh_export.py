@@ -17,7 +17,8 @@ from models.puzzle_box import component_prefixes
 from models.scene import SceneConfig, build_scene
 
 TOLERANCE = 1e-4  # 0.1 mm, the issue's target
-RANDOM = [(6, False, 0), (9, True, 1), (12, True, 2)]
+RANDOM = [(6, False, 0), (9, True, 1), (12, True, 2)] + [(3 + i % 18, i % 2 == 1, 1000 + i) for i in range(50)]
+"""The issue's target set: every paper box and 50 random boxes (3-20 components, half with several lockers)."""
 SPECS = {s.name: s for s in paper_family("all")} | {
     s.name: s
     for s in (
