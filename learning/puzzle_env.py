@@ -19,6 +19,7 @@ from gymnasium import spaces
 from learning.errors import ConfigError, InvalidAction
 from models import LockTable, PuzzleSpec
 from models.disassembly_kinds import family_kind_names
+from models.geometry import wrap_angle
 
 
 @dataclass(frozen=True)
@@ -124,7 +125,7 @@ class PuzzleEnv(gym.Env[dict[str, Any], np.int64]):
             self._poses[:, :2] += rng.normal(0.0, faults.position_noise_std, size=(n, 2))
         if faults.yaw_noise_std > 0.0:
             yaw = self._poses[:, -1] + rng.normal(0.0, faults.yaw_noise_std, size=n)
-            self._poses[:, -1] = (yaw + np.pi) % (2.0 * np.pi) - np.pi
+            self._poses[:, -1] = wrap_angle(yaw)
         return self._observation(), {"moved": False, "num_actions": 0}
 
     def step(self, action: Any) -> tuple[dict[str, Any], float, bool, bool, dict[str, Any]]:

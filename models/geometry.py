@@ -10,9 +10,15 @@ import math
 import numpy as np
 
 
-def wrap_angle(angle: float) -> float:
-    """Wrap an angle [rad] into [-pi, pi)."""
+def wrap_angle(angle: float | np.ndarray) -> float | np.ndarray:
+    """Wrap an angle [rad] (or each of an array of them) into [-pi, pi)."""
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def upright_pose(x: float, y: float, yaw: float, height: float) -> np.ndarray:
+    """4x4 pose with z up at ``(x, y, height)`` [m], turned by ``yaw`` [rad] about z."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([[c, -s, 0, x], [s, c, 0, y], [0, 0, 1, height], [0, 0, 0, 1]], dtype=float)
 
 
 def compose(T_a_b: tuple[float, float, float], T_b_c: tuple[float, float, float]) -> tuple[float, float, float]:

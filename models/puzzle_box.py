@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from dm_control import mjcf
 
+from models.geometry import upright_pose
 from models.kinds import (
     DOOR_HALF,
     HANDLE_HEIGHT,
@@ -220,6 +221,4 @@ def yaw_quat(yaw: float) -> list[float]:
 
 def lid_to_world(box_pose: tuple[float, float, float], height: float) -> np.ndarray:
     """4x4 transform of the lid frame in the world frame for a box at ``box_pose`` ``[x, y, yaw]``."""
-    x, y, yaw = box_pose
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([[c, -s, 0, x], [s, c, 0, y], [0, 0, 1, height], [0, 0, 0, 1]], dtype=float)
+    return upright_pose(*box_pose, height)

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from models import geometry
 from models.calibration import CameraCalibration
 from models.kinds import MARKER_SIZE
 from models.markers import aruco_dictionary
@@ -79,9 +80,7 @@ def upright_pose(planar_pose: np.ndarray, height: float) -> np.ndarray:
     Seen from above, a small marker's tilt is ill-conditioned (the two IPPE solutions differ by
     several degrees) while its position and yaw are accurate; a box on a level table has its lid
     level, so components are placed upright."""
-    x, y, yaw = planar_pose
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([[c, -s, 0, x], [s, c, 0, y], [0, 0, 1, height], [0, 0, 0, 1]], dtype=float)
+    return geometry.upright_pose(*planar_pose, height)
 
 
 def lid_height(detections: dict[int, MarkerDetection]) -> float:

@@ -34,6 +34,7 @@ import numpy as np
 
 from models import ComponentObservation, SceneObservation, TryResult
 from models.calibration import CellCalibration
+from models.geometry import wrap_angle
 from models.robot import Robot
 from skills.door_clearance import lean_away, near_open_door
 from skills.joint_model import JointModel, joint_model
@@ -340,7 +341,7 @@ class TwinWorld:
             at = self.joint_models[marker].fraction_between(self._closed_point(marker), seen.T_base_marker[:3, 3])
             return self._door_verdict(at, opening)
         delta = seen.planar_pose - self.closed_poses[marker]
-        turn = abs((delta[2] + math.pi) % (2 * math.pi) - math.pi)
+        turn = abs(wrap_angle(delta[2]))
         away = bool(np.linalg.norm(delta[:2]) > MOVED_DISTANCE or turn > MOVED_ANGLE)
         if away == opening:
             return TryResult("moved")

@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from models.toggle_log import ToggleLog
 from twin.toggle_signals import SignalConfig, joint_load
@@ -54,8 +55,7 @@ def pose_basis(
             shift[i] = step
             axis, origin = log.axis, log.origin + shift
         else:  # a yaw error turns the joint about the vertical through the marker
-            c, s = np.cos(step), np.sin(step)
-            R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+            R = Rotation.from_euler("z", step).as_matrix()
             axis, origin = R @ log.axis, centre + R @ (log.origin - centre)
         column = (joint_load(replace(log, axis=axis, origin=origin), force, torque, tcp, signals) - base) / step
         if np.abs(column).max() * step > 1e-6:  # a direction that changes the load
