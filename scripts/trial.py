@@ -3,7 +3,8 @@
     python scripts/trial.py --specs FILE... [--memory MEM.sqlite] --sim {symbolic,twin} --runs K --seed S \
                             --max-actions M --out DIR [--agent NAME] [--max-lockers K] [--video] \
                             [--reality ideal|realistic|harsh|FILE.json] [--calibration FILE.json] [--wrong-kind] \
-                            [--workers K | --ray auto|ADDRESS] [--resume | --force]
+                            [--workers K | --ray auto|ADDRESS] [--resume | --force] \
+                            [--robot twin|xarm --ip ADDRESS --cell FILE]
 
 ``--sim twin`` runs each trial end to end in the MuJoCo twin (ArUco perception, the agent, mink
 primitives, F/T outcomes) and adds a per-action ``timeline`` to each run (sensed outcome beside the
@@ -19,6 +20,10 @@ agent's belief hold a component with a set of up to K lockers (default 1: the pa
 and agent) one
 component's kind wrong in every run, drawn from the run's seed (the run's ``told_kinds``): the force limits
 must hold when a slide is pulled along a wheel's arc.
+
+``--robot xarm --ip ADDRESS --cell FILE`` is for a real xArm-7 (``real.XArmRobot``, the ``real`` extra): it
+refuses at once, in one line, an address where no arm answers, a missing SDK or a bad cell config; an arm that
+answers is let go again, since trials on a real arm are not wired to the skills yet.
 
 Runs are tasks of ``learning.runner``: ``--workers K`` runs them in K worker processes (default: one per
 core for ``--sim twin``; in-process for ``--sim symbolic``, whose runs last less than handing them over),
@@ -44,7 +49,7 @@ import sys
 from pathlib import Path
 
 import _trial_task
-from _cli import fail
+from _cli import fail, one_line
 from _interrupt import StopRequests
 from _run_store import Periodic, RunStore
 from tqdm import tqdm
@@ -58,6 +63,25 @@ from models import SpecError, load_spec
 from twin.errors import TwinError
 
 SIMS = ("symbolic", "twin")
+ROBOTS = ("twin", "xarm")
+
+
+def _connect_xarm(args) -> None:
+    """``--robot xarm``: refuse clearly what cannot run (no --ip or --cell, no SDK, no arm answering); an arm that
+    answers is connected and let go again, since the skills pipeline is not wired to a real arm yet."""
+    if args.ip is None or args.cell is None:
+        fail("--robot xarm needs --ip ADDRESS (the arm's controller) and --cell FILE (the cell config)")
+    if args.sim != "twin":
+        fail("--robot xarm runs the perception and skills pipeline: give --sim twin")
+    from models.cell_config import CellConfigError, load_cell_config
+    from real import RealError, XArmRobot
+
+    try:
+        cell = load_cell_config(args.cell)
+        XArmRobot(args.ip, cell).close()
+    except (CellConfigError, RealError) as err:
+        fail(f"--robot xarm: {one_line(err)}")
+    fail(f"--robot xarm: the arm at {args.ip} answered, but trials on a real arm are not wired to the skills yet")
 
 
 def twin_figures(runs: list) -> dict:
@@ -166,9 +190,21 @@ def main(argv: list[str] | None = None) -> int:
         "--workers", type=int, default=None, help="worker processes (default: one per core for twin, 1 = in-process)"
     )
     parser.add_argument("--ray", default=None, metavar="auto|ADDRESS", help="run on Ray: auto = a local cluster")
+    parser.add_argument(
+        "--robot", choices=ROBOTS, default="twin",
+        help="twin: the MuJoCo twin (default); xarm: a real xArm-7 at --ip (connects, then stops: not wired yet)",
+    )  # fmt: skip
+    parser.add_argument("--ip", default=None, metavar="ADDRESS", help="the xArm controller's address (--robot xarm)")
+    parser.add_argument(
+        "--cell", default=None, metavar="FILE", help="cell config, models/cell_config.py (--robot xarm)"
+    )
     parser.add_argument("--resume", action="store_true", help="continue the runs already in --out (same arguments)")
     parser.add_argument("--force", action="store_true", help="delete the results already in --out first")
     args = parser.parse_args(argv)
+    if args.robot == "xarm":
+        _connect_xarm(args)
+    elif args.ip is not None or args.cell is not None:
+        fail("--ip and --cell go with --robot xarm")
     # The memory is read, never written, during trials: evaluation does not change what was learned.
 
     if args.runs < 1 or args.max_actions < 1:
@@ -226,7 +262,8 @@ def main(argv: list[str] | None = None) -> int:
         memory.close()  # each run opens it where it runs
 
     out = Path(args.out)
-    not_results = ("out", "resume", "force", "workers", "ray")  # where and how it runs changes no record
+    # where and how it runs changes no record; --robot is twin here (xarm stops above), as before the flag existed
+    not_results = ("out", "resume", "force", "workers", "ray", "robot", "ip", "cell")
     experiment = {"command": "trial", **{k: v for k, v in vars(args).items() if k not in not_results}}
     if args.max_lockers == 1:  # the default leaves the configuration as it was before k existed (resumable)
         del experiment["max_lockers"]
