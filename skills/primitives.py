@@ -43,10 +43,12 @@ import collections.abc
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
+from models.cell_config import CellConfig
 from skills.door_push import DoorPushConfig, DoorPushing
 from skills.errors import ForceLimitExceeded, GraspFailure, IKFailure, SlipDetected
 from skills.joint_model import JointModel
@@ -238,6 +240,12 @@ class PrimitiveConfig:
     felt at 20 N (``blocked_force``); UFACTORY publishes no newton threshold for its collision detection
     (REALITY_NOTES.md §1), so this sits where a latched pull is already decided and far below the
     100-300 N that tore grasps off, and below the F/T range (150 N)."""
+
+    @classmethod
+    def for_cell(cls, cell: CellConfig, **overrides: Any) -> PrimitiveConfig:
+        """The primitives of a cell: its force limit and blocked threshold [N] (the rest as given, or the
+        defaults, which are the twin's)."""
+        return cls(**{"force_limit": cell.force_limit, "blocked_force": cell.blocked_force, **overrides})
 
     def __post_init__(self) -> None:
         if not 1 <= self.force_filter_samples <= self.force_filter_max_samples:

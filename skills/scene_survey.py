@@ -21,10 +21,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from models.calibration import CellCalibration
+from models.cell_config import CellConfig
 from models.reach import MIN_REACH
 from models.robot import Robot
 from skills.errors import ForceLimitExceeded, IKFailure, MarkersNotFound
@@ -69,6 +71,15 @@ class SurveyConfig:
     calibration (intrinsics 1-2 % off) the overview's depth along its line of sight is off by 5-11 mm, up to
     5.4 mm across the lid at a 24 deg view; close up the same markers are posed within 0.2 mm. It costs
     ~15 s of simulated time (~4 s of wall time) per trial. The overview still tells moved from stayed."""
+    overview_camera: str = OVERVIEW_CAMERA
+    """The cell's fixed camera over the workspace (a :class:`models.cell_config.CellConfig` names it)."""
+    wrist_camera: str = WRIST_CAMERA
+    """The cell's camera on the gripper (a :class:`models.cell_config.CellConfig` names it)."""
+
+    @classmethod
+    def for_cell(cls, cell: CellConfig, **overrides: Any) -> SurveyConfig:
+        """The survey of a cell: its cameras (the rest as given, or the defaults)."""
+        return cls(**{"overview_camera": cell.overview_camera, "wrist_camera": cell.wrist_camera, **overrides})
 
 
 class SceneSurvey:
@@ -105,14 +116,14 @@ class SceneSurvey:
         return []
 
     def overview(self) -> list[MarkerDetection]:
-        return self.look(OVERVIEW_CAMERA)
+        return self.look(self.config.overview_camera)
 
     def _wrist_from_above(self, point: np.ndarray, height: float, yaws: tuple[float, ...] = CAMERA_YAWS) -> bool:
         """Put the wrist camera ``height`` above ``point`` looking down, arriving through the toggler's
         transit waypoint high above the workspace, the camera turned (the first of ``yaws`` [rad] that works)
         so the TCP stays at least ``MIN_REACH`` from the base axis; False if the arm cannot, or if the force
         limit stopped it (it then withdraws)."""
-        T_tcp_camera = self.calibration.camera(WRIST_CAMERA).T_tcp_camera
+        T_tcp_camera = self.calibration.camera(self.config.wrist_camera).T_tcp_camera
         for yaw in yaws:
             target = top_down(np.zeros(3), yaw)
             target[:3, 3] = np.asarray(point, float) + (0.0, 0.0, height) - target[:3, :3] @ T_tcp_camera[:3, 3]
@@ -157,7 +168,7 @@ class SceneSurvey:
         )
         if not self.last_close_up_reached:
             return None
-        seen = [d for d in self.look(WRIST_CAMERA) if d.marker_id == marker]
+        seen = [d for d in self.look(self.config.wrist_camera) if d.marker_id == marker]
         return min(seen, key=lambda d: d.view_angle) if seen else None
 
     # -- the survey --------------------------------------------------------------------------------
@@ -178,7 +189,8 @@ class SceneSurvey:
             # close up: what the search found from afar, then (with the lid height those give) every
             # overview pose off the lid's plane — a marker partly hidden by its own handle post in an
             # oblique view reprojects well but is posed centimetres deep along the line of sight
-            from_afar = [m for m, d in found.items() if d.camera != OVERVIEW_CAMERA or self.config.close_up_all]
+            overview = self.config.overview_camera
+            from_afar = [m for m, d in found.items() if d.camera != overview or self.config.close_up_all]
             moved_arm |= self._refine(found, from_afar)
             moved_arm |= self._refine(found, self._off_the_lid(found))
         finally:
@@ -186,7 +198,7 @@ class SceneSurvey:
                 self.toggler.go_rest()
         missing = expected - set(found)
         if missing:
-            raise MarkersNotFound(missing, (), (OVERVIEW_CAMERA, WRIST_CAMERA))
+            raise MarkersNotFound(missing, (), (self.config.overview_camera, self.config.wrist_camera))
         return found
 
     def _refine(self, found: dict[int, MarkerDetection], markers: list[int]) -> bool:
@@ -207,7 +219,8 @@ class SceneSurvey:
         return [
             m
             for m, d in found.items()
-            if d.camera == OVERVIEW_CAMERA and abs(d.T_base_marker[2, 3] - height) > self.config.lid_tolerance
+            if d.camera == self.config.overview_camera
+            and abs(d.T_base_marker[2, 3] - height) > self.config.lid_tolerance
         ]
 
     def _search(self, found: dict[int, MarkerDetection], missing: set[int]) -> list[MarkerDetection]:
@@ -221,18 +234,17 @@ class SceneSurvey:
         for point in points:
             if not self._wrist_from_above(point, c.search_height):
                 continue
-            for d in self.look(WRIST_CAMERA):
+            for d in self.look(self.config.wrist_camera):
                 if d.marker_id in missing and (d.marker_id not in seen or d.view_angle < seen[d.marker_id].view_angle):
                     seen[d.marker_id] = d
             if missing <= set(seen):
                 break
         return list(seen.values())
 
-    @staticmethod
-    def _unique(detections: list[MarkerDetection], expected: set[int]) -> dict[int, MarkerDetection]:
+    def _unique(self, detections: list[MarkerDetection], expected: set[int]) -> dict[int, MarkerDetection]:
         """Expected ids seen exactly once (an id seen twice in one image is ambiguous: dropped)."""
         try:
-            return select_markers(detections, expected, (OVERVIEW_CAMERA,))
+            return select_markers(detections, expected, (self.config.overview_camera,))
         except MarkersNotFound as err:
             ambiguous = set(err.duplicated)
             return {d.marker_id: d for d in detections if d.marker_id in expected and d.marker_id not in ambiguous}
