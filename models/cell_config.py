@@ -31,6 +31,25 @@ from models.atomic import write_text_atomically
 from models.errors import ModelsError
 
 CELL_CONFIG_FORMAT = "puzzlebox-cell/1"
+EXAMPLE: dict = {
+    "format": CELL_CONFIG_FORMAT,
+    "name": "lab-a",
+    "camera_names": ["overview", "wrist"],
+    "overview_camera": "overview",
+    "wrist_camera": "wrist",
+    "camera_devices": {"overview": 0, "wrist": "/dev/video2"},
+    "aruco_dictionary": "DICT_4X4_250",
+    "marker_size": 0.036,
+    "force_limit": 60.0,
+    "blocked_force": 20.0,
+    "gripper_open": 850.0,
+    "gripper_closed": 0.0,
+    "rest_posture": [-1.5708, -0.247, 0.0, 0.909, 0.0, 1.156, 0.0],
+    "workspace_min": [-0.62, -0.62, 0.0],
+    "workspace_max": [0.62, 0.62, 0.58],
+    "ft_rate_hz": 100.0,
+}
+"""The module docstring's example file, as data: a start for a real cell's own (``CellConfig.from_dict``)."""
 
 
 class CellConfigError(ModelsError):

@@ -3,26 +3,8 @@
 Importing this package imports no SDK: :class:`XArmRobot` imports ``xarm-python-sdk`` when it is constructed.
 """
 
-from real.errors import (
-    ArmUnreachable,
-    CommandRefused,
-    ForceLimitExceeded,
-    RealError,
-    SDKCallFailed,
-    SDKMissing,
-    UnknownCamera,
-)
+from real import errors
+from real.errors import *  # noqa: F403 - the typed errors, listed in real.errors.__all__
 from real.xarm_driver import XARM_CONTROL_PORT, XArmRobot, probe_controller
 
-__all__ = [
-    "XARM_CONTROL_PORT",
-    "ArmUnreachable",
-    "CommandRefused",
-    "ForceLimitExceeded",
-    "RealError",
-    "SDKCallFailed",
-    "SDKMissing",
-    "UnknownCamera",
-    "XArmRobot",
-    "probe_controller",
-]
+__all__ = [*errors.__all__, "XARM_CONTROL_PORT", "XArmRobot", "probe_controller"]

@@ -43,6 +43,21 @@ def spec_dict() -> dict[str, Any]:
 
 
 @pytest.fixture
+def scene_dict() -> dict[str, Any]:
+    """A minimal valid disassembly scene (no box, 6-DOF poses): one screw holding a side panel."""
+    return {
+        "format": "puzzlebox-spec/1",
+        "name": "one-screw",
+        "components": [
+            {"name": "s1", "kind": "screw", "pose": [0.0, 0.0, 0.0, 0, 0, 0]},
+            {"name": "panel", "kind": "panel", "pose": [-0.23, 0.02, -0.2, 0, 0, 1.5708]},
+        ],
+        "locks": [{"locker": "s1", "locker_state": 0, "locked": "panel", "locked_state": 0}],
+        "goal": {"component": "panel", "state": 1},
+    }
+
+
+@pytest.fixture
 def write_spec(tmp_path: Path):
     """Write a dict (or raw text) to a file in tmp_path and return its path."""
 

@@ -4,26 +4,9 @@ import json
 
 import pytest
 
-from models.cell_config import CELL_CONFIG_FORMAT, CellConfig, CellConfigError, load_cell_config, save_cell_config
+from models.cell_config import EXAMPLE, CellConfig, CellConfigError, load_cell_config, save_cell_config
 
-GOOD = {
-    "format": CELL_CONFIG_FORMAT,
-    "name": "lab-a",
-    "camera_names": ["overview", "wrist"],
-    "overview_camera": "overview",
-    "wrist_camera": "wrist",
-    "camera_devices": {"overview": 0, "wrist": "/dev/video2"},
-    "aruco_dictionary": "DICT_4X4_250",
-    "marker_size": 0.036,
-    "force_limit": 60.0,
-    "blocked_force": 20.0,
-    "gripper_open": 850.0,
-    "gripper_closed": 0.0,
-    "rest_posture": [-1.5708, -0.247, 0.0, 0.909, 0.0, 1.156, 0.0],
-    "workspace_min": [-0.62, -0.62, 0.0],
-    "workspace_max": [0.62, 0.62, 0.58],
-    "ft_rate_hz": 100.0,
-}
+GOOD = EXAMPLE
 
 
 def test_config_round_trips_through_its_file(tmp_path):

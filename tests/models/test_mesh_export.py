@@ -136,16 +136,7 @@ def test_parts_are_in_the_lid_frame_wherever_the_box_stands():
         assert np.allclose(a[name].bounds, b[name].bounds, atol=1e-9), name
 
 
-def test_a_disassembly_scene_is_refused():
-    scene = {
-        "format": "puzzlebox-spec/1",
-        "name": "one-screw",
-        "components": [
-            {"name": "s1", "kind": "screw", "pose": [0.0, 0.0, 0.0, 0, 0, 0]},
-            {"name": "panel", "kind": "panel", "pose": [-0.23, 0.02, -0.2, 0, 0, 1.5708]},
-        ],
-        "locks": [{"locker": "s1", "locker_state": 0, "locked": "panel", "locked_state": 0}],
-        "goal": {"component": "panel", "state": 1},
-    }
+def test_a_disassembly_scene_is_refused(scene_dict):
+    scene = scene_dict
     with pytest.raises(MeshExportError, match="no box"):
         component_meshes(spec_from_dict(scene))

@@ -9,31 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from models.cell_config import CELL_CONFIG_FORMAT, CellConfig, save_cell_config
+from models.cell_config import EXAMPLE, CellConfig, save_cell_config
 from models.robot import Robot
 from real import ArmUnreachable, CommandRefused, ForceLimitExceeded, SDKMissing, UnknownCamera, XArmRobot, xarm_driver
 
 ROOT = Path(__file__).resolve().parents[2]
-CELL = CellConfig.from_dict(
-    {
-        "format": CELL_CONFIG_FORMAT,
-        "name": "test-cell",
-        "camera_names": ["overview", "wrist"],
-        "overview_camera": "overview",
-        "wrist_camera": "wrist",
-        "camera_devices": {"overview": 0, "wrist": 1},
-        "aruco_dictionary": "DICT_4X4_250",
-        "marker_size": 0.036,
-        "force_limit": 60.0,
-        "blocked_force": 20.0,
-        "gripper_open": 850.0,
-        "gripper_closed": 0.0,
-        "rest_posture": [-1.5708, -0.247, 0.0, 0.909, 0.0, 1.156, 0.0],
-        "workspace_min": [-0.62, -0.62, 0.0],
-        "workspace_max": [0.62, 0.62, 0.58],
-        "ft_rate_hz": 100.0,
-    }
-)
+CELL = CellConfig.from_dict({**EXAMPLE, "name": "test-cell", "camera_devices": {"overview": 0, "wrist": 1}})
 
 
 class FakeSDK:
