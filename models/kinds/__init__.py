@@ -1,0 +1,84 @@
+"""Component kinds of the puzzle box: one module per kind, a registry, and the paper's family.
+
+- :mod:`models.kinds.template`: :class:`KindTemplate` (joint, travel, handle, footprint in the component
+  frame) and the dimensions every kind shares (marker, handle).
+- :mod:`models.kinds.door`, :mod:`~models.kinds.slide`, :mod:`~models.kinds.wheel`: each kind's frame,
+  dimensions, template, joint dynamics, colour and MJCF parts.
+- :mod:`models.kinds.registry`: the kinds ``models`` can build, by name.
+- :mod:`models.kinds.family`: :data:`PAPER_FAMILY`, the paper's kinds, codes and allowed neighbours,
+  pinned so that registering a kind never changes the paper's boxes.
+
+Dimensions are chosen for the xArm-7's gripper and for markers an overview camera reads reliably;
+travels follow the motions measured on this stack in DESIGN.md (door 85 deg, slide 50 mm, wheel 85 deg).
+"""
+
+from __future__ import annotations
+
+from models.errors import UnknownKindError
+from models.kinds.door import DOOR, DOOR_HALF
+from models.kinds.family import PAPER_FAMILY, KindFamily
+from models.kinds.kind import JointDynamics, Kind
+from models.kinds.registry import (
+    DuplicateKindError,
+    KindRegistry,
+    get_kind,
+    register,
+    registered_kind,
+    registered_kinds,
+)
+from models.kinds.slide import SLIDE, SLIDE_BACK, SLIDE_HALF
+from models.kinds.template import HANDLE_HEIGHT, HANDLE_MARGIN, HANDLE_OFFSET, HANDLE_SIZE, MARKER_SIZE, KindTemplate
+from models.kinds.wheel import WHEEL, WHEEL_RADIUS
+
+PUZZLE_KINDS: dict[str, KindTemplate] = {k.name: k for k in (DOOR, SLIDE, WHEEL)}
+"""The paper family's kinds, by name (pinned: a newly registered kind is not a paper kind)."""
+
+KIND_NAMES: tuple[str, ...] = PAPER_FAMILY.kinds
+"""The paper family's kinds in a fixed order: the integer code of a kind is its index here."""
+
+ALLOWED_NEIGHBOURS: frozenset[frozenset[str]] = PAPER_FAMILY.neighbours
+"""Kind pairs that may lock each other (the paper: doors and wheels never interact, nor do two
+components of the same kind)."""
+
+
+def kind_code(name: str) -> int:
+    """Integer code of a kind (its index in :data:`KIND_NAMES`)."""
+    return PAPER_FAMILY.code(name)
+
+
+def may_neighbour(kind_a: str, kind_b: str) -> bool:
+    """Whether components of these two kinds may lock each other (in the paper's family)."""
+    return PAPER_FAMILY.may_neighbour(kind_a, kind_b)
+
+
+__all__ = [
+    "ALLOWED_NEIGHBOURS",
+    "DOOR",
+    "DOOR_HALF",
+    "HANDLE_HEIGHT",
+    "HANDLE_MARGIN",
+    "HANDLE_OFFSET",
+    "HANDLE_SIZE",
+    "KIND_NAMES",
+    "MARKER_SIZE",
+    "PAPER_FAMILY",
+    "PUZZLE_KINDS",
+    "SLIDE",
+    "SLIDE_BACK",
+    "SLIDE_HALF",
+    "WHEEL",
+    "WHEEL_RADIUS",
+    "DuplicateKindError",
+    "JointDynamics",
+    "Kind",
+    "KindFamily",
+    "KindRegistry",
+    "KindTemplate",
+    "UnknownKindError",
+    "get_kind",
+    "kind_code",
+    "may_neighbour",
+    "register",
+    "registered_kind",
+    "registered_kinds",
+]

@@ -1,0 +1,60 @@
+"""The geometry template of a component kind, and the dimensions every kind shares.
+
+Every component has a *component frame*: its pose ``[x, y, yaw]`` in a spec is this frame in the lid
+frame (origin at the lid centre on its top face, x along the lid length, z up). For every kind the
+component frame is where the component's ArUco marker centre sits in state 0 (closed), with z up and
+x along the component's direction of motion, so that a marker seen by a camera gives the component
+pose directly. Each kind's module (:mod:`models.kinds.door`, ``slide``, ``wheel``) describes its frame.
+
+Every marker is ``MARKER_SIZE`` wide (black square) inside a one-bit white quiet zone; every handle
+is a 12 mm square post ``HANDLE_HEIGHT`` tall, clear of the quiet zone, so the overview camera reads
+every marker and the gripper closes on every handle (DESIGN.md: 12 mm square handles at least 3 cm
+above the surface were grasped in every randomized run).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from models.geometry import transform_points
+
+MARKER_SIZE = 0.036
+"""Side of every component's ArUco marker (black square) [m]: ~38 px from the overview camera."""
+HANDLE_SIZE = 0.012
+"""Side of the square handle posts [m]."""
+HANDLE_HEIGHT = 0.035
+"""Height of the handle posts above the component's top face [m]."""
+HANDLE_MARGIN = 0.011
+"""Extra flap/plate length beyond the half-width that carries the handle clear of the marker [m]."""
+HANDLE_OFFSET = 0.035
+"""Distance of the handle centre from the marker centre along the component's x [m]: clear of the
+marker's quiet zone (MARKER_SIZE / 2 * 4 / 3 = 24 mm) by 5 mm."""
+
+
+@dataclass(frozen=True)
+class KindTemplate:
+    """What the project knows about a component kind: its joint, travel and footprint on the lid."""
+
+    name: str
+    """Kind name as written in specs."""
+    joint: Literal["hinge", "slide"]
+    """Joint type: ``hinge`` (revolute) or ``slide`` (prismatic)."""
+    joint_axis: tuple[float, float, float]
+    """Joint axis in the component frame (unit vector)."""
+    joint_origin: tuple[float, float, float]
+    """A point on the joint axis in the component frame [m]."""
+    travel: float
+    """Joint travel from state 0 to state 1 [rad for hinges, m for slides]."""
+    marker_size: float
+    """Side of the ArUco marker's black square [m]."""
+    handle_xy: tuple[float, float]
+    """Centre of the handle post in the component frame, state 0 [m]."""
+    footprint: np.ndarray = field(repr=False, compare=False)
+    """Convex polygon ``(n, 2)`` [m] in the component frame that the component occupies on the lid."""
+
+    def footprint_in_lid(self, pose: tuple[float, float, float]) -> np.ndarray:
+        """The footprint polygon in the lid frame for a component at ``pose`` ``[x, y, yaw]``."""
+        return transform_points(pose, self.footprint)
