@@ -12,8 +12,7 @@ import numpy as np  # noqa: E402
 from matplotlib.patches import FancyArrowPatch, Polygon, Rectangle  # noqa: E402
 
 from models import PuzzleSpec, get_kind  # noqa: E402
-
-KIND_COLOURS = {"door": "#4C72B0", "slide": "#DD8452", "wheel": "#55A868"}
+from models.kinds import registered_kind  # noqa: E402
 
 
 def plot_spec(spec: PuzzleSpec, path: Path) -> Path:
@@ -29,7 +28,7 @@ def plot_spec(spec: PuzzleSpec, path: Path) -> Path:
         polygon = template.footprint_in_lid(c.pose)
         goal = c.name == spec.goal.component
         ax.add_patch(
-            Polygon(polygon, closed=True, alpha=0.35, color=KIND_COLOURS.get(c.kind, "0.6"), lw=2.5 if goal else 1)
+            Polygon(polygon, closed=True, alpha=0.35, color=registered_kind(c.kind).glyph, lw=2.5 if goal else 1)
         )
         x, y, yaw = c.pose[:3]
         centres[c.name] = np.array([x, y])

@@ -13,11 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from models.kinds import registered_kind
 from twin.session import TwinSession
-
-# Largest ghost-hand effort per kind: enough to beat friction and lift a door, far below what
-# would tear a latch (DESIGN.md: latches held against 100-245 N of robot pull).
-MAX_EFFORT = {"door": 0.3, "slide": 3.0, "wheel": 0.3}  # [N·m or N]
 
 
 @dataclass(frozen=True)
@@ -48,7 +45,7 @@ def sweep_open(
     goal = spec.index_of(spec.goal.component)
     dofs = np.array([session.model.jnt_dofadr[session.model.joint(session.scene.names.components[c.name].joint).id]
                      for c in spec.components])  # fmt: skip
-    efforts = np.array([MAX_EFFORT[c.kind] for c in spec.components])
+    efforts = np.array([registered_kind(c.kind).sweep_effort for c in spec.components])  # the kind's own [N·m or N]
     steps_per_frame = max(1, round(frame_period / session.timestep))
     done: list[SweepStep] = []
     progress = True

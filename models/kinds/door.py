@@ -57,5 +57,5 @@ def build(body: mjcf.Element, name: str) -> mjcf.Element:
     return add_joint(body, name, DOOR, DYNAMICS)
 
 
-KIND = Kind(template=DOOR, dynamics=DYNAMICS, colour=COLOUR, build=build)
+KIND = Kind(template=DOOR, dynamics=DYNAMICS, colour=COLOUR, build=build, glyph="#4C72B0", sweep_effort=0.3)
 """The door, as registered (:mod:`models.kinds.registry`)."""

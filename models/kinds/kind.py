@@ -42,6 +42,11 @@ class Kind:
     """RGBA [0-1] of the kind's plate or disc."""
     build: PartBuilder
     """Adds the kind's MJCF parts to a component body; see :data:`PartBuilder`."""
+    glyph: str
+    """Matplotlib colour of the kind in plots (a spec's top view)."""
+    sweep_effort: float
+    """Largest effort the twin's ghost-hand sweep applies to open it [N·m or N]: enough to beat friction and
+    lift a door, far below what would tear a latch (DESIGN.md: latches held against 100-245 N of robot pull)."""
 
     @property
     def name(self) -> str:

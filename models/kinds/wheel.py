@@ -52,5 +52,5 @@ def build(body: mjcf.Element, name: str) -> mjcf.Element:
     return add_joint(body, name, WHEEL, DYNAMICS)
 
 
-KIND = Kind(template=WHEEL, dynamics=DYNAMICS, colour=COLOUR, build=build)
+KIND = Kind(template=WHEEL, dynamics=DYNAMICS, colour=COLOUR, build=build, glyph="#55A868", sweep_effort=0.3)
 """The wheel, as registered (:mod:`models.kinds.registry`)."""

@@ -49,7 +49,14 @@ def _build_lever(body, name):
     return add_joint(body, name, LEVER, LEVER_DYNAMICS)
 
 
-LEVER_KIND = Kind(template=LEVER, dynamics=LEVER_DYNAMICS, colour=(0.5, 0.5, 0.5, 1), build=_build_lever)
+LEVER_KIND = Kind(
+    template=LEVER,
+    dynamics=LEVER_DYNAMICS,
+    colour=(0.5, 0.5, 0.5, 1),
+    build=_build_lever,
+    glyph="0.5",
+    sweep_effort=1.0,
+)
 """A throwaway kind that exists only in these tests."""
 
 
