@@ -36,6 +36,28 @@ SPEC_EXAMPLE: dict[str, Any] = {
 }
 
 
+SCENE_EXAMPLE: dict[str, Any] = {
+    "format": "puzzlebox-spec/1",
+    "name": "small-computer",
+    "components": [
+        {"name": "s1", "kind": "screw", "pose": [0.0, 0.0, 0.0, 0, 0, 0]},
+        {"name": "s2", "kind": "screw", "pose": [0.0, 0.0, -0.37, 0, 0, 0]},
+        {"name": "panel", "kind": "panel", "pose": [-0.23, 0.02, -0.2, 0, 0, 1.5708]},
+        {"name": "ram", "kind": "ram", "pose": [-0.17, -0.14, -0.07, 0, 0, 1.5708]},
+        {"name": "board", "kind": "motherboard", "pose": [-0.12, -0.15, -0.1, 0, 0, 1.5708]},
+    ],
+    "locks": [
+        {"locker": "s1", "locker_state": 0, "locked": "panel", "locked_state": 0},
+        {"locker": "s2", "locker_state": 0, "locked": "panel", "locked_state": 0},
+        {"locker": "panel", "locker_state": 0, "locked": "ram", "locked_state": 0},
+        {"locker": "ram", "locker_state": 0, "locked": "board", "locked_state": 0},
+    ],
+    "goal": {"component": "board", "state": 1},
+}
+"""A small disassembly scene (no box, 6-DOF poses): two screws hold the panel, the panel the RAM, the RAM the
+board."""
+
+
 @pytest.fixture
 def spec_dict() -> dict[str, Any]:
     """A fresh deep copy of the SPEC.md example (valid)."""
@@ -44,17 +66,8 @@ def spec_dict() -> dict[str, Any]:
 
 @pytest.fixture
 def scene_dict() -> dict[str, Any]:
-    """A minimal valid disassembly scene (no box, 6-DOF poses): one screw holding a side panel."""
-    return {
-        "format": "puzzlebox-spec/1",
-        "name": "one-screw",
-        "components": [
-            {"name": "s1", "kind": "screw", "pose": [0.0, 0.0, 0.0, 0, 0, 0]},
-            {"name": "panel", "kind": "panel", "pose": [-0.23, 0.02, -0.2, 0, 0, 1.5708]},
-        ],
-        "locks": [{"locker": "s1", "locker_state": 0, "locked": "panel", "locked_state": 0}],
-        "goal": {"component": "panel", "state": 1},
-    }
+    """A fresh deep copy of :data:`SCENE_EXAMPLE` (a valid disassembly scene)."""
+    return copy.deepcopy(SCENE_EXAMPLE)
 
 
 @pytest.fixture

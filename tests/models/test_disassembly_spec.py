@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import SPEC_EXAMPLE
+from conftest import SCENE_EXAMPLE, SPEC_EXAMPLE
 
 from models import LockTable, SpecError, load_spec, spec_from_dict, validate_data
 from models.disassembly_kinds import (
@@ -30,24 +30,7 @@ needs_data = pytest.mark.skipif(not DATA.is_dir(), reason=f"{DATA} (the shared d
 
 def _scene() -> dict[str, Any]:
     """A small disassembly scene: two screws hold the panel, the panel holds the RAM, which holds the board."""
-    return {
-        "format": "puzzlebox-spec/1",
-        "name": "small-computer",
-        "components": [
-            {"name": "s1", "kind": "screw", "pose": [0.0, 0.0, 0.0, 0, 0, 0]},
-            {"name": "s2", "kind": "screw", "pose": [0.0, 0.0, -0.37, 0, 0, 0]},
-            {"name": "panel", "kind": "panel", "pose": [-0.23, 0.02, -0.2, 0, 0, 1.5708]},
-            {"name": "ram", "kind": "ram", "pose": [-0.17, -0.14, -0.07, 0, 0, 1.5708]},
-            {"name": "board", "kind": "motherboard", "pose": [-0.12, -0.15, -0.1, 0, 0, 1.5708]},
-        ],
-        "locks": [
-            {"locker": "s1", "locker_state": 0, "locked": "panel", "locked_state": 0},
-            {"locker": "s2", "locker_state": 0, "locked": "panel", "locked_state": 0},
-            {"locker": "panel", "locker_state": 0, "locked": "ram", "locked_state": 0},
-            {"locker": "ram", "locker_state": 0, "locked": "board", "locked_state": 0},
-        ],
-        "goal": {"component": "board", "state": 1},
-    }
+    return copy.deepcopy(SCENE_EXAMPLE)
 
 
 def _problems(data: Any) -> list[str]:
@@ -62,7 +45,7 @@ def test_both_lab_computers_load_and_validate(file):
     spec = load_spec(DATA / file)
     assert spec.family == "disassembly" and spec.box is None
     assert all(len(c.pose) == 6 for c in spec.components)
-    assert LockTable.from_spec(spec).shortest_solution() is not None
+    assert len(LockTable.from_spec(spec).shortest_solution()) == 8  # every part out, once each
     assert spec.poses_in_world().shape == (len(spec.components), 6)
 
 

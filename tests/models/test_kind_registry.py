@@ -2,6 +2,7 @@
 and boxes untouched, and every registered kind's template agrees with the MJCF its module builds."""
 
 import math
+from dataclasses import replace
 
 import mujoco
 import numpy as np
@@ -14,11 +15,11 @@ from models.kinds import (
     ALLOWED_NEIGHBOURS,
     KIND_NAMES,
     PAPER_FAMILY,
+    SLIDE,
     DuplicateKindError,
     JointDynamics,
     Kind,
     KindRegistry,
-    KindTemplate,
     get_kind,
     kind_code,
     may_neighbour,
@@ -27,16 +28,14 @@ from models.kinds import (
     registry,
 )
 from models.kinds.parts import PLATE_THICKNESS, add_handle, add_joint, add_plate
-from models.kinds.template import HANDLE_HEIGHT, MARKER_SIZE
+from models.kinds.template import HANDLE_HEIGHT
 from models.puzzle_box import build_puzzle_box
 
-LEVER = KindTemplate(
+LEVER = replace(  # a slide along y with its own travel, handle and footprint
+    SLIDE,
     name="lever",
-    joint="slide",
     joint_axis=(0.0, 1.0, 0.0),
-    joint_origin=(0.0, 0.0, 0.0),
     travel=0.03,
-    marker_size=MARKER_SIZE,
     handle_xy=(0.0, -0.035),
     footprint=rectangle(-0.03, 0.03, -0.05, 0.06),
 )
