@@ -30,7 +30,7 @@ from _run_store import Periodic
 from _trial_task import trial_task
 from trial import twin_figures
 
-from learning import LearningError, MemoryAgent, SymbolicWorld, run_episode, summarise
+from learning import MemoryAgent, SymbolicWorld, run_episode, summarise
 from learning.memory import MemoryStore
 from learning.runner import RecordStore, RunReport, Task, make_executor, run_tasks
 from models.calibration import CellCalibration
@@ -164,11 +164,7 @@ def calibration_task(settings: dict[str, Any]) -> dict[str, Any]:
 
 
 def _raise_failures(report: RunReport) -> None:
-    if report.failures:
-        key, error = next(iter(report.failures.items()))
-        raise LearningError(f"{len(report.failures)} task(s) failed, the others kept; {key}: {error.splitlines()[0]}")
-    if report.stopped:
-        raise LearningError(f"interrupted: {len(report.records)} finished task(s) kept; run the same command again")
+    report.raise_for_failures()
 
 
 def _figures(runs: list[dict[str, Any]], max_actions: int, calibration: dict[str, Any]) -> dict[str, Any]:

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from learning.agent_names import DEEP_AGENT_NAMES
-from learning.errors import ConfigError, LearningError
+from learning.errors import ConfigError
 from learning.experiments.protocol import (
     ProtocolConfig,
     Score,
@@ -221,11 +221,7 @@ def run_jobs(
         report = run_tasks(
             tasks, RecordStore(Path(out_dir) / "jobs"), executor, desc=f"deep agents ({len(tasks)} jobs)"
         )
-    if report.failures:
-        key, error = next(iter(report.failures.items()))
-        raise LearningError(f"{len(report.failures)} deep job(s) failed; {key}: {error.splitlines()[0]}")
-    if report.stopped:
-        raise LearningError(f"interrupted: {len(report.records)} of {len(tasks)} deep jobs kept in {out_dir}/jobs")
+    report.raise_for_failures("deep job")
     summary = {
         "jobs": len(tasks),
         "reused": len(report.reused),

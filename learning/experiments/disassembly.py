@@ -32,7 +32,7 @@ import numpy as np
 from learning.agents.dual_agent import DualAgent, MemoryAgent
 from learning.belief import BeliefConfig
 from learning.dual_controller import DualControllerConfig
-from learning.errors import ConfigError, LearningError
+from learning.errors import ConfigError
 from learning.memory.store import MemoryStore
 from learning.runner import RecordStore, Task, make_executor, run_tasks
 from learning.symbolic_world import SymbolicWorld
@@ -231,11 +231,7 @@ def run_disassembly(out: Path, agents: Sequence[str], config: DisassemblyConfig,
     tasks = tasks_for(agents, config)
     with make_executor(workers, ray) as executor:
         report = run_tasks(tasks, RecordStore(out / "records"), executor, desc="disassembly")
-    if report.failures:
-        key, error = next(iter(report.failures.items()))
-        raise LearningError(f"{len(report.failures)} task(s) failed, the others kept; {key}: {error.splitlines()[0]}")
-    if report.stopped:
-        raise LearningError(f"interrupted: {len(report.records)} finished task(s) kept; run the same command again")
+    report.raise_for_failures()
     train, tests = scenes(config)
     summary = summarise(report.records, config, tests)
     summary.update({"wall_time_s": time.perf_counter() - start, "config": asdict(config), "agents": list(agents),

@@ -10,6 +10,7 @@ from typing import Any
 
 from tqdm import tqdm
 
+from learning.errors import LearningError
 from learning.runner.errors import RunnerError
 from learning.runner.executors import Executor
 from learning.runner.records import RecordStore
@@ -37,6 +38,16 @@ class RunReport:
     stopped: bool = False
     wall_time_s: float = 0.0
     planned: int = 0
+
+    def raise_for_failures(self, what: str = "task") -> None:
+        """Raise :class:`~learning.errors.LearningError` (one line: how many ``what``s failed, the first one's key
+        and error) if a task failed, or if a stop left tasks undone; the finished records are kept either way."""
+        if self.failures:
+            key, error = next(iter(self.failures.items()))
+            first = error.splitlines()[0]
+            raise LearningError(f"{len(self.failures)} {what}(s) failed, the others kept; {key}: {first}")
+        if self.stopped:
+            raise LearningError(f"interrupted: {len(self.records)} finished {what}(s) kept; run the same command again")
 
     @property
     def missing(self) -> int:

@@ -9,7 +9,17 @@ import threading
 import pytest
 import runner_tasks
 
-from learning.runner import InlineExecutor, PoolExecutor, RayExecutor, RecordStore, RunnerError, Task, run_tasks
+from learning.errors import LearningError
+from learning.runner import (
+    InlineExecutor,
+    PoolExecutor,
+    RayExecutor,
+    RecordStore,
+    RunnerError,
+    RunReport,
+    Task,
+    run_tasks,
+)
 
 
 def _tasks(n, function=runner_tasks.draws, **extra):
@@ -91,6 +101,16 @@ def test_a_task_that_always_kills_its_worker_fails_alone(tmp_path):
         report = run_tasks(tasks, RecordStore(tmp_path / "runs"), executor)
     assert set(report.records) == {f"seed{s}" for s in range(5)}, "tasks that shared the pool with it are kept"
     assert list(report.failures) == ["killer"] and report.failures["killer"].startswith("WorkerDied")
+    with pytest.raises(LearningError, match="^1 task\\(s\\) failed, the others kept; killer: WorkerDied"):
+        report.raise_for_failures()
+
+
+def test_a_complete_report_raises_nothing_and_a_stopped_one_says_what_it_kept():
+    done = RunReport(records={"a": {}}, planned=1)
+    done.raise_for_failures()
+    stopped = RunReport(records={"a": {}}, planned=3, stopped=True)
+    with pytest.raises(LearningError, match="interrupted: 1 finished deep job\\(s\\) kept"):
+        stopped.raise_for_failures("deep job")
 
 
 def test_a_stop_request_keeps_what_finished_and_a_rerun_completes_it(tmp_path):
