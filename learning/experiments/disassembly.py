@@ -194,12 +194,14 @@ def curve_name(agent: str, max_lockers: int) -> str:
     return agent if max_lockers == 1 else f"{agent}-k{max_lockers}"
 
 
-def tasks_for(agents: Sequence[str], config: DisassemblyConfig) -> list[Task]:
-    """Every (curve, training seed) task of the experiment."""
+def tasks_for(
+    agents: Sequence[str], config: DisassemblyConfig, scenes_: tuple[PuzzleSpec, list[PuzzleSpec]] | None = None
+) -> list[Task]:
+    """Every (curve, training seed) task of the experiment (``scenes_``: :func:`scenes` of ``config``, if made)."""
     unknown = [a for a in agents if a not in AGENTS]
     if unknown or not agents:
         raise ConfigError(f"unknown disassembly agents {unknown or list(agents)}; available: {list(AGENTS)}")
-    train, tests = scenes(config)
+    train, tests = scenes_ or scenes(config)
     # each task's settings are what it reads, so a change to one agent's settings reruns that agent only
     common = {"train": train.to_dict(), "tests": [t.to_dict() for t in tests], "max_actions": config.max_actions}
     symbolic = {
@@ -228,11 +230,11 @@ def run_disassembly(out: Path, agents: Sequence[str], config: DisassemblyConfig,
                     ray: str | None = None) -> dict[str, Any]:  # fmt: skip
     """Run (or resume) the experiment into ``out``; returns the summary (also ``out/disassembly.json``)."""
     start = time.perf_counter()
-    tasks = tasks_for(agents, config)
+    train, tests = scenes(config)
+    tasks = tasks_for(agents, config, (train, tests))
     with make_executor(workers, ray) as executor:
         report = run_tasks(tasks, RecordStore(out / "records"), executor, desc="disassembly")
     report.raise_for_failures()
-    train, tests = scenes(config)
     summary = summarise(report.records, config, tests)
     summary.update({"wall_time_s": time.perf_counter() - start, "config": asdict(config), "agents": list(agents),
                     "tasks": {"computed": len(report.computed), "reused": len(report.reused)}})  # fmt: skip

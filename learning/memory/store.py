@@ -267,10 +267,6 @@ class MemoryStore:
         return self._schema
 
     def migrate(self) -> None:
-        """Bring an older file to the current schema in place (see :meth:`_upgrade`); nothing for a current one."""
-        self._upgrade()
-
-    def _upgrade(self) -> None:
         """Bring an older file to the current schema (once, whichever trainer gets there first, in one
         transaction): add the training log (schema 1), the provenance columns (schemas 1 and 2), and rewrite
         every compact pair key as its SE(3) key (schemas 1 to 3)."""
@@ -304,7 +300,7 @@ class MemoryStore:
         or None for a memory kept in RAM only."""
         if self._conn is None:
             return None
-        self._upgrade()
+        self.migrate()
         with self._conn:
             cursor = self._conn.execute(
                 "INSERT INTO training_runs (started, config) VALUES (?, ?)",
@@ -386,7 +382,7 @@ class MemoryStore:
         ]
         singles = [(kinds[j], independence[j].astype(np.float64)) for j in range(n)]
         if self._conn is not None:
-            self._upgrade()
+            self.migrate()
             with self._conn:  # one transaction: the episode (log row included) is stored whole or not at all
                 cursor = self._conn.execute(
                     "INSERT INTO episodes (spec, solved, num_actions, created, seed, training_run, source, profile, "
