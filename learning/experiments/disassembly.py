@@ -33,6 +33,7 @@ from learning.agents.dual_agent import DualAgent, MemoryAgent
 from learning.belief import BeliefConfig
 from learning.dual_controller import DualControllerConfig
 from learning.errors import ConfigError
+from learning.experiments.scene_evaluation import TEST_SEED, evaluate_on_scenes
 from learning.memory.store import MemoryStore
 from learning.runner import RecordStore, Task, make_executor, run_tasks
 from learning.symbolic_world import SymbolicWorld
@@ -51,8 +52,6 @@ PAPER = {
     "100 % at ~150 episodes)",
 }
 """The paper's disassembly numbers (PAPER_NOTES.md)."""
-TEST_SEED = 500
-"""World seed of test run 0 (run r: ``TEST_SEED + r``), the same for every agent and point."""
 
 
 @dataclass(frozen=True)
@@ -137,29 +136,13 @@ def _controller(max_lockers: int, entropy_scale: float = 4.0) -> DualControllerC
     return DualControllerConfig(belief=BeliefConfig(), max_lockers=max_lockers, entropy_scale=entropy_scale)
 
 
-def _evaluate(make: Any, tests: Sequence[PuzzleSpec], runs: int, max_actions: int) -> dict[str, Any]:
-    """One point: ``runs`` runs on every test scene with agents from ``make()``."""
-    per_test: dict[str, dict[str, float]] = {}
-    solved_all, actions_all = [], []
-    for spec in tests:
-        solved, actions = [], []
-        for r in range(runs):
-            result = run_episode(make(), SymbolicWorld(spec, TEST_SEED + r), spec.name, TEST_SEED + r, max_actions)
-            solved.append(bool(result.solved))
-            actions.append(result.num_actions if result.solved else max_actions)
-        per_test[spec.name] = {"solved": float(np.mean(solved)), "mean_actions": float(np.mean(actions))}
-        solved_all += solved
-        actions_all += actions
-    return {"solved": float(np.mean(solved_all)), "mean_actions": float(np.mean(actions_all)), "per_test": per_test}
-
-
 def symbolic_task(settings: dict[str, Any]) -> dict[str, Any]:
     """One (memory or dual agent, training seed): its points (see the module docstring)."""
     train, tests = spec_from_dict(settings["train"]), [spec_from_dict(t) for t in settings["tests"]]
     seed, k, agent, runs, budget = (settings[name] for name in ("seed", "max_lockers", "agent", "runs", "max_actions"))
     start = time.perf_counter()
     if agent == "dual":
-        point = _evaluate(lambda: DualAgent(_controller(k)), tests, runs, budget)
+        point = evaluate_on_scenes(lambda: DualAgent(_controller(k)), tests, runs, budget)
         return {"points": [{"episodes": e, **point} for e in settings["episodes"]],
                 "wall_time_s": time.perf_counter() - start}  # fmt: skip
     store, trained, points = MemoryStore(position_scale=settings["position_scale"]), [], []
@@ -172,7 +155,7 @@ def symbolic_task(settings: dict[str, Any]) -> dict[str, Any]:
             result = run_episode(learner, SymbolicWorld(train, world_seed), train.name, world_seed,
                                  settings["train_max_actions"])  # fmt: skip
             trained.append({"solved": bool(result.solved), "num_actions": result.num_actions})
-        point = _evaluate(lambda: MemoryAgent(store, config=tested), tests, runs, budget)
+        point = evaluate_on_scenes(lambda: MemoryAgent(store, config=tested), tests, runs, budget)
         points.append({"episodes": episodes, **point})
     return {"points": points, "training": trained, "wall_time_s": time.perf_counter() - start}
 
@@ -203,7 +186,8 @@ def tasks_for(
         raise ConfigError(f"unknown disassembly agents {unknown or list(agents)}; available: {list(AGENTS)}")
     train, tests = scenes_ or scenes(config)
     # each task's settings are what it reads, so a change to one agent's settings reruns that agent only
-    common = {"train": train.to_dict(), "tests": [t.to_dict() for t in tests], "max_actions": config.max_actions}
+    common = {"train": train.to_dict(), "tests": [t.to_dict() for t in tests], "max_actions": config.max_actions,
+              "test_seed": TEST_SEED}  # fmt: skip
     symbolic = {
         **common,
         "episodes": list(config.memory_episodes),

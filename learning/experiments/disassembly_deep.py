@@ -19,9 +19,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-import numpy as np
-
 from learning.errors import ConfigError
+from learning.experiments.scene_evaluation import evaluate_on_scenes
 from learning.symbolic_world import SymbolicWorld
 from learning.trial import run_episode
 from models import PuzzleSpec
@@ -34,9 +33,6 @@ never seen); 0.1 solved at most 20 % of the runs; 0.3 and 0.5 100 % at some chec
 solved 100 % (9.2 actions; optimum 8) at every checkpoint of both seeds."""
 TRAIN_SEED_STRIDE = 100_000
 """World seed of training episode ``e`` with training seed ``s``: ``s * TRAIN_SEED_STRIDE + e``."""
-EVAL_SEED_BASE = 10_000_000
-"""World seed of evaluation run ``r`` on test scene ``t``: ``EVAL_SEED_BASE + 1000 * t + r`` (the same
-worlds for every checkpoint and training seed, and never a training world)."""
 
 
 def train_deep_on_scene(
@@ -96,20 +92,9 @@ def train_deep_on_scene(
 
 
 def _evaluate(learner: Any, test_specs: Sequence[PuzzleSpec], runs: int, max_actions: int) -> dict[str, Any]:
-    """Greedy-with-epsilon_eval runs without learning; the records' ``solved``/``mean_actions``."""
+    """Greedy-with-epsilon_eval runs without learning, on the worlds every agent of the experiment meets."""
     learner.training = False
-    per_test, all_solved, all_actions = {}, [], []
     try:
-        for t, spec in enumerate(test_specs):
-            solved, actions = [], []
-            for run in range(runs):
-                world_seed = EVAL_SEED_BASE + 1000 * t + run
-                result = run_episode(learner, SymbolicWorld(spec, world_seed), spec.name, world_seed, max_actions)
-                solved.append(result.solved)
-                actions.append(result.num_actions if result.solved else max_actions)
-            per_test[spec.name] = {"solved": float(np.mean(solved)), "mean_actions": float(np.mean(actions))}
-            all_solved += solved
-            all_actions += actions
+        return evaluate_on_scenes(lambda: learner, test_specs, runs, max_actions)
     finally:
         learner.training = True
-    return {"solved": float(np.mean(all_solved)), "mean_actions": float(np.mean(all_actions)), "per_test": per_test}
