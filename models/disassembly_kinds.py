@@ -38,7 +38,7 @@ relations).
 from __future__ import annotations
 
 from models.errors import UnknownKindError
-from models.kinds import KIND_NAMES
+from models.kinds import KIND_NAMES, registered_kinds, registry_family
 
 DISASSEMBLY_FAMILY = "disassembly"
 """Name of this kind family."""
@@ -86,18 +86,21 @@ def may_lock(locker_kind: str, locked_kind: str) -> bool:
 
 def kind_family(kind: str) -> str:
     """``"puzzle-box"`` or ``"disassembly"``; :class:`UnknownKindError` lists every known kind."""
-    if kind in KIND_NAMES:
+    if kind in registered_kinds():
         return PUZZLE_BOX_FAMILY
     if kind in DISASSEMBLY_KINDS:
         return DISASSEMBLY_FAMILY
-    raise UnknownKindError(kind, (*KIND_NAMES, *DISASSEMBLY_KIND_NAMES))
+    raise UnknownKindError(kind, (*registered_kinds(), *DISASSEMBLY_KIND_NAMES))
 
 
 def family_kind_names(kinds: tuple[str, ...] | list[str]) -> tuple[str, ...]:
     """The kind names of the one family all ``kinds`` belong to (their integer codes are indices here):
-    :data:`models.kinds.KIND_NAMES` or :data:`DISASSEMBLY_KIND_NAMES`. Raises :class:`UnknownKindError`
-    for an unknown kind and ``ValueError`` for kinds of both families."""
+    :data:`models.kinds.KIND_NAMES` (the paper's, when every kind is one of them), every registered kind
+    (:func:`models.kinds.registry_family`, for boxes with another kind) or :data:`DISASSEMBLY_KIND_NAMES`.
+    Raises :class:`UnknownKindError` for an unknown kind and ``ValueError`` for kinds of both families."""
     families = {kind_family(k) for k in kinds}
     if len(families) > 1:
         raise ValueError(f"kinds {sorted(set(kinds))} mix the puzzle-box and disassembly families")
-    return DISASSEMBLY_KIND_NAMES if families == {DISASSEMBLY_FAMILY} else KIND_NAMES
+    if families == {DISASSEMBLY_FAMILY}:
+        return DISASSEMBLY_KIND_NAMES
+    return KIND_NAMES if set(kinds) <= set(KIND_NAMES) else registry_family().kinds

@@ -10,7 +10,9 @@ inactive at start, that the twin engages while a lock rule holds the component (
 door, slide and wheel to < 0.05 deg / 0.4 mm under a 50 N push with no MuJoCo warnings).
 
 Each component's parts (plate or disc, handle, joint) come from its registered kind
-(:func:`models.kinds.registry.registered_kind`); this module holds no per-kind knowledge.
+(:func:`models.kinds.registry.registered_kind`); this module holds no per-kind knowledge. A kind with
+fixed parts (a lever's bracket, a drawer's rails) builds them in the component body and its moving
+parts and joint in a child body: the marker and the sites go on the body the joint moves.
 
 MJCF names may not contain '/' (dm_control's scope separator) and ':' separates a component's
 elements, so a component's MJCF name is its spec name with every character outside
@@ -88,12 +90,13 @@ def build_puzzle_box(spec: PuzzleSpec, with_markers: bool = True) -> mjcf.RootEl
         body = box.add("body", name=name, pos=[x, y, 0.0], quat=yaw_quat(yaw))
         kind = registered_kind(component.kind)  # UnknownKindError lists the registered kinds
         joint = kind.build(body, name)
+        moving = joint.parent  # the body the joint moves: the component's (or a child above fixed parts)
         template = kind.template
         hx, hy = template.handle_xy
-        body.add("site", name=f"{name}:handle_site", pos=[hx, hy, PLATE_THICKNESS + HANDLE_HEIGHT], size=[0.003])
-        body.add("site", name=f"{name}:frame", pos=[0, 0, PLATE_THICKNESS], size=[0.002], group=4)
+        moving.add("site", name=f"{name}:handle_site", pos=[hx, hy, PLATE_THICKNESS + HANDLE_HEIGHT], size=[0.003])
+        moving.add("site", name=f"{name}:frame", pos=[0, 0, PLATE_THICKNESS], size=[0.002], group=4)
         if with_markers:  # the marker frame is the component frame, on the plate's top face
-            add_marker_geom(body, component.marker, f"{name}:marker", template.marker_size, pos=(0, 0, MARKER_Z))
+            add_marker_geom(moving, component.marker, f"{name}:marker", template.marker_size, pos=(0, 0, MARKER_Z))
         root.equality.add(
             "joint",
             name=f"{name}:latch",

@@ -1,11 +1,11 @@
 """Validation of puzzle spec files: every problem at once, each naming the field or component.
 
-Two kind families exist (SPEC.md extended, issue 14): puzzle boxes (``box`` required, kinds door / slide /
-wheel, planar poses ``[x, y, yaw]``, footprints inside the lid and not overlapping) and disassembly
-scenes (no ``box``, kinds of :mod:`models.disassembly_kinds`, 6-DOF poses ``[x, y, z, roll, pitch, yaw]``,
-no footprint rules). A spec without a box that has a disassembly kind is a disassembly scene; one
-family's kind in the other's spec is a problem naming the component. The generic rules (names, locks,
-goal, reachability) apply to both.
+Two kind families exist (SPEC.md extended, issue 14): puzzle boxes (``box`` required, the registered kinds of
+:mod:`models.kinds` — door, slide, wheel and any kind module added there —, planar poses ``[x, y, yaw]``,
+footprints inside the lid and not overlapping) and disassembly scenes (no ``box``, kinds of
+:mod:`models.disassembly_kinds`, 6-DOF poses ``[x, y, z, roll, pitch, yaw]``, no footprint rules). A spec
+without a box that has a disassembly kind is a disassembly scene; one family's kind in the other's spec is a
+problem naming the component. The generic rules (names, locks, goal, reachability) apply to both.
 
 :func:`validate_data` takes the parsed JSON value (anything ``json.loads`` may return) and never
 raises on bad input: it returns the list of problems, empty for a valid spec.
@@ -19,7 +19,7 @@ from typing import Any
 from models.disassembly_kinds import DISASSEMBLY_KIND_NAMES, DISASSEMBLY_KINDS, DISASSEMBLY_POSE_SIZE
 from models.errors import ReachabilityUndecided, SpecProblem
 from models.geometry import polygon_gap
-from models.kinds import KIND_NAMES, PUZZLE_KINDS, get_kind
+from models.kinds import get_kind, registered_kinds
 from models.lock_table import LockTable
 from models.markers import MAX_MARKER_ID
 from models.spec import SPEC_FORMAT, build_from_valid_data
@@ -60,8 +60,13 @@ def is_disassembly_data(data: Any) -> bool:
     return any(isinstance(c, dict) and c.get("kind") in DISASSEMBLY_KINDS for c in data["components"])
 
 
+def _is_box_kind(kind: Any) -> bool:
+    """Whether ``kind`` is a registered puzzle-box kind (:mod:`models.kinds.registry`)."""
+    return isinstance(kind, str) and kind in registered_kinds()
+
+
 def _known_kinds(disassembly: bool) -> str:
-    puzzle, other = f"puzzle-box kinds {list(KIND_NAMES)}", f"disassembly kinds {list(DISASSEMBLY_KIND_NAMES)}"
+    puzzle, other = f"puzzle-box kinds {list(registered_kinds())}", f"disassembly kinds {list(DISASSEMBLY_KIND_NAMES)}"
     return f"{other}; {puzzle}" if disassembly else f"{puzzle}; {other}"
 
 
@@ -69,7 +74,7 @@ def _check_pose(pose: Any, kind: Any, where: str, problem: Any) -> bool:
     """The pose's length follows its kind's family: ``[x, y, yaw]`` for puzzle-box kinds, ``[x, y, z, roll,
     pitch, yaw]`` for disassembly kinds (either for an unknown kind, already reported)."""
     bound = f"finite numbers within +-{MAX_MAGNITUDE:g} [m, rad]"
-    if isinstance(kind, str) and kind in PUZZLE_KINDS:
+    if _is_box_kind(kind):
         if _number_list(pose, (3,)):
             return True
         if isinstance(pose, list) and len(pose) == DISASSEMBLY_POSE_SIZE:
@@ -145,10 +150,10 @@ def validate_data(data: Any) -> list[SpecProblem]:
         if not isinstance(kind, str):
             problem(f"{where}.kind", f"missing or not a string; known kinds: {_known_kinds(disassembly)}")
             ok = False
-        elif kind not in KIND_NAMES and kind not in DISASSEMBLY_KINDS:
+        elif not _is_box_kind(kind) and kind not in DISASSEMBLY_KINDS:
             problem(f"{where}.kind", f"unknown kind {kind!r}; known kinds: {_known_kinds(disassembly)}")
             ok = False
-        elif disassembly and kind in PUZZLE_KINDS:
+        elif disassembly and _is_box_kind(kind):
             problem(
                 f"{where}.kind",
                 f"puzzle-box kind {kind!r} in a disassembly scene (no box, disassembly kinds); a spec has one "
@@ -159,7 +164,7 @@ def validate_data(data: Any) -> list[SpecProblem]:
             problem(
                 f"{where}.kind",
                 f"disassembly kind {kind!r} in a puzzle-box spec (it has a box); a disassembly scene has no box "
-                f"and 6-DOF poses; puzzle-box kinds are {list(KIND_NAMES)}",
+                f"and 6-DOF poses; puzzle-box kinds are {list(registered_kinds())}",
             )
             ok = False
         if not _check_pose(comp.get("pose"), kind, where, problem):
@@ -245,7 +250,7 @@ def validate_data(data: Any) -> list[SpecProblem]:
 
 def _check_geometry(data: dict[str, Any], components: dict[str, dict[str, Any]]) -> list[SpecProblem]:
     problems: list[SpecProblem] = []
-    box_kinds = [c for c in components.values() if c["kind"] in PUZZLE_KINDS]
+    box_kinds = [c for c in components.values() if _is_box_kind(c["kind"])]
     box = data.get("box")
     if box is None:
         if box_kinds:
@@ -265,7 +270,7 @@ def _check_geometry(data: dict[str, Any], components: dict[str, dict[str, Any]])
     half_x, half_y = size[0] / 2.0, size[1] / 2.0
     footprints = {}
     for name, comp in components.items():
-        if comp["kind"] not in PUZZLE_KINDS:
+        if not _is_box_kind(comp["kind"]):
             continue
         polygon = get_kind(comp["kind"]).footprint_in_lid(tuple(comp["pose"]))
         footprints[name] = polygon

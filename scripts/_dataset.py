@@ -15,6 +15,7 @@ from learning.runner import Task
 from models import LockTable
 from models.atomic import write_text_atomically
 from models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random
+from models.kinds import family_named
 from models.lock_table import ReachabilityUndecided
 
 MANIFEST = "manifest.json"
@@ -30,7 +31,11 @@ def make_spec(settings: Mapping[str, Any]) -> dict[str, Any]:
     box = BoxConfig(fit_reach=not settings["anywhere"])
     name = f"{settings['name']}-s{settings['seed']}" if settings["name"] else None
     if settings["generator"] == "random":
-        config = RandomGraphConfig(num_components=settings["components"], multi_locker=settings["multi_locker"])
+        config = RandomGraphConfig(
+            num_components=settings["components"],
+            multi_locker=settings["multi_locker"],
+            family=family_named(settings.get("kinds", "paper")),
+        )
         spec = generate_random(config, seed=settings["seed"], name=name, box=box)
     else:
         spec = generate_chain(settings["kinds"], seed=settings["seed"], name=name, box=box)

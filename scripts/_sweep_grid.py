@@ -41,6 +41,7 @@ from learning.errors import ConfigError
 from learning.runner import Task
 from models import PuzzleSpec, load_spec
 from models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random
+from models.kinds import KindFamily, UnknownFamilyError, family_named
 from models.spec import file_precision
 
 KEYS = {"sim", "specs", "generate", "placements", "placement_seed", "seeds", "agents", "profiles", "calibrations",
@@ -102,7 +103,9 @@ def _specs(sweep: dict[str, Any], base: Path) -> list[PuzzleSpec]:
     box = BoxConfig(fit_reach=not recipe.pop("anywhere", False))
     if kind == "random":
         config = RandomGraphConfig(
-            num_components=recipe.pop("components"), multi_locker=recipe.pop("multi_locker", False)
+            num_components=recipe.pop("components"),
+            multi_locker=recipe.pop("multi_locker", False),
+            family=_family(recipe.pop("kinds", "paper")),
         )
         specs = [generate_random(config, seed=s, box=box) for s in range(seed, seed + count)]
     elif kind == "chain":
@@ -112,6 +115,14 @@ def _specs(sweep: dict[str, Any], base: Path) -> list[PuzzleSpec]:
     if recipe:
         raise SweepError(f"'generate': unknown key(s) {sorted(recipe)}")
     return specs
+
+
+def _family(name: object) -> KindFamily:
+    """The kind family a random recipe's ``kinds`` names (``paper`` or ``all``)."""
+    try:
+        return family_named(str(name))
+    except UnknownFamilyError as err:
+        raise SweepError(f"'generate': 'kinds': {err}") from None
 
 
 def _seeds(sweep: dict[str, Any]) -> list[int]:

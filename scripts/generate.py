@@ -2,7 +2,7 @@
 
     python scripts/generate.py paper --split {train,test,all} --out DIR     # DIR/<name>.json
     python scripts/generate.py chain --kinds door,slide,wheel --seed S --out FILE
-    python scripts/generate.py random --components N --seed S [--multi-locker] --out FILE
+    python scripts/generate.py random --components N --seed S [--multi-locker] [--kinds paper|all] --out FILE
     python scripts/generate.py random|chain ... --count N --out DIR [--workers K | --ray auto|ADDRESS]
     python scripts/generate.py validate FILE...     # exit 1 and one line per problem if any is invalid
     python scripts/generate.py mjcf SPEC --out DIR  # DIR/scene.xml + assets, loadable by mujoco
@@ -35,6 +35,7 @@ from tqdm import tqdm
 
 from models import LockTable, ModelsError, PuzzleSpec, SpecError, load_spec, save_spec
 from models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random, paper_family
+from models.kinds import family_named
 
 
 def _write(spec: PuzzleSpec, path: Path, plot: bool) -> None:
@@ -99,8 +100,9 @@ def _dataset(args: argparse.Namespace, generator: dict) -> None:
 
 def _random(args: argparse.Namespace) -> None:
     if args.count is not None:
-        return _dataset(args, {"generator": "random", "components": args.components, "multi_locker": args.multi_locker})
-    config = RandomGraphConfig(num_components=args.components, multi_locker=args.multi_locker)
+        settings = {"components": args.components, "multi_locker": args.multi_locker, "kinds": args.kinds}
+        return _dataset(args, {"generator": "random", **settings})
+    config = RandomGraphConfig(args.components, multi_locker=args.multi_locker, family=family_named(args.kinds))
     box = BoxConfig(fit_reach=not args.anywhere)
     _write(generate_random(config, seed=args.seed, name=args.name, box=box), Path(args.out), args.plot)
 
@@ -163,7 +165,7 @@ def main(argv: list[str] | None = None) -> int:
     paper.add_argument("--plot", action="store_true", help="also write a top-view PNG beside each JSON")
     paper.set_defaults(run=_paper)
 
-    chain = verbs.add_parser("chain", help="a chain of any kinds (door-slide and slide-wheel neighbours)")
+    chain = verbs.add_parser("chain", help="a chain of any registered kinds whose neighbours may lock each other")
     chain.add_argument("--kinds", required=True, help="comma-separated, e.g. door,slide,wheel")
     chain.add_argument("--seed", type=int, required=True)
     chain.add_argument("--out", required=True, help="output JSON file")
@@ -181,6 +183,12 @@ def main(argv: list[str] | None = None) -> int:
     rand.add_argument("--components", type=int, required=True)
     rand.add_argument("--seed", type=int, required=True)
     rand.add_argument("--multi-locker", action="store_true", help="some components get two lockers")
+    rand.add_argument(
+        "--kinds",
+        choices=("paper", "all"),
+        default="paper",
+        help="kinds drawn: the paper's door/slide/wheel (default) or every registered kind (models.kinds)",
+    )
     rand.add_argument("--out", required=True, help="output JSON file")
     rand.add_argument("--name", default=None, help="spec name (default: derived from N and seed)")
     rand.add_argument("--plot", action="store_true", help="also write a top-view PNG beside each JSON")

@@ -11,8 +11,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
-from models.kinds import HANDLE_HEIGHT, get_kind
+from models.kinds import HANDLE_HEIGHT, Handling, get_kind, registered_kind
 from models.puzzle_box import PLATE_THICKNESS
 
 
@@ -40,6 +41,11 @@ class JointModel:
     travel: float
     """Motion from state 0 to state 1 [rad or m]."""
 
+    @property
+    def handling(self) -> Handling:
+        """How the kind is grasped and moved, and how its marker shows a move (the kind module's)."""
+        return registered_kind(self.kind).handling
+
     def grasp_point_at(self, fraction: float) -> np.ndarray:
         """The grasp point after moving ``fraction`` (0..1, negative to close) of the travel [m]."""
         amount = fraction * self.travel
@@ -60,6 +66,15 @@ class JointModel:
         b -= np.dot(b, self.axis) * self.axis
         return float(np.arctan2(np.dot(self.axis, cross(a, b)), np.dot(a, b)) / self.travel)
 
+    def tilt_fraction(self, T_closed: np.ndarray, T_seen: np.ndarray) -> float:
+        """Fraction of the travel (signed: positive opens) by which a frame on the part turned about a
+        hinge's axis from ``T_closed`` to ``T_seen`` (4x4, base frame): a marker's own turn, whatever its
+        centre did (a lever's marker near its pivot drops a few mm but tilts with it). Slides: 0."""
+        if self.joint == "slide":
+            return 0.0
+        turn = Rotation.from_matrix(T_seen[:3, :3] @ T_closed[:3, :3].T).as_rotvec()
+        return float(np.dot(turn, self.axis) / self.travel)
+
     def motion_direction(self, fraction: float) -> np.ndarray:
         """Unit direction in which the grasp point moves when opening, at ``fraction`` of the travel."""
         if self.joint == "slide":
@@ -78,8 +93,9 @@ def joint_model(kind: str, T_base_component: np.ndarray) -> JointModel:
     (``skills.perception.upright_pose``): a marker's perceived tilt is not to be trusted."""
     template = get_kind(kind)
     R, p = T_base_component[:3, :3], T_base_component[:3, 3]
-    # the marker frame is on the top face; the joint origin and handle are given from the plate bottom
-    plate_bottom = p - R[:, 2] * (PLATE_THICKNESS + 0.0005)
+    # the marker frame is on the top face; the joint origin and handle are given from the plate bottom. The
+    # pose is the marker's in the lid's plane (perception's upright pose): a raised part's plate sits ``lift`` higher
+    plate_bottom = p - R[:, 2] * (PLATE_THICKNESS + 0.0005 - template.lift)
 
     def to_base(point: tuple[float, float, float]) -> np.ndarray:
         return plate_bottom + R @ np.asarray(point, dtype=float)

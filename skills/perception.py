@@ -83,9 +83,12 @@ def upright_pose(planar_pose: np.ndarray, height: float) -> np.ndarray:
     return geometry.upright_pose(*planar_pose, height)
 
 
-def lid_height(detections: dict[int, MarkerDetection]) -> float:
-    """Height of the markers' plane [m]: the median of their heights (all lie on the lid, state 0)."""
-    return float(np.median([d.T_base_marker[2, 3] for d in detections.values()]))
+def lid_height(detections: dict[int, MarkerDetection], lifts: dict[int, float] | None = None) -> float:
+    """Height of the markers' plane [m]: the median of their heights (all lie on the lid, state 0), each
+    less its part's ``lifts[marker]`` (a kind's ``KindTemplate.lift``: a lever's marker stands on its arm
+    30 mm above the others; with two markers the median is their mean)."""
+    lifts = lifts or {}
+    return float(np.median([d.T_base_marker[2, 3] - lifts.get(m, 0.0) for m, d in detections.items()]))
 
 
 class MarkerDetector:

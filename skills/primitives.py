@@ -471,11 +471,11 @@ class Toggler(DoorPushing):
 
     # -- the toggle --------------------------------------------------------------------------------
     def grasp_yaw(self, jm: JointModel) -> float:
-        """Yaw of the gripper. Slides and wheels: the fingers close along the handle's (horizontal)
-        direction of motion, so the pads push it. Doors: along the hinge axis, so the handle pivots
-        between the pads like a pin as the door swings and the gripper need not tilt 85 degrees
+        """Yaw of the gripper (the kind's ``Handling.grasp``). Slides and wheels: the fingers close along
+        the handle's (horizontal) direction of motion, so the pads push it. Doors: along the hinge axis, so the
+        handle pivots between the pads like a pin as the door swings and the gripper need not tilt 85 degrees
         (tilting with it folded the arm onto itself)."""
-        direction = jm.axis if jm.kind == "door" else jm.motion_direction(0.0)
+        direction = jm.axis if jm.handling.grasp == "along_axis" else jm.motion_direction(0.0)
         return float(np.arctan2(direction[1], direction[0]) + np.pi / 2)
 
     def toggle(
@@ -507,7 +507,7 @@ class Toggler(DoorPushing):
         start_time = self.robot.time
         self.reset_force_watch()
         c = self.config
-        pushable = jm.kind == "door" and c.door_push
+        pushable = jm.handling.swings_up and c.door_push
         covered = None if door_at is None else (door_at if opening else 1.0 - door_at)
         if pushable and opening and raised:
             result = self._attempt(lambda: self._top_up_door(jm))
@@ -648,14 +648,14 @@ class Toggler(DoorPushing):
             * np.linalg.norm((jm.grasp_point - jm.origin) - np.dot(jm.grasp_point - jm.origin, jm.axis) * jm.axis)
         )
         lead = c.lead / path_length  # as a fraction of the travel
-        end = 1.0 + (c.door_overtravel if jm.kind == "door" and sign > 0 else 0.0)
+        end = 1.0 + (c.door_overtravel if jm.handling.swings_up and sign > 0 else 0.0)
         pace = end / ticks  # travel per tick up to the travel's end
         slow = c.breakaway_fraction / (pace * c.breakaway_pace)  # ticks of the slow start
         last_tick = math.ceil(slow + (1.0 + 2 * (end - 1.0) - c.breakaway_fraction) / pace - 1e-9)
         progress_at_peak = 0.0
         in_end_stop = False  # felt the door reach its end stop: open, whatever the pads do next
         across = np.zeros(3)  # the path's offset across itself, yielding to the load there [m, base frame]
-        yields = jm.kind == "door"  # (slides and wheels yielding too were read latched while free)
+        yields = jm.handling.swings_up  # (slides and wheels yielding too were read latched while free)
         returning = 1.0 - c.tick / c.comply_return_time  # the offset kept per tick past the travel
         self.ik.set_joints(self.robot.joint_positions())
         for k in range(1, last_tick + 1):

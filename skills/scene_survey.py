@@ -92,8 +92,12 @@ class SceneSurvey:
         toggler: Toggler,
         detector: MarkerDetector | None = None,
         config: SurveyConfig | None = None,
+        marker_lifts: dict[int, float] | None = None,
     ) -> None:
         self.robot, self.calibration, self.toggler = robot, calibration, toggler
+        self.marker_lifts = dict(marker_lifts or {})
+        """Marker id -> how far above the lid's marker plane its part holds it, closed [m] (its kind's
+        ``KindTemplate.lift``; 0 for parts lying on the lid)."""
         self.detector = detector or MarkerDetector()
         self.config = config or SurveyConfig()
         self.last_close_up_reached = False
@@ -162,7 +166,7 @@ class SceneSurvey:
     def _measure_from_above(
         self, marker: int, xy: np.ndarray, height: float | None, yaws: tuple[float, ...] = CAMERA_YAWS
     ) -> MarkerDetection | None:
-        z = height if height is not None else self.config.table_height
+        z = (height if height is not None else self.config.table_height) + self.marker_lifts.get(marker, 0.0)
         self.last_close_up_reached = self._wrist_from_above(
             np.array([xy[0], xy[1], z]), self.config.close_up_height, yaws
         )
@@ -203,7 +207,7 @@ class SceneSurvey:
 
     def _refine(self, found: dict[int, MarkerDetection], markers: list[int]) -> bool:
         """Replace ``markers`` in ``found`` by close-up measurements where seen; True if the arm moved."""
-        height = lid_height(found) if found else None
+        height = lid_height(found, self.marker_lifts) if found else None
         for marker in sorted(markers):
             closer = self._measure_from_above(marker, found[marker].T_base_marker[:2, 3], height)
             if closer is not None:
@@ -215,12 +219,12 @@ class SceneSurvey:
         markers of a closed box lie on its lid)."""
         if len(found) < 2:
             return []
-        height = lid_height(found)
+        height = lid_height(found, self.marker_lifts)
         return [
             m
             for m, d in found.items()
             if d.camera == self.config.overview_camera
-            and abs(d.T_base_marker[2, 3] - height) > self.config.lid_tolerance
+            and abs(d.T_base_marker[2, 3] - self.marker_lifts.get(m, 0.0) - height) > self.config.lid_tolerance
         ]
 
     def _search(self, found: dict[int, MarkerDetection], missing: set[int]) -> list[MarkerDetection]:

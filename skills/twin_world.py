@@ -35,6 +35,7 @@ import numpy as np
 from models import ComponentObservation, SceneObservation, TryResult
 from models.calibration import CellCalibration
 from models.geometry import wrap_angle
+from models.kinds import get_kind
 from models.robot import Robot
 from skills.door_clearance import lean_away, near_open_door
 from skills.joint_model import JointModel, joint_model
@@ -123,9 +124,12 @@ class TwinWorld:
     def __post_init__(self) -> None:
         self.detector = MarkerDetector()
         self.toggler = Toggler(self.robot)
-        self.survey = SceneSurvey(self.robot, self.calibration, self.toggler, self.detector, self.config.survey)
+        lifts = {m: get_kind(kind).lift for m, kind in self.marker_map.items()}  # a lever's marker stands higher
+        self.survey = SceneSurvey(
+            self.robot, self.calibration, self.toggler, self.detector, self.config.survey, marker_lifts=lifts
+        )
         found = self.survey.locate(set(self.marker_map))
-        self.lid_height = lid_height(found)
+        self.lid_height = lid_height(found, lifts)
         order = np.random.default_rng(self.seed).permutation(sorted(self.marker_map))
         self.markers = [int(m) for m in order]
         self.closed_poses = {m: found[m].planar_pose for m in self.markers}
@@ -151,7 +155,7 @@ class TwinWorld:
         peak = 0.0
         sim_time = wall_time = 0.0
         attempts = 0
-        is_door = kind_of(self.marker_map, marker) == "door"
+        is_door = self._swings_up(marker)  # (a door, or any kind that swings up out of the lid plane)
         door_at = None
         raised = False  # a door left part-way where no look sees it
         if marker in self.unsettled and opening:  # a door an earlier try left part-way: where is it now?
@@ -216,7 +220,7 @@ class TwinWorld:
         ):
             self.unsettled.add(marker)  # the next try of it looks first
         outcome = self._sensed_outcome(result, marker, opening)
-        if self._door_stayed_shut(outcome):
+        if self._door_stayed_shut(outcome, marker):
             # the fingers went the whole way and the door stayed: weak pads slid along its post (a latch,
             # or a door heavier than they hold). A push tells which: it turns a free door, a latch holds it.
             result = self.toggler.toggle(self.joint_models[marker], opening, push=True)
@@ -224,7 +228,7 @@ class TwinWorld:
             peak, sim_time = max(peak, result.peak_force), sim_time + result.sim_time
             wall_time += result.wall_time
             outcome = self._sensed_outcome(result, marker, opening)
-            if self._door_stayed_shut(outcome):
+            if self._door_stayed_shut(outcome, marker):
                 outcome = TryResult("blocked", HELD_UNDER_PINCH_AND_PUSH)
         if outcome.moved:
             self.states[index] ^= 1
@@ -247,7 +251,7 @@ class TwinWorld:
         grasp = jm.grasp_point_at(0.0 if opening else 1.0)
         doors = []
         for other, state in zip(self.markers, self.states, strict=True):
-            if other == marker or kind_of(self.marker_map, other) != "door":
+            if other == marker or not self._swings_up(other):
                 continue
             if other in self.unsettled:
                 lowest = self.toggler.config.blocked_progress
@@ -259,10 +263,11 @@ class TwinWorld:
                 doors.append(other)
         return doors
 
-    def _door_stayed_shut(self, outcome: TryResult) -> bool:
+    def _door_stayed_shut(self, outcome: TryResult, marker: int) -> bool:
         """Whether a pinch that carried its fingers the whole way left a door seen shut (its marker where
         it was): the signature of pads sliding along the post of a door they could not turn."""
-        return self.toggler.config.door_push and outcome.reason.startswith(DOOR_STAYED)  # (doors, opening only)
+        stayed = outcome.reason.startswith(DOOR_STAYED)  # (opening only)
+        return self.toggler.config.door_push and self._swings_up(marker) and stayed
 
     def _fraction_open(self, marker: int) -> float | None:
         """Fraction of its travel at which ``marker``'s part stands now (0 closed, 1 open), from its marker
@@ -271,7 +276,7 @@ class TwinWorld:
         jm = self.joint_models[marker]
         closed = self._closed_point(marker)
         look_at = closed
-        if jm.kind == "door":  # from over its hinge side (see WorldConfig.door_look_offset)
+        if jm.handling.swings_up:  # from over its hinge side (see WorldConfig.door_look_offset)
             out = closed - jm.origin
             out -= np.dot(out, jm.axis) * jm.axis
             out[2] = 0.0
@@ -320,7 +325,7 @@ class TwinWorld:
         stands edge-on), a closed one did not come back; the arm out of reach leaves the primitive's
         verdict standing."""
         seen = self.survey.close_up(marker, self.closed_poses[marker], self.lid_height)
-        is_door = kind_of(self.marker_map, marker) == "door"
+        is_door = self._swings_up(marker)
         if seen is None and opening and is_door and self.survey.last_close_up_reached:
             # from straight above, a door raised 20-50 deg shows its marker tilted and offset (often not read):
             # from over its hinge side a door short of ~50 deg is seen, one standing open is not
@@ -334,12 +339,18 @@ class TwinWorld:
         return self._verdict(seen, marker, opening)
 
     def _verdict(self, seen: MarkerDetection, marker: int, opening: bool) -> TryResult:
-        """``moved`` if the marker ``seen`` is where the part's other state puts it: a door's by the fraction
-        of its travel it turned (a door let go part-way has left its closed pose too), any other part's by
-        having left its closed pose (``MOVED_DISTANCE``, ``MOVED_ANGLE``) or not."""
-        if kind_of(self.marker_map, marker) == "door":
-            at = self.joint_models[marker].fraction_between(self._closed_point(marker), seen.T_base_marker[:3, 3])
+        """``moved`` if the marker ``seen`` is where the part's other state puts it, as its kind's
+        ``Handling.verdict`` reads it: ``arc``, by the fraction of its travel the marker centre turned about the
+        hinge (a door let go part-way has left its closed pose too); ``tilt``, by the marker's own turn about
+        the hinge axis (a lever's marker drops a few mm but tilts); ``left_pose``, by having left its closed
+        pose (``MOVED_DISTANCE``, ``MOVED_ANGLE``) or not."""
+        jm = self.joint_models[marker]
+        if jm.handling.verdict == "arc":
+            at = jm.fraction_between(self._closed_point(marker), seen.T_base_marker[:3, 3])
             return self._door_verdict(at, opening)
+        if jm.handling.verdict == "tilt":
+            at = jm.tilt_fraction(upright_pose(self.closed_poses[marker], self.lid_height), seen.T_base_marker)
+            return self._door_verdict(at, opening, stayed="the part stayed where it was")
         delta = seen.planar_pose - self.closed_poses[marker]
         turn = abs(wrap_angle(delta[2]))
         away = bool(np.linalg.norm(delta[:2]) > MOVED_DISTANCE or turn > MOVED_ANGLE)
@@ -347,14 +358,21 @@ class TwinWorld:
             return TryResult("moved")
         return TryResult("failed", "SlipDetected: the handle moved but the marker did not")
 
-    def _door_verdict(self, at: float, opening: bool) -> TryResult:
-        """Whether a door seen at fraction ``at`` of its travel reached its other state."""
+    def _door_verdict(self, at: float, opening: bool, stayed: str = "") -> TryResult:
+        """Whether a part (a door, a lever) seen at fraction ``at`` of its travel reached its other state;
+        ``stayed``: the reason of a part seen at its start (default :data:`DOOR_STAYED`, which a door's push
+        follows up)."""
         c = self.toggler.config
         if (at >= c.moved_fraction) if opening else (at <= 1.0 - c.moved_fraction):
             return TryResult("moved")
         if opening and at < c.blocked_progress:
-            return TryResult("failed", f"{DOOR_STAYED} ({at:.0%} of its travel)")
-        return TryResult("failed", f"SlipDetected: the door stands at {at:.0%} of its travel")
+            reason = f"SlipDetected: {stayed}" if stayed else DOOR_STAYED
+            return TryResult("failed", f"{reason} ({at:.0%} of its travel)")
+        return TryResult("failed", f"SlipDetected: the part stands at {at:.0%} of its travel")
+
+    def _swings_up(self, marker: int) -> bool:
+        """Whether ``marker``'s part swings up out of the lid plane (a door: ``Handling.swings_up``)."""
+        return self.joint_models[marker].handling.swings_up
 
     def ground_truth_name(self, index: int) -> str:
         """For logs: the spec name of component ``index`` when given, else its marker id."""

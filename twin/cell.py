@@ -21,12 +21,13 @@ everything drawn before them existed, which therefore stays bit-identical.
 from __future__ import annotations
 
 import math
+import zlib
 from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
-from models.kinds import KIND_NAMES
+from models.kinds import KIND_NAMES, registered_kinds
 from twin.reality import RealityProfile
 from twin.sensors.random_vectors import random_vector
 
@@ -114,6 +115,13 @@ def draw_cell(profile: RealityProfile, camera_names: tuple[str, ...]) -> CellImp
                   physics.kind_latch_compliance_scale):  # fmt: skip
         factors = np.asarray(scale.draw(rng, len(KIND_NAMES)), dtype=float)
         tables.append({kind: float(f) for kind, f in zip(KIND_NAMES, factors, strict=True)})
+    for kind in registered_kinds():  # kinds beyond the paper's: a stream of their own per name, so that
+        if kind in KIND_NAMES:  # registering a kind changes no other kind's hardware
+            continue
+        kind_rng = np.random.default_rng(np.random.SeedSequence([profile.cell_seed, zlib.crc32(kind.encode())]))
+        for table, scale in zip(tables, (physics.kind_joint_damping_scale, physics.kind_joint_friction_scale,
+                                         physics.kind_latch_compliance_scale), strict=True):  # fmt: skip
+            table[kind] = float(np.asarray(scale.draw(kind_rng, 1), dtype=float)[0])
     return CellImperfections(cameras, tcp_bias, KindFactors(*tables))
 
 

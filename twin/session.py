@@ -187,7 +187,8 @@ class TwinSession:
         self.jams: Jams | None = None
         if r.physics.jam_probability > 0:
             gripper_bodies = subtree_bodies(m, gripper_body)
-            part_geoms = [np.flatnonzero(m.geom_bodyid == m.body(c.body).id) for c in component_names]
+            part_geoms = [np.flatnonzero(np.isin(m.geom_bodyid, subtree_bodies(m, m.body(c.body).id)))
+                          for c in component_names]  # fmt: skip
             self.jams = Jams(
                 m, part_geoms, gripper_bodies, self.travel, r.physics.jam_probability, r.physics.jam_release_after
             )

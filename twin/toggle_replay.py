@@ -39,6 +39,7 @@ from models.puzzle_box import MARKER_Z
 from models.scene import SceneConfig
 from models.spec import Box, Component, Goal, PuzzleSpec
 from models.toggle_log import ToggleLog
+from twin.physics_draws import subtree_bodies
 from twin.reality import ArmReality, ForceTorqueReality
 from twin.robot_interface import GRIPPER_CTRL_MAX
 from twin.scene_cache import compiled_scene
@@ -167,7 +168,7 @@ class ToggleReplay:
         joint = m.joint(part.joint)
         self._qpos, self._dof = int(joint.qposadr[0]), int(joint.dofadr[0])
         self._latch = m.equality(part.latch).id
-        self._part_geoms = np.flatnonzero(m.geom_bodyid == m.body(part.body).id)
+        self._part_geoms = np.flatnonzero(np.isin(m.geom_bodyid, subtree_bodies(m, m.body(part.body).id)))
         driver = m.joint(names.gripper_actuator.replace("fingers", "right_driver_joint"))
         self._driver_qpos, self._driver_range = int(driver.qposadr[0]), driver.range.copy()
         if self.config.handle_friction is not None:

@@ -39,6 +39,7 @@ from models.disassembly_kinds import (
     PUZZLE_BOX_FAMILY,
     family_kind_names,
 )
+from models.kinds import registry_family
 
 NODE_FEATURES = len(KIND_NAMES) + 2
 """Puzzle-box family: kind one-hot, state, goal flag (plus 4 pose features with ``poses="absolute"``);
@@ -58,8 +59,13 @@ class SceneMismatch(LearningError, ValueError):
 
 
 def family_name(kinds: Sequence[str]) -> str:
-    """``puzzle-box``, ``disassembly``, or the kinds themselves for a custom tuple (for messages)."""
-    names = {tuple(KIND_NAMES): PUZZLE_BOX_FAMILY, tuple(DISASSEMBLY_KIND_NAMES): DISASSEMBLY_FAMILY}
+    """``puzzle-box``, ``disassembly``, ``puzzle-box (every registered kind)`` or the kinds themselves for a
+    custom tuple (for messages)."""
+    names = {  # (the paper's last: with no other kind registered, the registry's kinds are the paper's)
+        registry_family().kinds: f"{PUZZLE_BOX_FAMILY} (every registered kind)",
+        tuple(DISASSEMBLY_KIND_NAMES): DISASSEMBLY_FAMILY,
+        tuple(KIND_NAMES): PUZZLE_BOX_FAMILY,
+    }
     return names.get(tuple(kinds), f"kinds {list(kinds)}")
 
 

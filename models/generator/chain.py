@@ -14,7 +14,7 @@ import numpy as np
 
 from models.errors import GeneratorError
 from models.generator.layout import Layout, LayoutConfig
-from models.kinds import ALLOWED_NEIGHBOURS, PUZZLE_KINDS, may_neighbour
+from models.kinds import registered_kinds, registry_family
 from models.reach import MAX_REACH, MIN_REACH, fitting_box_pose
 from models.spec import Box, Component, Goal, LockRule, PuzzleSpec, file_precision
 
@@ -67,15 +67,17 @@ def fit_to_reach(spec: PuzzleSpec, box: BoxConfig) -> PuzzleSpec | None:
 
 
 def check_chain_kinds(kinds: Sequence[str]) -> None:
-    """Raise :class:`GeneratorError` unless ``kinds`` is a chain the paper's rules allow."""
+    """Raise :class:`GeneratorError` unless ``kinds`` is a chain of registered kinds whose neighbours may lock
+    each other (:func:`models.kinds.registry_family`: for the paper's kinds, the paper's pairs)."""
     if len(kinds) < 2:
         raise GeneratorError(f"a chain needs at least 2 components, got {len(kinds)}")
-    unknown = [k for k in kinds if k not in PUZZLE_KINDS]
+    unknown = [k for k in kinds if k not in registered_kinds()]
     if unknown:
-        raise GeneratorError(f"unknown kinds {unknown}; known kinds: {sorted(PUZZLE_KINDS)}")
+        raise GeneratorError(f"unknown kinds {unknown}; known kinds: {sorted(registered_kinds())}")
+    family = registry_family()
     for k in range(len(kinds) - 1):
-        if not may_neighbour(kinds[k], kinds[k + 1]):
-            allowed = sorted("-".join(sorted(p)) for p in ALLOWED_NEIGHBOURS)
+        if not family.may_neighbour(kinds[k], kinds[k + 1]):
+            allowed = sorted("-".join(sorted(p)) for p in family.neighbours)
             raise GeneratorError(
                 f"kinds {kinds[k]!r} and {kinds[k + 1]!r} at positions {k} and {k + 1} cannot lock each "
                 f"other; neighbours must be one of {allowed}"

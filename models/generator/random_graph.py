@@ -1,10 +1,10 @@
 """Random lock graphs: N components in a tree of neighbours, always valid and solvable.
 
-Components are placed one at a time, each next to an already placed *anchor* of an allowed kind
-(door-slide, slide-wheel), so a locker always sits next to what it locks. The anchor locks the new
-component closed (``anchor 0 keeps new 0``) and, with probability ``reverse_lock_probability``, the
-new component open keeps the anchor open (the paper's second chain rule). With ``multi_locker``,
-some components get a second locker: another placed neighbour of an allowed kind.
+Components are placed one at a time, each next to an already placed *anchor* of an allowed kind (the config's
+family: the paper's door-slide, slide-wheel by default), so a locker always sits next to what it locks. The
+anchor locks the new component closed (``anchor 0 keeps new 0``) and, with probability
+``reverse_lock_probability``, the new component open keeps the anchor open (the paper's second chain rule).
+With ``multi_locker``, some components get a second locker: another placed neighbour of an allowed kind.
 
 Every locker of a component is placed before it, so opening the components in placement order
 solves the puzzle: every generated spec is solvable by construction (and validated anyway).
@@ -20,7 +20,7 @@ import numpy as np
 from models.errors import GeneratorError
 from models.generator.chain import MAX_LAYOUT_ATTEMPTS, BoxConfig, assemble, check_reach_size, fit_to_reach
 from models.generator.layout import Layout
-from models.kinds import KIND_NAMES, may_neighbour
+from models.kinds import PAPER_FAMILY, KindFamily
 from models.spec import PuzzleSpec
 
 MAX_RANDOM_COMPONENTS = 40
@@ -39,10 +39,13 @@ class RandomGraphConfig:
     """With ``multi_locker``: chance that a component with a free neighbour gets a second locker."""
     reverse_lock_probability: float = 0.5
     """Chance of the rule 'new component open keeps its anchor open'."""
+    family: KindFamily = PAPER_FAMILY
+    """Kinds drawn and the pairs that may lock each other: the paper's (default; its boxes unchanged) or
+    :func:`models.kinds.registry_family` (every registered kind: ``generate.py random --kinds all``)."""
 
 
-def _partner_kinds(kind: str) -> list[str]:
-    return [k for k in KIND_NAMES if may_neighbour(kind, k)]
+def _partner_kinds(family: KindFamily, kind: str) -> list[str]:
+    return [k for k in family.kinds if family.may_neighbour(kind, k)]
 
 
 def generate_random(
@@ -79,13 +82,14 @@ def _try_build(
     config: RandomGraphConfig, rng: np.random.Generator, box: BoxConfig
 ) -> tuple[Layout, list[tuple[int, int, int, int]], int] | None:
     layout = Layout(box.layout)
-    layout.place_first(KIND_NAMES[int(rng.integers(len(KIND_NAMES)))])
+    kinds = config.family.kinds
+    layout.place_first(kinds[int(rng.integers(len(kinds)))])
     lockers: list[list[int]] = [[]]
     rules: list[tuple[int, int, int, int]] = []
     for new in range(1, config.num_components):
         placed = False
         for anchor in rng.permutation(len(layout)):
-            partners = _partner_kinds(layout.kinds[anchor])
+            partners = _partner_kinds(config.family, layout.kinds[anchor])
             kind = partners[int(rng.integers(len(partners)))]
             if layout.attach(int(anchor), kind, rng):
                 placed = True
@@ -98,7 +102,7 @@ def _try_build(
         if rng.random() < config.reverse_lock_probability:
             rules.append((new, 1, anchor, 1))
         if config.multi_locker and rng.random() < config.second_locker_probability:
-            second = _second_locker(layout, new, anchor, rng)
+            second = _second_locker(config.family, layout, new, anchor, rng)
             if second is not None:
                 lockers[new].append(second)
                 rules.append((second, 0, new, 0))
@@ -112,12 +116,12 @@ def _try_build(
     return layout, rules, goal
 
 
-def _second_locker(layout: Layout, new: int, anchor: int, rng: np.random.Generator) -> int | None:
+def _second_locker(family: KindFamily, layout: Layout, new: int, anchor: int, rng: np.random.Generator) -> int | None:
     options = [
         other
         for other in range(new)
         if other != anchor
-        and may_neighbour(layout.kinds[other], layout.kinds[new])
+        and family.may_neighbour(layout.kinds[other], layout.kinds[new])
         and layout.are_neighbours(other, new)
     ]
     return int(options[int(rng.integers(len(options)))]) if options else None

@@ -4,7 +4,8 @@
   frame) and the dimensions every kind shares (marker, handle).
 - :mod:`models.kinds.door`, :mod:`~models.kinds.slide`, :mod:`~models.kinds.wheel`: each kind's frame,
   dimensions, template, joint dynamics, colour and MJCF parts.
-- :mod:`models.kinds.registry`: the kinds ``models`` can build, by name.
+- :mod:`models.kinds.registry`: the kinds ``models`` can build, by name: every module here defining
+  ``KIND``, found by the registry (adding a kind is adding its module), and :func:`registry_family`.
 - :mod:`models.kinds.family`: :data:`PAPER_FAMILY`, the paper's kinds, codes and allowed neighbours,
   pinned so that registering a kind never changes the paper's boxes.
 
@@ -16,15 +17,17 @@ from __future__ import annotations
 
 from models.errors import UnknownKindError
 from models.kinds.door import DOOR, DOOR_HALF
-from models.kinds.family import PAPER_FAMILY, KindFamily
-from models.kinds.kind import JointDynamics, Kind
+from models.kinds.family import PAPER_FAMILY, KindFamily, UnknownFamilyError
+from models.kinds.kind import Handling, JointDynamics, Kind
 from models.kinds.registry import (
     DuplicateKindError,
     KindRegistry,
+    family_named,
     get_kind,
     register,
     registered_kind,
     registered_kinds,
+    registry_family,
 )
 from models.kinds.slide import SLIDE, SLIDE_BACK, SLIDE_HALF
 from models.kinds.template import HANDLE_HEIGHT, HANDLE_MARGIN, HANDLE_OFFSET, HANDLE_SIZE, MARKER_SIZE, KindTemplate
@@ -69,16 +72,20 @@ __all__ = [
     "WHEEL",
     "WHEEL_RADIUS",
     "DuplicateKindError",
+    "Handling",
     "JointDynamics",
     "Kind",
     "KindFamily",
     "KindRegistry",
     "KindTemplate",
+    "UnknownFamilyError",
     "UnknownKindError",
+    "family_named",
     "get_kind",
     "kind_code",
     "may_neighbour",
     "register",
     "registered_kind",
     "registered_kinds",
+    "registry_family",
 ]

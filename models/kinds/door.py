@@ -12,7 +12,7 @@ import math
 from typing import TYPE_CHECKING
 
 from models.geometry import rectangle
-from models.kinds.kind import JointDynamics, Kind
+from models.kinds.kind import Handling, JointDynamics, Kind
 from models.kinds.parts import PLATE_THICKNESS, add_handle, add_joint, add_plate
 from models.kinds.template import HANDLE_MARGIN, HANDLE_OFFSET, MARKER_SIZE, KindTemplate
 
@@ -57,5 +57,14 @@ def build(body: mjcf.Element, name: str) -> mjcf.Element:
     return add_joint(body, name, DOOR, DYNAMICS)
 
 
-KIND = Kind(template=DOOR, dynamics=DYNAMICS, colour=COLOUR, build=build, glyph="#4C72B0", sweep_effort=0.3)
+KIND = Kind(
+    template=DOOR,
+    dynamics=DYNAMICS,
+    colour=COLOUR,
+    build=build,
+    glyph="#4C72B0",
+    sweep_effort=0.3,
+    neighbours=("slide",),
+    handling=Handling(grasp="along_axis", verdict="arc", swings_up=True),
+)
 """The door, as registered (:mod:`models.kinds.registry`)."""

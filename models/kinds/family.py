@@ -4,9 +4,19 @@ each other. The paper's family is pinned here by name, so registering a new kind
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
-from models.errors import UnknownKindError
+from models.errors import ModelsError, UnknownKindError
+
+
+class UnknownFamilyError(ModelsError, ValueError):
+    """A kind family asked for by a name that names none."""
+
+    def __init__(self, name: str, available: Iterable[str]) -> None:
+        self.family = name
+        self.available = tuple(sorted(available))
+        super().__init__(f"unknown kind family {name!r}; families: {list(self.available)}")
 
 
 @dataclass(frozen=True)

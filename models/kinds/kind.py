@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
 from models.kinds.template import KindTemplate
 
@@ -23,6 +23,26 @@ class JointDynamics:
     """Dry friction [N·m or N]: keeps a released component where the robot left it."""
     armature: float = 1e-4
     """Reflected inertia [kg·m² or kg], for numerical stability of light parts."""
+
+
+@dataclass(frozen=True)
+class Handling:
+    """How the robot grasps and moves a kind, and how its marker shows that it moved (the skills read this;
+    they hold no kind names)."""
+
+    grasp: Literal["across_motion", "along_axis"] = "across_motion"
+    """How the fingers close on the handle: ``across_motion``, along the handle's direction of motion at the
+    start (the pads push it: slides, wheels, drawers); ``along_axis``, along the hinge axis, so the handle
+    pivots between the pads like a pin as the part turns and the gripper need not tilt with it (doors, levers)."""
+    verdict: Literal["left_pose", "arc", "tilt"] = "left_pose"
+    """How a marker seen after a try tells that the part moved: ``left_pose``, it left its closed planar pose
+    (moved ``skills.twin_world.MOVED_DISTANCE`` or turned ``MOVED_ANGLE``); ``arc``, the marker centre's turn
+    about the hinge as a fraction of the travel (a door's marker rises with its flap); ``tilt``, the marker's
+    own tilt about the hinge axis as a fraction of the travel (a lever's marker drops a few mm but tilts)."""
+    swings_up: bool = False
+    """Opens by swinging its plate up out of the lid plane (a door): pushed where a pinch cannot hold it,
+    carried past its travel into its end stop, may stand open over its neighbours, and hides its marker when
+    open (the skills' door rules: :mod:`skills.door_push`, :mod:`skills.door_clearance`)."""
 
 
 PartBuilder = Callable[["mjcf.Element", str], "mjcf.Element"]
@@ -47,6 +67,11 @@ class Kind:
     sweep_effort: float
     """Largest effort the twin's ghost-hand sweep applies to open it [N·m or N]: enough to beat friction and
     lift a door, far below what would tear a latch (DESIGN.md: latches held against 100-245 N of robot pull)."""
+    neighbours: tuple[str, ...] = ()
+    """Kinds a component of this kind may lock or be locked by, in a family that holds both (the relation is
+    symmetric: a pair is allowed when either kind names the other). The paper's family pins its own pairs."""
+    handling: Handling = Handling()
+    """How the robot grasps and moves it and reads its marker (see :class:`Handling`)."""
 
     @property
     def name(self) -> str:

@@ -1,18 +1,30 @@
 """The kind registry: every component kind ``models`` can build, by name.
 
-A kind is registered once, as a :class:`~models.kinds.kind.Kind`; builders ask the registry
-(:func:`registered_kind`) and hold no per-kind branches. Registering a kind makes it buildable; it
-does not add it to any family (:mod:`models.kinds.family`), so the paper's boxes never change.
+A kind is one module of this package that defines ``KIND`` (a :class:`~models.kinds.kind.Kind`); the
+registry finds it there, so adding a kind is adding its module (and its tests). Builders, generators and
+the skills ask the registry (:func:`registered_kind`) and hold no per-kind branches. Registering a kind
+makes it buildable and part of :func:`registry_family` (every registered kind); it never enters the
+paper's family (:data:`models.kinds.family.PAPER_FAMILY`), so the paper's boxes never change.
+
+Order: door, slide and wheel (the paper's), then the other kind modules by module name. A kind's integer
+code in :func:`registry_family` is its index in that order; deep-agent checkpoints record the kind list
+they were built for and refuse another.
 """
 
 from __future__ import annotations
 
+import importlib
+import pkgutil
 from collections.abc import Iterable
 
 from models.errors import ModelsError, UnknownKindError
 from models.kinds import door, slide, wheel
+from models.kinds.family import PAPER_FAMILY, KindFamily, UnknownFamilyError
 from models.kinds.kind import Kind
 from models.kinds.template import KindTemplate
+
+_NOT_KINDS = frozenset({"family", "kind", "parts", "registry", "template"})
+"""Modules of this package that hold no kind."""
 
 
 class DuplicateKindError(ModelsError, ValueError):
@@ -63,8 +75,29 @@ class KindRegistry:
         return name in self._kinds
 
 
-BUILTIN_KINDS: tuple[Kind, ...] = (door.KIND, slide.KIND, wheel.KIND)
-"""The kinds this package defines, one module each."""
+PAPER_KINDS: tuple[Kind, ...] = (door.KIND, slide.KIND, wheel.KIND)
+"""The paper's kinds, registered first (their codes in :func:`registry_family` are the paper's)."""
+
+
+def _kind_modules() -> list[str]:
+    """Names of this package's modules that may define a kind, sorted (the paper's excluded)."""
+    package = importlib.import_module("models.kinds")
+    paper = {k.name for k in PAPER_KINDS}
+    return sorted(m.name for m in pkgutil.iter_modules(package.__path__) if m.name not in _NOT_KINDS | paper)
+
+
+def _discover() -> tuple[Kind, ...]:
+    found = []
+    for module_name in _kind_modules():
+        module = importlib.import_module(f"models.kinds.{module_name}")
+        kind = getattr(module, "KIND", None)
+        if isinstance(kind, Kind):
+            found.append(kind)
+    return (*PAPER_KINDS, *found)
+
+
+BUILTIN_KINDS: tuple[Kind, ...] = _discover()
+"""The kinds this package defines, one module each: the paper's, then the others by module name."""
 
 _REGISTRY = KindRegistry(BUILTIN_KINDS)
 """The process-wide registry the builders use."""
@@ -89,3 +122,27 @@ def registered_kinds() -> tuple[str, ...]:
 def get_kind(name: str) -> KindTemplate:
     """The geometry template of a registered kind; :class:`UnknownKindError` lists the registered kinds."""
     return _REGISTRY.get(name).template
+
+
+def registry_family(registry: KindRegistry | None = None) -> KindFamily:
+    """The family of every registered kind (``registry`` or the process-wide one): kinds in registration
+    order, a pair allowed to lock each other when either kind names the other in its ``neighbours``."""
+    registry = registry or _REGISTRY
+    names = registry.names()
+    pairs = {
+        frozenset({kind.name, other})
+        for kind in (registry.get(n) for n in names)
+        for other in kind.neighbours
+        if other in registry
+    }
+    return KindFamily(name="registry", kinds=names, neighbours=frozenset(pairs))
+
+
+def family_named(name: str) -> KindFamily:
+    """A puzzle-box kind family by name: ``paper`` (:data:`~models.kinds.family.PAPER_FAMILY`) or ``all``
+    (:func:`registry_family`); an unknown name lists both."""
+    families = {"paper": PAPER_FAMILY, "all": registry_family()}
+    try:
+        return families[name]
+    except KeyError:
+        raise UnknownFamilyError(name, families) from None

@@ -45,5 +45,13 @@ def build(body: mjcf.Element, name: str) -> mjcf.Element:
     return add_joint(body, name, SLIDE, DYNAMICS)
 
 
-KIND = Kind(template=SLIDE, dynamics=DYNAMICS, colour=COLOUR, build=build, glyph="#DD8452", sweep_effort=3.0)
+KIND = Kind(
+    template=SLIDE,
+    dynamics=DYNAMICS,
+    colour=COLOUR,
+    build=build,
+    glyph="#DD8452",
+    sweep_effort=3.0,
+    neighbours=("door", "wheel"),
+)
 """The slide, as registered (:mod:`models.kinds.registry`)."""

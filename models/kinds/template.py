@@ -54,6 +54,10 @@ class KindTemplate:
     """Centre of the handle post in the component frame, state 0 [m]."""
     footprint: np.ndarray = field(repr=False, compare=False)
     """Convex polygon ``(n, 2)`` [m] in the component frame that the component occupies on the lid."""
+    lift: float = 0.0
+    """Height of the moving plate's bottom above the lid, state 0 [m]: 0 for parts lying on the lid; a part
+    raised on fixed supports (a lever on its bracket) has its marker, handle and joint this much higher,
+    and its builder puts the moving parts in a child body at this height."""
 
     def footprint_in_lid(self, pose: tuple[float, float, float]) -> np.ndarray:
         """The footprint polygon in the lid frame for a component at ``pose`` ``[x, y, yaw]``."""

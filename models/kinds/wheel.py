@@ -52,5 +52,13 @@ def build(body: mjcf.Element, name: str) -> mjcf.Element:
     return add_joint(body, name, WHEEL, DYNAMICS)
 
 
-KIND = Kind(template=WHEEL, dynamics=DYNAMICS, colour=COLOUR, build=build, glyph="#55A868", sweep_effort=0.3)
+KIND = Kind(
+    template=WHEEL,
+    dynamics=DYNAMICS,
+    colour=COLOUR,
+    build=build,
+    glyph="#55A868",
+    sweep_effort=0.3,
+    neighbours=("slide",),
+)
 """The wheel, as registered (:mod:`models.kinds.registry`)."""

@@ -33,7 +33,7 @@ from models.puzzle_box import build_puzzle_box
 
 LEVER = replace(  # a slide along y with its own travel, handle and footprint
     SLIDE,
-    name="lever",
+    name="spinner",
     joint_axis=(0.0, 1.0, 0.0),
     travel=0.03,
     handle_xy=(0.0, -0.035),
@@ -56,12 +56,13 @@ LEVER_KIND = Kind(
     glyph="0.5",
     sweep_effort=1.0,
 )
-"""A throwaway kind that exists only in these tests."""
+"""A throwaway kind (named ``spinner``) that exists only in these tests."""
+THROWAWAY = LEVER.name
 
 
 @pytest.fixture
 def with_lever(monkeypatch):
-    """The process-wide registry extended by the lever, for this test only (restored afterwards)."""
+    """The process-wide registry extended by the throwaway kind, for this test only (restored afterwards)."""
     extended = registry._REGISTRY.copy()
     extended.register(LEVER_KIND)
     monkeypatch.setattr(registry, "_REGISTRY", extended)
@@ -78,31 +79,33 @@ def one_component_spec(kind: str, pose=(0.031, -0.017, 0.6)) -> PuzzleSpec:
     )
 
 
-def test_the_builtin_kinds_are_registered_in_the_paper_order():
-    assert registered_kinds() == ("door", "slide", "wheel")
+def test_the_builtin_kinds_are_registered_paper_first_then_by_module_name():
+    names = registered_kinds()
+    assert names[:3] == ("door", "slide", "wheel") and list(names[3:]) == sorted(names[3:])
+    assert names == tuple(k.name for k in registry.BUILTIN_KINDS)
     for name in registered_kinds():
         assert registered_kind(name).name == name and get_kind(name) is registered_kind(name).template
 
 
 def test_an_unknown_kind_is_refused_listing_the_registered_ones():
     with pytest.raises(UnknownKindError) as err:
-        registered_kind("drawer")
-    assert err.value.kind == "drawer" and err.value.available == ("door", "slide", "wheel")
-    assert "drawer" in str(err.value) and all(k in str(err.value) for k in ("door", "slide", "wheel"))
+        registered_kind("trapdoor")
+    assert err.value.kind == "trapdoor" and err.value.available == tuple(sorted(registered_kinds()))
+    assert "trapdoor" in str(err.value) and all(k in str(err.value) for k in registered_kinds())
     with pytest.raises(UnknownKindError, match="door"):
-        get_kind("drawer")
+        get_kind("trapdoor")
 
 
 def test_an_unknown_kind_in_a_spec_is_refused_by_the_box_builder():
     spec = one_component_spec("door")
     spec = PuzzleSpec(
         name=spec.name,
-        components=(Component(name="x", kind="drawer", pose=(0, 0, 0), marker=0),),
+        components=(Component(name="x", kind="trapdoor", pose=(0, 0, 0), marker=0),),
         locks=(),
         goal=Goal("x", 1),
         box=spec.box,
     )
-    with pytest.raises(UnknownKindError, match="drawer"):
+    with pytest.raises(UnknownKindError, match="trapdoor"):
         build_puzzle_box(spec)
 
 
@@ -110,10 +113,11 @@ def test_a_kind_registered_twice_is_refused():
     fresh = KindRegistry(registry.BUILTIN_KINDS)
     with pytest.raises(DuplicateKindError, match="'door' is already registered") as err:
         fresh.register(registered_kind("door"))
-    assert err.value.registered == ("door", "slide", "wheel")
+    assert err.value.registered == tuple(sorted(registered_kinds()))
+    before = registered_kinds()
     with pytest.raises(DuplicateKindError):
         registry.register(registered_kind("slide"))
-    assert registered_kinds() == ("door", "slide", "wheel")  # the refused registration left no trace
+    assert registered_kinds() == before  # the refused registration left no trace
 
 
 def test_only_kinds_are_registered():
@@ -127,27 +131,27 @@ def test_a_new_kind_changes_neither_the_paper_family_nor_its_boxes(monkeypatch):
     extended = registry._REGISTRY.copy()
     extended.register(LEVER_KIND)
     monkeypatch.setattr(registry, "_REGISTRY", extended)
-    assert "lever" in registered_kinds()  # the builders see it ...
+    assert THROWAWAY in registered_kinds()  # the builders see it ...
     assert (PAPER_FAMILY, KIND_NAMES, ALLOWED_NEIGHBOURS, [kind_code(k) for k in KIND_NAMES]) == family
     assert KIND_NAMES == ("door", "slide", "wheel") and [kind_code(k) for k in KIND_NAMES] == [0, 1, 2]
-    assert not any(may_neighbour("lever", k) for k in (*KIND_NAMES, "lever"))  # ... the paper does not
+    assert not any(may_neighbour(THROWAWAY, k) for k in (*KIND_NAMES, THROWAWAY))  # ... the paper does not
     with pytest.raises(UnknownKindError):
-        kind_code("lever")
+        kind_code(THROWAWAY)
     assert [spec.to_json() for spec in paper_family("all")] == before
 
 
 def test_a_newly_registered_kind_is_built(with_lever):
     model = mujoco.MjModel.from_xml_string(
-        build_puzzle_box(one_component_spec("lever"), with_markers=False).to_xml_string()
+        build_puzzle_box(one_component_spec(THROWAWAY), with_markers=False).to_xml_string()
     )
-    assert model.joint("lever-0:joint").type == mujoco.mjtJoint.mjJNT_SLIDE
+    assert model.joint(f"{THROWAWAY}-0:joint").type == mujoco.mjtJoint.mjJNT_SLIDE
 
 
 def test_the_registry_is_restored_after_a_test():
-    assert "lever" not in registered_kinds()
+    assert THROWAWAY not in registered_kinds()
 
 
-@pytest.mark.parametrize("name", [*registered_kinds(), "lever"])
+@pytest.mark.parametrize("name", [*registered_kinds(), THROWAWAY])
 def test_template_mjcf_and_handle_agree(name, with_lever):
     kind = with_lever.get(name)
     pose = (0.031, -0.017, 0.6)
@@ -160,9 +164,13 @@ def test_template_mjcf_and_handle_agree(name, with_lever):
     expected_xy = transform_points(pose, np.array([kind.template.handle_xy]))[0]
     handle = data.geom(f"{name}-0:handle").xpos
     assert np.allclose(handle[:2], expected_xy, rtol=0, atol=1e-9)
-    assert math.isclose(handle[2], PLATE_THICKNESS + HANDLE_HEIGHT / 2, abs_tol=1e-9)
+    lift = kind.template.lift  # a raised part (a lever on its bracket) stands that much higher
+    assert math.isclose(handle[2], lift + PLATE_THICKNESS + HANDLE_HEIGHT / 2, abs_tol=1e-9)
     site = data.site(f"{name}-0:handle_site").xpos
-    assert np.allclose(site, [*expected_xy, PLATE_THICKNESS + HANDLE_HEIGHT], rtol=0, atol=1e-9)
+    assert np.allclose(site, [*expected_xy, lift + PLATE_THICKNESS + HANDLE_HEIGHT], rtol=0, atol=1e-9)
+    marker = data.geom(f"{name}-0:marker")  # the marker frame is the component frame, on the plate's top
+    assert np.allclose(marker.xpos[:2], pose[:2], atol=1e-9) and marker.xpos[2] > lift + PLATE_THICKNESS
+    assert math.isclose(data.site(f"{name}-0:frame").xpos[2], lift + PLATE_THICKNESS, abs_tol=1e-9)
     joint = model.joint(f"{name}-0:joint")
     t = kind.template
     assert joint.type == {"hinge": mujoco.mjtJoint.mjJNT_HINGE, "slide": mujoco.mjtJoint.mjJNT_SLIDE}[t.joint]
@@ -175,3 +183,13 @@ def test_template_mjcf_and_handle_agree(name, with_lever):
     assert math.isclose(data.xaxis[joint.id][2], t.joint_axis[2], abs_tol=1e-9)
     anchor = transform_points(pose, np.array([t.joint_origin[:2]]))[0]
     assert np.allclose(data.xanchor[joint.id][:2], anchor, atol=1e-9)
+    assert math.isclose(data.xanchor[joint.id][2], lift + PLATE_THICKNESS / 2, abs_tol=1e-9)
+    # the handle the primitives grasp is where the MJCF put it: the skills' joint model from the marker pose
+    from skills.joint_model import GRASP_DEPTH, joint_model
+
+    T = np.eye(4)
+    T[:3, :3] = data.geom(f"{name}-0:marker").xmat.reshape(3, 3)
+    T[:3, 3] = [*pose[:2], marker.xpos[2] - lift]  # perception's upright pose: the marker in the lid's plane
+    jm = joint_model(name, T)
+    assert np.allclose(jm.grasp_point, handle + [0, 0, HANDLE_HEIGHT / 2 - GRASP_DEPTH], atol=1e-3)
+    assert np.allclose(jm.axis, data.xaxis[joint.id], atol=1e-9)
