@@ -4,7 +4,10 @@ The geometry is the compiled MuJoCo model's: the scene of :func:`models.scene.bu
 posed at ``qpos0`` (every component closed) and each geom is turned into triangles at its pose. Parts:
 ``box`` (the shell: every geom of the box that no component carries) and one per component, named by its
 spec name, holding every geom of that component's body subtree (plate or disc, handle, hinge pin and the
-ArUco marker plate, kept as the thin box it is in the model; its texture is not exported).
+ArUco marker plate, kept as the thin box it is in the model; its texture is not exported) and, unless
+``lock_features=False``, the visible lock features whose locker it is (:mod:`models.lock_features`: bolts,
+notches and catches, dark red or black, as :func:`models.puzzle_box.build_puzzle_box` with
+``lock_features=True`` carries them), so a locker's part includes its bolts.
 
 Frame and units: the **lid frame** (origin at the centre of the lid's top face, x along the box length, z
 up; the shell spans ``z`` from ``-height`` to 0), in **metres** — wherever ``spec.box.pose`` puts the box.
@@ -29,6 +32,7 @@ import trimesh
 
 from models.atomic import write_atomically
 from models.errors import ModelsError
+from models.lock_features import lock_features as features_of
 from models.puzzle_box import component_prefixes
 from models.scene import BOX, SceneConfig, build_scene
 from models.spec import PuzzleSpec
@@ -44,9 +48,10 @@ class MeshExportError(ModelsError):
     """A spec whose box cannot be exported as meshes."""
 
 
-def component_meshes(spec: PuzzleSpec) -> dict[str, trimesh.Trimesh]:
+def component_meshes(spec: PuzzleSpec, lock_features: bool = True) -> dict[str, trimesh.Trimesh]:
     """Part name -> mesh (its geoms concatenated, coloured by geom rgba) in the lid frame [m]:
-    ``box`` first, then the components in spec order. Raises :class:`MeshExportError`."""
+    ``box`` first, then the components in spec order; with ``lock_features`` each locker's part also holds
+    its lock features' meshes (:func:`models.lock_features.lock_features`). Raises :class:`MeshExportError`."""
     if spec.box is None:
         raise MeshExportError(f"spec {spec.name!r} has no box (a disassembly scene): only puzzle boxes export")
     if BOX_PART in {c.name for c in spec.components} | set(component_prefixes(spec).values()):
@@ -67,14 +72,19 @@ def component_meshes(spec: PuzzleSpec) -> dict[str, trimesh.Trimesh]:
         taken.update(parts[name])
     shell = [g for g in _subtree_geoms(model, lid) if g not in taken]
     parts = {BOX_PART: shell, **parts}
-    return {name: _part_mesh(model, data, geoms, T_lid_world) for name, geoms in parts.items()}
+    meshes = {name: _part_mesh(model, data, geoms, T_lid_world) for name, geoms in parts.items()}
+    if lock_features:
+        for feature in features_of(spec):
+            meshes[feature.locker] = trimesh.util.concatenate([meshes[feature.locker], feature.mesh])
+    return meshes
 
 
-def export_meshes(spec: PuzzleSpec, out_dir: str | Path) -> list[Path]:
+def export_meshes(spec: PuzzleSpec, out_dir: str | Path, lock_features: bool = True) -> list[Path]:
     """Write ``<name>.glb``, ``<name>.obj``, ``<name>.stl`` (all parts merged) and ``<name>-<part>.stl``
-    per part into ``out_dir`` (created), each atomically; lid frame, metres (module docstring).
+    per part into ``out_dir`` (created), each atomically; lid frame, metres (module docstring); the parts
+    are :func:`component_meshes`'s (lock features included unless ``lock_features=False``).
     ``<name>`` and ``<part>`` in file names have characters outside ``[A-Za-z0-9_.-]`` replaced by '_'."""
-    meshes = component_meshes(spec)
+    meshes = component_meshes(spec, lock_features=lock_features)
     out = Path(out_dir)
     stem = _safe(spec.name)
     scene = trimesh.Scene()

@@ -67,8 +67,14 @@ def component_prefixes(spec: PuzzleSpec) -> dict[str, str]:
     return out
 
 
-def build_puzzle_box(spec: PuzzleSpec, with_markers: bool = True) -> mjcf.RootElement:
-    """The box model of a puzzle-box spec (see the module docstring). Attach it at the lid frame."""
+def build_puzzle_box(spec: PuzzleSpec, with_markers: bool = True, lock_features: bool = False) -> mjcf.RootElement:
+    """The box model of a puzzle-box spec (see the module docstring). Attach it at the lid frame.
+
+    With ``lock_features``, every visible lock feature of :func:`models.lock_features.lock_features` is added
+    to its locker's body (so it moves with the locker's joint) as a visual-only mesh geom
+    ``<locker>:lock:<locked>`` (mesh asset of the same name, vertices in the body frame [m]): no contacts
+    (``contype = conaffinity = 0``), no mass, ``group`` 2. Without it (the default) the model is exactly the one
+    built before lock features existed."""
     if spec.box is None:
         raise ValueError(f"spec {spec.name!r} has no box: not a puzzle box")
     length, width, height = spec.box.size
@@ -84,6 +90,7 @@ def build_puzzle_box(spec: PuzzleSpec, with_markers: bool = True) -> mjcf.RootEl
         rgba=[0.76, 0.64, 0.48, 1],
     )
     prefixes = component_prefixes(spec)
+    bodies: dict[str, mjcf.Element] = {}
     for component in spec.components:
         name = prefixes[component.name]
         x, y, yaw = component.pose
@@ -108,7 +115,43 @@ def build_puzzle_box(spec: PuzzleSpec, with_markers: bool = True) -> mjcf.RootEl
         )
         # the parts rest on the lid: contacts with the shell would only cost time (limits hold them)
         root.contact.add("exclude", name=f"{name}:on_lid", body1=box, body2=body)
+        bodies[component.name] = moving
+    if lock_features:
+        _add_lock_features(root, spec, bodies, prefixes)
     return root
+
+
+def _add_lock_features(
+    root: mjcf.RootElement, spec: PuzzleSpec, bodies: dict[str, mjcf.Element], prefixes: dict[str, str]
+) -> None:
+    """Each lock feature as a visual-only mesh geom in its locker's body (see :func:`build_puzzle_box`)."""
+    from models.lock_features import lock_features as features_of  # imports trimesh only when asked
+
+    poses = {c.name: c.pose for c in spec.components}
+    for feature in features_of(spec):
+        x, y, yaw = poses[feature.locker]
+        c, s = math.cos(yaw), math.sin(yaw)
+        body = bodies[feature.locker]  # the body the locker's joint moves (a child above its fixed parts)
+        raised = 0.0 if body.pos is None else float(body.pos[2])  # a child body stands at its kind's lift
+        shifted = np.asarray(feature.mesh.vertices, dtype=float) - [x, y, raised]
+        local = np.column_stack(
+            [c * shifted[:, 0] + s * shifted[:, 1], -s * shifted[:, 0] + c * shifted[:, 1], shifted[:, 2]]
+        )
+        name = f"{prefixes[feature.locker]}:lock:{prefixes[feature.locked]}"
+        mesh = root.asset.add(
+            "mesh", name=name, vertex=local.ravel().tolist(), face=np.asarray(feature.mesh.faces).ravel().tolist()
+        )
+        body.add(
+            "geom",
+            name=name,
+            type="mesh",
+            mesh=mesh,
+            rgba=list(feature.rgba),
+            contype=0,
+            conaffinity=0,
+            group=2,
+            mass=0,
+        )
 
 
 def yaw_quat(yaw: float) -> list[float]:
