@@ -11,7 +11,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from models.kinds import HANDLE_HEIGHT, Handling, get_kind, registered_kind
 from models.puzzle_box import PLATE_THICKNESS
@@ -65,15 +64,6 @@ class JointModel:
         a -= np.dot(a, self.axis) * self.axis
         b -= np.dot(b, self.axis) * self.axis
         return float(np.arctan2(np.dot(self.axis, cross(a, b)), np.dot(a, b)) / self.travel)
-
-    def tilt_fraction(self, T_closed: np.ndarray, T_seen: np.ndarray) -> float:
-        """Fraction of the travel (signed: positive opens) by which a frame on the part turned about a
-        hinge's axis from ``T_closed`` to ``T_seen`` (4x4, base frame): a marker's own turn, whatever its
-        centre did (a lever's marker near its pivot drops a few mm but tilts with it). Slides: 0."""
-        if self.joint == "slide":
-            return 0.0
-        turn = Rotation.from_matrix(T_seen[:3, :3] @ T_closed[:3, :3].T).as_rotvec()
-        return float(np.dot(turn, self.axis) / self.travel)
 
     def motion_direction(self, fraction: float) -> np.ndarray:
         """Unit direction in which the grasp point moves when opening, at ``fraction`` of the travel."""

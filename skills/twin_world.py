@@ -288,7 +288,7 @@ class TwinWorld:
 
     def _closed_point(self, marker: int) -> np.ndarray:
         """Where ``marker``'s centre is with its part closed, in the base frame [m]."""
-        return np.array([*self.closed_poses[marker][:2], self.lid_height])
+        return np.array([*self.closed_poses[marker][:2], self.lid_height + get_kind(self.marker_map[marker]).lift])
 
     def _remeasure(self, marker: int) -> None:
         """Measure ``marker`` again close up and use it if it is still near its closed pose."""
@@ -308,7 +308,9 @@ class TwinWorld:
     def _overview_verdict(self, marker: int, opening: bool, unseen_moved: bool = True) -> TryResult:
         """Whether the overview agrees that ``marker``'s part moved (``moved``) or shows it where it was
         (``failed``: slipped); when the overview has no trusted view of it, ``moved`` if ``unseen_moved``."""
-        if marker not in self.seen_by_overview:
+        if marker not in self.seen_by_overview or self.joint_models[marker].handling.read_close_up:
+            # a small motion is read close up (a lever's marker moves 12 mm; its tilt, 19 deg, read from the
+            # overview put a lever left at 2 deg at 7 deg, close up at 5 deg: its centre is read within 1 deg)
             return self._close_up_verdict(marker, opening, unseen_moved)
         seen = [d for d in self.survey.overview() if d.marker_id == marker]
         if not seen:
@@ -341,16 +343,12 @@ class TwinWorld:
     def _verdict(self, seen: MarkerDetection, marker: int, opening: bool) -> TryResult:
         """``moved`` if the marker ``seen`` is where the part's other state puts it, as its kind's
         ``Handling.verdict`` reads it: ``arc``, by the fraction of its travel the marker centre turned about the
-        hinge (a door let go part-way has left its closed pose too); ``tilt``, by the marker's own turn about
-        the hinge axis (a lever's marker drops a few mm but tilts); ``left_pose``, by having left its closed
-        pose (``MOVED_DISTANCE``, ``MOVED_ANGLE``) or not."""
+        hinge (a door let go part-way has left its closed pose too; a lever's marker, 12 mm, read close up);
+        ``left_pose``, by having left its closed pose (``MOVED_DISTANCE``, ``MOVED_ANGLE``) or not."""
         jm = self.joint_models[marker]
         if jm.handling.verdict == "arc":
             at = jm.fraction_between(self._closed_point(marker), seen.T_base_marker[:3, 3])
             return self._door_verdict(at, opening)
-        if jm.handling.verdict == "tilt":
-            at = jm.tilt_fraction(upright_pose(self.closed_poses[marker], self.lid_height), seen.T_base_marker)
-            return self._door_verdict(at, opening, stayed="the part stayed where it was")
         delta = seen.planar_pose - self.closed_poses[marker]
         turn = abs(wrap_angle(delta[2]))
         away = bool(np.linalg.norm(delta[:2]) > MOVED_DISTANCE or turn > MOVED_ANGLE)
@@ -358,16 +356,13 @@ class TwinWorld:
             return TryResult("moved")
         return TryResult("failed", "SlipDetected: the handle moved but the marker did not")
 
-    def _door_verdict(self, at: float, opening: bool, stayed: str = "") -> TryResult:
-        """Whether a part (a door, a lever) seen at fraction ``at`` of its travel reached its other state;
-        ``stayed``: the reason of a part seen at its start (default :data:`DOOR_STAYED`, which a door's push
-        follows up)."""
+    def _door_verdict(self, at: float, opening: bool) -> TryResult:
+        """Whether a part (a door, a lever) seen at fraction ``at`` of its travel reached its other state."""
         c = self.toggler.config
         if (at >= c.moved_fraction) if opening else (at <= 1.0 - c.moved_fraction):
             return TryResult("moved")
         if opening and at < c.blocked_progress:
-            reason = f"SlipDetected: {stayed}" if stayed else DOOR_STAYED
-            return TryResult("failed", f"{reason} ({at:.0%} of its travel)")
+            return TryResult("failed", f"{DOOR_STAYED} ({at:.0%} of its travel)")
         return TryResult("failed", f"SlipDetected: the part stands at {at:.0%} of its travel")
 
     def _swings_up(self, marker: int) -> bool:

@@ -34,11 +34,14 @@ class Handling:
     """How the fingers close on the handle: ``across_motion``, along the handle's direction of motion at the
     start (the pads push it: slides, wheels, drawers); ``along_axis``, along the hinge axis, so the handle
     pivots between the pads like a pin as the part turns and the gripper need not tilt with it (doors, levers)."""
-    verdict: Literal["left_pose", "arc", "tilt"] = "left_pose"
+    verdict: Literal["left_pose", "arc"] = "left_pose"
     """How a marker seen after a try tells that the part moved: ``left_pose``, it left its closed planar pose
     (moved ``skills.twin_world.MOVED_DISTANCE`` or turned ``MOVED_ANGLE``); ``arc``, the marker centre's turn
-    about the hinge as a fraction of the travel (a door's marker rises with its flap); ``tilt``, the marker's
-    own tilt about the hinge axis as a fraction of the travel (a lever's marker drops a few mm but tilts)."""
+    about the hinge as a fraction of the travel (a door's marker rises with its flap, a lever's drops)."""
+    read_close_up: bool = False
+    """Whether a try's outcome is always read from the wrist camera close up, not from the overview: a part
+    whose marker moves too little for the overview to tell (a lever's 12 mm: the overview's depth along its
+    line of sight is off by 5-11 mm under a realistic calibration)."""
     swings_up: bool = False
     """Opens by swinging its plate up out of the lid plane (a door): pushed where a pinch cannot hold it,
     carried past its travel into its end stop, may stand open over its neighbours, and hides its marker when
