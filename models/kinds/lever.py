@@ -13,7 +13,8 @@ pivot axis, as on a door: the handle turns between the pads as the arm goes down
 
 Parts: a fixed bracket, two cheeks beside the arm up to the pivot pin (the component body, on the lid), and
 the arm, its handle and marker in the child body ``<name>:arm`` at ``LEVER_LIFT``. Footprint: the bracket
-and the arm, ``[-LEVER_BACK - BRACKET_DEPTH / 2, LEVER_BACK + HANDLE_MARGIN] x [-OUTER_HALF, OUTER_HALF]``.
+and the arm and room for fingers ahead of its handle,
+``[-LEVER_BACK - BRACKET_DEPTH / 2, LEVER_BACK + HANDLE_MARGIN + FINGER_ROOM] x [-OUTER_HALF, OUTER_HALF]``.
 """
 
 from __future__ import annotations
@@ -45,6 +46,10 @@ OUTER_HALF = LEVER_HALF + CHEEK_GAP + CHEEK_WIDTH
 """Half the width of the lever across its cheeks [m]."""
 ARM_LENGTH = LEVER_BACK + LEVER_BACK + HANDLE_MARGIN
 """From the pivot to the arm's free end [m]."""
+FINGER_ROOM = 0.015
+"""Room kept free ahead of the free end [m]: the handle stands 30 mm higher than a door's (71 mm above the lid),
+so a neighbour's fingers coming down beside it need more than the layouts' 15 mm clearance (a slide's knob 32 mm
+from a lever's handle had its finger land on it at 62 N)."""
 
 LEVER = KindTemplate(
     name="lever",
@@ -54,7 +59,9 @@ LEVER = KindTemplate(
     travel=math.radians(19.0),  # sin(19 deg) * 81 mm = 26.4 mm of the 30 mm to the lid
     marker_size=MARKER_SIZE,
     handle_xy=(HANDLE_OFFSET, 0.0),
-    footprint=rectangle(-LEVER_BACK - BRACKET_DEPTH / 2, LEVER_BACK + HANDLE_MARGIN, -OUTER_HALF, OUTER_HALF),
+    footprint=rectangle(
+        -LEVER_BACK - BRACKET_DEPTH / 2, LEVER_BACK + HANDLE_MARGIN + FINGER_ROOM, -OUTER_HALF, OUTER_HALF
+    ),
     lift=LEVER_LIFT,
 )
 DYNAMICS = JointDynamics(damping=0.02, frictionloss=0.03)
