@@ -10,6 +10,7 @@ the reality gap in the twin.
     python scripts/experiment.py sysid --out DIR [--workers W] [--quick]
     python scripts/experiment.py disassembly --agents memory,dual,dqn,model-based --out DIR [--quick] [--runs R]
                                  [--seeds S] [--workers W | --ray ...]
+    python scripts/experiment.py kinds --out DIR [--quick] [--runs R] [--workers W]
 
 Writes ``DIR/<protocol>.json`` (every point, mean and std over training seeds and each seed's value,
 the settings), ``DIR/<protocol>.png`` (success and mean actions, like the paper's Fig. 3 panels) and
@@ -44,6 +45,11 @@ against training episodes (memory: 1-20, with the paper's one-locker belief and 
 ``memory-k2``; the deep agents, with dense rewards: 0-200). It writes ``DIR/disassembly.{json,md,png}``; each
 (agent, training seed) is a task whose record is kept in ``DIR/records/``: the same command resumes.
 
+``kinds`` (``scripts/_kinds_experiment.py``) runs boxes mixing every registered kind (door, slide, wheel,
+drawer, lever): every five-kind chain and 100 random boxes symbolically, and 3 held-out chains end to end in the
+twin under ``ideal`` and ``realistic``, by the memory agent trained on the other chains:
+``DIR/kinds.{json,md,png}``; every step resumes.
+
 ``faults`` (``scripts/_faults.py``) runs each fault class on purpose in real processes — ``trial.py``
 SIGKILLed at random moments and resumed (``--runs`` runs in the twin; ``--quick``: symbolic), concurrent
 trainers on one memory, a memory truncated at every page, the ordinary command-line mistakes — and writes
@@ -71,13 +77,15 @@ REALITY = "reality"
 FAULTS = "faults"
 TWIN_LEARNING = "twin-learning"
 SYSID = "sysid"
+KINDS = "kinds"
 ALL = "all"
 AGENTS = (*SYMBOLIC_AGENTS, *DEEP_AGENTS)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("protocol", choices=(*PROTOCOLS, ALL, REALITY, FAULTS, TWIN_LEARNING, SYSID, DISASSEMBLY))
+    choices = (*PROTOCOLS, ALL, REALITY, FAULTS, TWIN_LEARNING, SYSID, DISASSEMBLY, KINDS)
+    parser.add_argument("protocol", choices=choices)
     parser.add_argument("--agents", default=None, help=f"comma-separated, from {list(AGENTS)} (reality: memory)")
     parser.add_argument("--out", required=True, help="output directory (also the resume cache of deep jobs)")
     parser.add_argument("--quick", action="store_true", help="CI size: few runs, one training seed, short schedules")
@@ -103,6 +111,8 @@ def main(argv: list[str] | None = None) -> int:
         return _sysid(args)
     if args.protocol == DISASSEMBLY:
         return _disassembly(args)
+    if args.protocol == KINDS:
+        return _kinds(args)
     if args.memory is not None:
         fail("--memory is for the reality protocol (the symbolic protocols train their own)")
     agents = _agents(args, AGENTS)
@@ -209,6 +219,21 @@ def _twin_learning(args: argparse.Namespace) -> int:
     except LearningError as err:
         fail(str(err))
     return _report(out, TWIN_LEARNING, summary)
+
+
+def _kinds(args: argparse.Namespace) -> int:
+    from _kinds_experiment import KindsConfig, run_kinds
+
+    given = [f"--{k}" for k in ("agents", "seeds", "ray", "memory") if getattr(args, k) is not None]
+    if given:
+        fail(f"the kinds protocol takes only --out, --runs, --workers and --quick, got {' '.join(given)}")
+    if args.workers is not None and args.workers < 1:
+        fail("--workers must be >= 1")
+    config = _with_runs(KindsConfig().quick() if args.quick else KindsConfig(), args.runs, "runs", 1)
+    out = Path(args.out)
+    _write_config(out, KINDS, args, kinds=asdict(config))
+    summary = run_kinds(out, config, args.workers)
+    return _report(out, KINDS, summary)
 
 
 def _sysid(args: argparse.Namespace) -> int:

@@ -48,3 +48,26 @@ def test_absolute_poses_go_into_the_nodes_and_unknown_encodings_are_config_error
     np.testing.assert_allclose(np.hypot(nodes[:, 7], nodes[:, 8]), 1.0, atol=1e-6)
     with pytest.raises(ConfigError, match="relative"):
         GraphNetworkConfig(poses="polar")
+
+
+def test_features_are_sized_from_the_registry_for_boxes_with_new_kinds_and_a_paper_network_refuses_them():
+    from learning.baselines.graph_network import SceneMismatch
+    from models.generator import generate_chain
+    from models.kinds import registry_family
+
+    spec = generate_chain(["slide", "lever", "drawer", "wheel"], seed=0)
+    config = GraphNetworkConfig.for_spec(spec)
+    assert config.kinds == registry_family().kinds  # the registry's order: door, slide, wheel, drawer, lever
+    observation = SymbolicWorld(spec, seed=0).observe()
+    nodes, _ = observation_tensors(observation, config)
+    assert nodes.shape == (4, len(config.kinds) + 2)
+    for row, kind in zip(nodes, observation.kinds, strict=True):  # one-hot in the network's own kind order
+        assert row[: len(config.kinds)].tolist() == [float(k == kind) for k in config.kinds]
+    paper = GraphNetworkConfig()
+    with pytest.raises(SceneMismatch, match=r"lever") as err:
+        observation_tensors(observation, paper)
+    assert "door', 'slide', 'wheel'" in str(err.value)
+    # a paper box in a registry-family network: the paper kinds keep their one-hot columns
+    paper_observation = SymbolicWorld(paper_family("test")[0], seed=0).observe()
+    paper_nodes, _ = observation_tensors(paper_observation, config)
+    assert paper_nodes[:, 3:5].sum() == 0.0

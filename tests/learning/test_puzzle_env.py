@@ -178,3 +178,15 @@ def test_a_turned_box_turns_the_observed_poses(paper_spec):
     for i in range(5):
         lid_x, lid_y, _ = turned.components[env.spec_index(i)].pose
         np.testing.assert_allclose(obs["poses"][i][:2], [0.3 - lid_y, 0.2 + lid_x], atol=1e-12)
+
+
+def test_boxes_with_new_kinds_code_kinds_in_the_registry_family_and_pass_check_env():
+    from models.generator import generate_chain
+    from models.kinds import registry_family
+
+    spec = generate_chain(["door", "drawer", "lever", "wheel"], seed=1)
+    env = PuzzleEnv(spec)
+    check_env(env, skip_render_check=True)
+    assert env.kind_names == registry_family().kinds
+    obs, _ = env.reset(seed=0)
+    assert sorted(env.kind_names[k] for k in obs["kinds"]) == sorted(spec.kinds)
