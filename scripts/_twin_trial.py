@@ -3,15 +3,15 @@ perception, the agent, the primitives, physics — with a timeline and, optional
 
 from __future__ import annotations
 
+import collections
 import hashlib
 import math
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
-import cv2
 import numpy as np
 
 from learning import RunResult, make_agent, run_episode
@@ -22,10 +22,10 @@ from models.calibration import CellCalibration
 from models.kinds import PUZZLE_KINDS
 from skills import MarkerDetector, SkillError
 from skills.twin_world import TwinWorld
-from twin import Renderer, VideoWriter
 from twin.errors import SimulationDiverged
 from twin.nominal_calibration import nominal_calibration
 from twin.reality import RealityProfile
+from twin.rollout_video import BackgroundRollout, Caption, RolloutFrame, SceneCameras
 from twin.session import TwinSession
 
 CELL_BELIEF = BeliefConfig(jam_probability=0.05)
@@ -36,27 +36,123 @@ jammed on the first try was written off, and the agent tried every other part be
 actions (10 instead of 5) on 2 of 60 realistic trials, +11 on one. With 0.05 those took 7, 10 and 6;
 on the symbolic paper test boxes (300 runs) the mean stays 5.00 actions."""
 
-VIDEO_PERIOD = 0.1
-"""Simulated time between video frames [s] (10 frames per simulated second)."""
 
+class RolloutRecorder:
+    """The robot interface, handing a :class:`twin.rollout_video.RolloutFrame` to the background drawer every
+    ``RolloutConfig.period`` of simulated time: the joint positions, the caption of the action under way, the
+    pipeline's latest detections (:class:`RecordingDetector`) and the recent wrist force the primitives
+    sensed. It reads nothing the pipeline senses (no extra F/T or camera reading: the trial is the same trial
+    with or without video); drawing happens in the other process."""
 
-class RecordingRobot:
-    """The robot interface, recording an overview frame (marker detections drawn) every VIDEO_PERIOD."""
-
-    def __init__(self, robot, renderer: Renderer, writer: VideoWriter, session: TwinSession) -> None:
-        self._robot, self._renderer, self._writer, self._session = robot, renderer, writer, session
-        self._detector = MarkerDetector()
+    def __init__(self, robot, session: TwinSession, rollout: BackgroundRollout, detector: RecordingDetector) -> None:
+        self._robot, self._session, self._rollout, self._detector = robot, session, rollout, detector
+        self._period = rollout.config.period
+        self._window = rollout.config.plot_window
         self._next = 0.0
+        self.caption = Caption()
+        self.force: Callable[[], float | None] = lambda: None
+        """The wrist force the primitives sensed last [N] (set once the world exists)."""
+        self.phase: Callable[[], str] = lambda: "surveying"
+        self._forces: collections.deque[tuple[float, float]] = collections.deque()
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._robot, name)
 
     def wait(self, seconds: float) -> None:
-        self._robot.wait(seconds)
-        if self._robot.time >= self._next:
-            self._next = self._robot.time + VIDEO_PERIOD
-            frame = self._renderer.render(self._session.data, "overview")
-            self._writer.append(annotate(frame, self._detector))
+        # a long wait (a look, a settle) is cut at the frame times, in whole physics steps (the session rounds a
+        # wait to whole steps, at least one): the same steps, so the same trial, and no frame late
+        dt = self._session.model.opt.timestep
+        steps = max(1, round(seconds / dt))
+        while steps:
+            chunk = min(steps, max(1, math.ceil((self._next - self._robot.time) / dt - 1e-6)))
+            self._robot.wait(chunk * dt)
+            steps -= chunk
+            self._after_wait()
+
+    def _after_wait(self) -> None:
+        now = self._robot.time
+        force = self.force()
+        if force is not None:
+            self._forces.append((now, force))
+            while self._forces and self._forces[0][0] < now - self._window:
+                self._forces.popleft()
+        if now >= self._next:
+            while self._next <= now:  # on the fixed grid 0, period, 2 period, ... (a tick may overshoot one)
+                self._next += self._period
+            self._frame(now)
+
+    @staticmethod
+    def ended(caption: Caption) -> str:
+        """How the action of ``caption`` ended, for the next action's caption ("" before the first)."""
+        if not caption.action or not caption.sensed:
+            return ""
+        truth = f" (truth: {caption.truth})" if caption.truth else ""
+        return f"action {caption.action} {caption.component}: {caption.sensed}{truth}"
+
+    def last_frame(self) -> None:
+        """The trial's last frame, whatever the time: it shows how the last action ended."""
+        self._frame(self._robot.time)
+
+    def _frame(self, now: float) -> None:
+        self._rollout.add(
+            RolloutFrame(
+                time=now, qpos=self._session.data.qpos.copy(), caption=replace(self.caption, phase=self.phase()),
+                detections=dict(self._detector.latest), forces=np.array(self._forces, dtype=float).reshape(-1, 2),
+            )
+        )  # fmt: skip
+
+
+class RecordingDetector(MarkerDetector):
+    """The pipeline's marker detector, keeping its latest detections per camera for the rollout video (the
+    video shows what the pipeline detected, never detecting again)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.latest: dict[str, tuple[float, list[tuple[int, np.ndarray]]]] = {}
+        """Camera name -> capture time [s] and detections (marker id, corners [px]) of its latest look."""
+
+    def detect(self, image, camera, T_base_tcp=None):
+        found = super().detect(image, camera, T_base_tcp)
+        if image is not None:
+            self.latest[image.camera] = (image.time, [(d.marker_id, d.corners_px.copy()) for d in found])
+        return found
+
+
+class CaptionedWorld:
+    """The world, telling the recorder which action is under way and how it ended (the sensed outcome and,
+    in evaluation, the truth); ``decisions`` gives the agent's decisions so far (its ``w`` and ``Q``)."""
+
+    def __init__(self, world: TwinWorld, recorder: RolloutRecorder, decisions: Callable[[], list]) -> None:
+        self._world, self._recorder, self._decisions = world, recorder, decisions
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._world, name)
+
+    def observe(self):
+        return self._world.observe()
+
+    def try_toggle(self, index: int):
+        world = self._world
+        marker = world.markers[index]
+        name = (world.names or {}).get(marker, f"marker {marker}")
+        decisions = self._decisions()
+        decision = decisions[-1] if decisions else None
+        previous = self._recorder.caption
+        caption = Caption(
+            previous=self._recorder.ended(previous),
+            action=len(world.log) + 1,
+            component=f"{name} ({world.marker_map[marker]})",
+            weight_info=None if decision is None else float(decision.weight_info),
+            q_info=None if decision is None else float(decision.q_info[index]),
+            q_exploit=None if decision is None else float(decision.q_exploit[index]),
+        )
+        self._recorder.caption = caption
+        result = world.try_toggle(index)
+        truth = world.log[-1].true_moved if world.log else None
+        self._recorder.caption = replace(
+            caption, sensed=result.outcome, truth="" if truth is None else ("moved" if truth else "did not move")
+        )
+        return result
 
 
 class TrueForceWatch:
@@ -120,24 +216,13 @@ class SensedDigest:
         return self._digest.hexdigest()
 
 
-def annotate(frame: np.ndarray, detector: MarkerDetector) -> np.ndarray:
-    """The frame with every detected marker outlined and labelled with its id."""
-    out = np.ascontiguousarray(frame.copy())
-    for d in detector.detect_pixels(frame):
-        corners, marker_id = d
-        cv2.polylines(out, [corners.astype(np.int32)], True, (0, 200, 0), 2)
-        cv2.putText(
-            out, str(marker_id), tuple(int(v) for v in corners[0]), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 120, 0), 1
-        )
-    return out
-
-
 def evaluation_world(
     session: TwinSession,
     robot: Any = None,
     calibration: CellCalibration | None = None,
     seed: int = 0,
     told_kinds: Mapping[str, str] | None = None,
+    detector: MarkerDetector | None = None,
 ) -> TwinWorld:
     """The world a twin trial runs on ``session`` (through ``robot``, default the session's): the spec's
     goal and markers, ``calibration`` (default: the nominal one, exact only under ``ideal``), and — for
@@ -155,6 +240,20 @@ def evaluation_world(
         seed=seed,
         ground_truth=lambda m: int(session.component_states()[by_marker[m]]),
         names={c.marker: c.name for c in spec.components},
+        detector=detector,
+    )
+
+
+def scene_cameras(session: TwinSession) -> SceneCameras:
+    """What the rollout video's views look at in ``session``: its cameras, and its lid for the perspective view."""
+    length, width, _ = session.spec.box.size
+    names, render = session.scene.names, session.config.render
+    return SceneCameras(
+        overview=names.overview_camera,
+        wrist=names.wrist_camera,
+        lid_centre=tuple(float(v) for v in session.scene.T_world_lid[:3, 3]),
+        lid_diagonal=float(np.hypot(length, width)),
+        capture_size=(render.width, render.height),
     )
 
 
@@ -193,31 +292,38 @@ def run_twin_trial(
         spec = session.spec  # placed by the profile, if it places boxes
         told_kinds = wrong_kind(spec, seed) if misreport_kind else {}
         robot = session.robot
-        renderer = writer = None
+        rollout = recorder = detector = None
         if video is not None:
-            renderer = Renderer(session.model)
-            writer = VideoWriter(video, fps=1 / VIDEO_PERIOD)
-            robot = RecordingRobot(robot, renderer, writer, session)
+            rollout = BackgroundRollout(video, session.model, scene_cameras(session))
+            detector = RecordingDetector()
+            robot = recorder = RolloutRecorder(robot, session, rollout, detector)
         robot = watch = TrueForceWatch(robot, session)
         robot = sensed = SensedDigest(robot)
         world = None
         pose_errors: dict[str, float] = {}
         try:
-            world = evaluation_world(session, robot, calibration, seed, told_kinds)
+            world = evaluation_world(session, robot, calibration, seed, told_kinds, detector)
             watch.doing = lambda: f"{world.toggler.phase}, action {len(world.log) + 1}"
             for c in spec.components:  # perceived closed pose against the simulator's (evaluation only)
                 truth = session.data.site(session.scene.names.components[c.name].frame_site).xpos
                 pose_errors[c.name] = float(np.linalg.norm(world.closed_poses[c.marker][:2] - truth[:2]))
             agent = make_agent(agent_name, spec, memory, checkpoint, belief=CELL_BELIEF, max_lockers=max_lockers)
-            result = run_episode(agent, world, spec.name, seed, max_actions, on_action)
+            acting: Any = world
+            if recorder is not None:
+                recorder.phase = lambda: world.toggler.phase
+                recorder.force = lambda: float(np.linalg.norm(world.toggler.force_in_base))
+                acting = CaptionedWorld(world, recorder, lambda: getattr(agent, "decisions", []))
+            result = run_episode(agent, acting, spec.name, seed, max_actions, on_action)
         except (SkillError, SimulationDiverged) as err:  # the cell could not run this trial: say why
             result = RunResult(spec.name, seed, False, len(world.log) if world else 0, 0.0,
                                ended=f"{type(err).__name__}: {err}")  # fmt: skip
-        finally:
-            if writer is not None:
-                writer.close()
-            if renderer is not None:
-                renderer.close()
+        except BaseException:
+            if rollout is not None:
+                rollout.abort()
+            raise
+        if rollout is not None:
+            recorder.last_frame()
+            rollout.close()
         sim_time = session.time
     entry = result.to_dict()
     entry["wall_time_s"] = time.perf_counter() - wall

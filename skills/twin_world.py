@@ -120,9 +120,12 @@ class TwinWorld:
     unsettled: set[int] = field(default_factory=set)
     """Markers of doors a failed try left possibly part-way where no look could see them: looked at before
     they are tried again."""
+    detector: MarkerDetector | None = None
+    """The marker detector every look uses (default a new :class:`MarkerDetector`); a recorder may pass one
+    that also keeps what it found, so a video shows the pipeline's own detections."""
 
     def __post_init__(self) -> None:
-        self.detector = MarkerDetector()
+        self.detector = self.detector or MarkerDetector()
         self.toggler = Toggler(self.robot)
         lifts = {m: get_kind(kind).lift for m, kind in self.marker_map.items()}  # a lever's marker stands higher
         self.survey = SceneSurvey(
