@@ -21,6 +21,11 @@ $(STAMP): pyproject.toml Makefile
 		echo "installing $(GL_PACKAGES)"; \
 		if [ "$$(id -u)" = 0 ]; then apt-get update -qq && apt-get install -y -qq $(GL_PACKAGES) >/dev/null; \
 		else sudo apt-get update -qq && sudo apt-get install -y -qq $(GL_PACKAGES) >/dev/null; fi; }
+	@command -v chromium >/dev/null 2>&1 || { \
+		echo "installing chromium (headless browser for tests/scripts/test_report.py)"; \
+		if [ "$$(id -u)" = 0 ]; then apt-get update -qq && apt-get install -y -qq chromium >/dev/null; \
+		else sudo apt-get update -qq && sudo apt-get install -y -qq chromium >/dev/null; fi; } \
+		|| echo "chromium not installed: the browser test will skip"
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check torch==2.13.0
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e ".[dev,baselines,cluster]"
