@@ -55,6 +55,10 @@ class SceneConfig:
     """Farthest a handle may be from the robot's base axis, horizontally [m] (top-down grasps)."""
     with_markers: bool = True
     """Texture every component with its ArUco marker."""
+    lock_features: bool = False
+    """Add the box's visible lock features as visual-only meshes (geom group 2, no contacts, no mass:
+    :func:`models.puzzle_box.build_puzzle_box`). Off by default: the scene is then exactly the one built before
+    lock features existed."""
     calibration_board: bool = False
     """Add the ChArUco calibration board as a mocap body, hidden in the table until a rig places it
     (``models.charuco.add_board_body``, ``twin.calibration_rig``)."""
@@ -178,7 +182,7 @@ def build_scene(spec: PuzzleSpec, config: SceneConfig | None = None) -> Scene:
 
     robot = build_xarm7(config.robot)
     world.add("site", name="robot_mount", pos=[0, 0, 0], size=[0.001], group=4).attach(robot)
-    box_model = build_puzzle_box(spec, with_markers=config.with_markers)
+    box_model = build_puzzle_box(spec, with_markers=config.with_markers, lock_features=config.lock_features)
     x, y, yaw = box_pose
     world.add("site", name="box_mount", pos=[x, y, height], quat=yaw_quat(yaw), size=[0.001], group=4).attach(box_model)
     if config.calibration_board:

@@ -1,9 +1,13 @@
 """Render a puzzle box in the twin: a PNG from a named camera and, with --video, an MP4 of a scripted
-sweep that opens each unlocked component in turn.
+sweep that opens each unlocked component in turn; or, with --views and/or --turntable, a gallery of the box
+alone with its lock features (twin.gallery).
 
     python scripts/render.py SPEC --out DIR [--camera NAME] [--video] [--seed S]
+    python scripts/render.py SPEC --out DIR [--views] [--turntable [--frames N] [--fps F]]
 
-Writes ``DIR/<camera>.png`` (and ``DIR/sweep.mp4``, ``DIR/sweep.json``) with ``DIR/render.config.json``.
+Writes ``DIR/<camera>.png`` (and ``DIR/sweep.mp4``, ``DIR/sweep.json``); or ``DIR/top.png``,
+``DIR/three-quarter.png``, ``DIR/component-<name>.png`` (--views) and ``DIR/turntable.mp4`` (--turntable);
+always ``DIR/render.config.json``.
 """
 
 from __future__ import annotations
@@ -13,7 +17,7 @@ import json
 from pathlib import Path
 
 import imageio.v3 as iio
-from _cli import fail, versions, write_json
+from _cli import fail, one_line, versions, write_json
 
 from models import ModelsError, SpecError, load_spec
 from twin.errors import TwinError
@@ -27,20 +31,36 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("spec", help="puzzle spec file")
     parser.add_argument("--out", required=True, help="output directory")
-    parser.add_argument("--camera", default="overview", help="camera name (default: overview)")
+    parser.add_argument("--camera", help="camera name (default: overview)")
     parser.add_argument("--video", action="store_true", help="also record the scripted sweep as an MP4")
+    parser.add_argument("--views", action="store_true", help="the box's standard views: top, three-quarter, close-ups")
+    parser.add_argument("--turntable", action="store_true", help="a camera circling the box once, as turntable.mp4")
+    parser.add_argument("--frames", type=int, default=72, help="turntable frames (default: 72, 5 deg apart)")
+    parser.add_argument("--fps", type=float, default=24.0, help="turntable playback rate [frames/s] (default: 24)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--width", type=int, default=640)
     parser.add_argument("--height", type=int, default=480)
     parser.add_argument("--shadows", action="store_true", help="render shadows (3-4x slower on the CPU)")
     args = parser.parse_args(argv)
+    gallery = args.views or args.turntable
+    if gallery and (args.video or args.camera is not None):
+        fail("--camera and --video render the twin's scene; run them apart from --views/--turntable")
+    if args.turntable and (args.frames < 1 or not args.fps > 0):
+        fail(f"--frames must be >= 1 and --fps > 0, got {args.frames} and {args.fps}")
+    if args.turntable and (args.width % 2 or args.height % 2):
+        fail(f"--turntable needs an even --width and --height (H.264 yuv420p), got {args.width}x{args.height}")
+    args.camera = args.camera or "overview"
     try:
+        config = RenderConfig(width=args.width, height=args.height, shadows=args.shadows)
         spec = load_spec(args.spec)
-    except SpecError as err:
-        fail(str(err))
+    except (ValueError, SpecError) as err:
+        fail(one_line(err))
+    if gallery and spec.box is None:
+        fail(f"spec {spec.name!r} is a disassembly scene (no box): --views and --turntable render puzzle boxes")
     out = Path(args.out)
     write_json(out / "render.config.json", {"command": "render", **vars(args), "versions": versions()})
-    config = RenderConfig(width=args.width, height=args.height, shadows=args.shadows)
+    if gallery:
+        return _gallery(spec, out, config, args)
     try:
         with TwinSession(spec, seed=args.seed) as session, Renderer(session.model, config) as renderer:
             png = out / f"{args.camera.replace('/', '_')}.png"
@@ -56,6 +76,22 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"wrote {video}: opened {opened} in {session.time:.1f} s simulated")
     except (ModelsError, TwinError) as err:
         fail(str(err))
+    return 0
+
+
+def _gallery(spec, out: Path, config: RenderConfig, args: argparse.Namespace) -> int:
+    from twin.gallery import Gallery
+
+    try:
+        with Gallery(spec, config) as gallery:
+            if args.views:
+                paths = gallery.write_views(out)
+                print(f"wrote {len(paths)} views to {out}: {', '.join(p.name for p in paths)}")
+            if args.turntable:
+                video = gallery.write_turntable(out / "turntable.mp4", frames=args.frames, fps=args.fps)
+                print(f"wrote {video}: {args.frames} frames at {args.fps:g} frames/s")
+    except (ModelsError, TwinError) as err:
+        fail(one_line(err))
     return 0
 
 

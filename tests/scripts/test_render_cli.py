@@ -30,3 +30,45 @@ def test_render_refuses_an_unknown_camera(tmp_path):
     run(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", tmp_path)
     result = run(ROOT / "scripts/render.py", tmp_path / "paper-test-0.json", "--out", tmp_path / "r", "--camera", "top")
     assert result.returncode == 2 and "overview" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_render_writes_the_views_and_the_turntable_of_a_box(tmp_path):
+    assert run(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", tmp_path).returncode == 0
+    out = tmp_path / "g"
+    result = run(
+        ROOT / "scripts/render.py", tmp_path / "paper-test-1.json", "--out", out, "--views", "--turntable",
+        "--frames", "12", "--width", "320", "--height", "240",
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    components = [c["name"] for c in json.loads((tmp_path / "paper-test-1.json").read_text())["components"]]
+    for name in ["top", "three-quarter", *(f"component-{c}" for c in components)]:
+        image = iio.imread(out / f"{name}.png")
+        assert image.shape == (240, 320, 3) and image.std() > 10, name
+    assert iio.imread(out / "turntable.mp4").shape == (12, 240, 320, 3)
+    config = json.loads((out / "render.config.json").read_text())
+    assert config["views"] and config["turntable"] and config["frames"] == 12
+    assert not (out / "overview.png").exists()  # the gallery draws the box alone, not the twin's cameras
+
+
+def test_render_refuses_command_line_mistakes_on_one_line(tmp_path):
+    run(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", tmp_path)
+    (tmp_path / "broken.json").write_text("{not json")
+    scene = {
+        "format": "puzzlebox-spec/1", "name": "one-screw",
+        "components": [{"name": "s1", "kind": "screw", "pose": [0.0, 0.0, 0.0, 0, 0, 0]}],
+        "locks": [], "goal": {"component": "s1", "state": 1},
+    }  # fmt: skip
+    (tmp_path / "scene.json").write_text(json.dumps(scene))
+    box = tmp_path / "paper-test-0.json"
+    cases = [
+        ([tmp_path / "missing.json", "--views"], "missing.json"),
+        ([tmp_path / "broken.json", "--turntable"], "JSON"),
+        ([tmp_path / "scene.json", "--views"], "no box"),
+        ([box, "--views", "--video"], "--video"),
+        ([box, "--turntable", "--width", "321"], "even"),
+    ]
+    for args, expected in cases:
+        result = run(ROOT / "scripts/render.py", *args, "--out", tmp_path / "r")
+        assert result.returncode == 2, (args, result.stderr)
+        lines = result.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("error:") and expected in lines[0], (args, result.stderr)
