@@ -48,6 +48,7 @@ def trial_task(
     video: str | None = None,
     misreport_kind: bool = False,
     max_lockers: int = 1,
+    record: str | None = None,
 ) -> Task:
     """The task of one run (``reality`` and ``calibration`` as their ``to_dict()``; twin only;
     ``misreport_kind``: one component's kind told wrong, drawn from the seed; ``max_lockers``: the most
@@ -64,7 +65,8 @@ def trial_task(
         settings["misreport_kind"] = True
     if max_lockers != 1:  # likewise: a k = 1 task is the task it was before k existed
         settings["max_lockers"] = max_lockers
-    return Task(key, run_trial, settings, context={"video": video} if video else None)
+    context = {k: v for k, v in (("video", video), ("record", record)) if v}  # outputs: not part of the record
+    return Task(key, run_trial, settings, context=context or None)
 
 
 @lru_cache(maxsize=4)
@@ -75,18 +77,18 @@ def _memory(path: str, sha256: str) -> MemoryStore:
 
 def run_trial(settings: Mapping[str, Any], context: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """Run the trial ``settings`` describe (see :func:`trial_task`); returns its run entry. ``context`` may name
-    a ``video`` file to record (where the rollout goes does not change the record)."""
+    a ``video`` file and a Rerun ``record`` file to write (where they go does not change the record)."""
     spec = spec_from_dict(settings["spec"])
     if _hook is not None:
         _hook.start(f"{spec.name} seed {settings['seed']}")
     try:
-        return _run(spec, settings, (context or {}).get("video"))
+        return _run(spec, settings, (context or {}).get("video"), (context or {}).get("record"))
     finally:
         if _hook is not None:
             _hook.close()
 
 
-def _run(spec: PuzzleSpec, settings: Mapping[str, Any], video: str | None) -> dict[str, Any]:
+def _run(spec: PuzzleSpec, settings: Mapping[str, Any], video: str | None, record: str | None = None) -> dict[str, Any]:
     memory = _memory(settings["memory"], settings["memory_sha256"]) if settings["memory"] else None
     if settings["sim"] == "twin":
         from _twin_trial import run_twin_trial  # MuJoCo and rendering only when asked
@@ -100,7 +102,8 @@ def _run(spec: PuzzleSpec, settings: Mapping[str, Any], video: str | None) -> di
                               Path(video) if video else None,
                               settings["checkpoint"], reality, calibration, on_action=_on_action,
                               misreport_kind=settings.get("misreport_kind", False),
-                              max_lockers=settings.get("max_lockers", 1))  # fmt: skip
+                              max_lockers=settings.get("max_lockers", 1),
+                              record=Path(record) if record else None)  # fmt: skip
     agent = make_agent(
         settings["agent"], spec, memory, settings["checkpoint"], max_lockers=settings.get("max_lockers", 1)
     )

@@ -25,6 +25,7 @@ from skills.twin_world import TwinWorld
 from twin.errors import SimulationDiverged
 from twin.nominal_calibration import nominal_calibration
 from twin.reality import RealityProfile
+from twin.rerun_log import TrialRecording
 from twin.rollout_video import BackgroundRollout, Caption, RolloutFrame, SceneCameras
 from twin.session import TwinSession
 
@@ -81,6 +82,12 @@ class RolloutRecorder:
                 self._next += self._period
             self._frame(now)
 
+    def begin(self, caption: Caption) -> None:
+        self.caption = caption
+
+    def end(self, caption: Caption) -> None:
+        self.caption = caption
+
     @staticmethod
     def ended(caption: Caption) -> str:
         """How the action of ``caption`` ended, for the next action's caption ("" before the first)."""
@@ -110,20 +117,27 @@ class RecordingDetector(MarkerDetector):
         super().__init__()
         self.latest: dict[str, tuple[float, list[tuple[int, np.ndarray]]]] = {}
         """Camera name -> capture time [s] and detections (marker id, corners [px]) of its latest look."""
+        self.listeners: list[Callable[[str, float, list[tuple[int, np.ndarray]]], None]] = []
+        """Called with (camera, capture time, detections) after every look (a Rerun recording's)."""
 
     def detect(self, image, camera, T_base_tcp=None):
         found = super().detect(image, camera, T_base_tcp)
         if image is not None:
-            self.latest[image.camera] = (image.time, [(d.marker_id, d.corners_px.copy()) for d in found])
+            seen = [(d.marker_id, d.corners_px.copy()) for d in found]
+            self.latest[image.camera] = (image.time, seen)
+            for listener in self.listeners:
+                listener(image.camera, image.time, seen)
         return found
 
 
-class CaptionedWorld:
-    """The world, telling the recorder which action is under way and how it ended (the sensed outcome and,
-    in evaluation, the truth); ``decisions`` gives the agent's decisions so far (its ``w`` and ``Q``)."""
+class NarratedWorld:
+    """The world, telling its listeners (the rollout video, the Rerun recording) which action is under way and
+    how it ended: ``begin(caption)`` before the try, ``end(caption)`` after it with the outcome as sensed and,
+    in evaluation, the truth; ``decisions`` gives the agent's decisions so far (its ``w`` and ``Q``)."""
 
-    def __init__(self, world: TwinWorld, recorder: RolloutRecorder, decisions: Callable[[], list]) -> None:
-        self._world, self._recorder, self._decisions = world, recorder, decisions
+    def __init__(self, world: TwinWorld, listeners: list[Any], decisions: Callable[[], list]) -> None:
+        self._world, self._listeners, self._decisions = world, listeners, decisions
+        self._last = Caption()
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._world, name)
@@ -137,22 +151,87 @@ class CaptionedWorld:
         name = (world.names or {}).get(marker, f"marker {marker}")
         decisions = self._decisions()
         decision = decisions[-1] if decisions else None
-        previous = self._recorder.caption
         caption = Caption(
-            previous=self._recorder.ended(previous),
+            previous=RolloutRecorder.ended(self._last),
             action=len(world.log) + 1,
             component=f"{name} ({world.marker_map[marker]})",
             weight_info=None if decision is None else float(decision.weight_info),
             q_info=None if decision is None else float(decision.q_info[index]),
             q_exploit=None if decision is None else float(decision.q_exploit[index]),
         )
-        self._recorder.caption = caption
+        for listener in self._listeners:
+            listener.begin(caption)
         result = world.try_toggle(index)
         truth = world.log[-1].true_moved if world.log else None
-        self._recorder.caption = replace(
+        self._last = replace(
             caption, sensed=result.outcome, truth="" if truth is None else ("moved" if truth else "did not move")
         )
+        for listener in self._listeners:
+            listener.end(self._last)
         return result
+
+
+class RerunRecorder:
+    """The robot interface, logging the trial into a :class:`twin.rerun_log.TrialRecording`: every image the
+    pipeline captured (as captured), and every ``RecordConfig.period`` of simulated time the arm's and the
+    components' poses, the TCP and the wrist force the primitives sensed; as a :class:`NarratedWorld` listener,
+    every decision, outcome and the agent's belief after it. It reads nothing the pipeline senses beyond what the
+    pipeline itself asked for (the same trial with or without a recording)."""
+
+    def __init__(self, robot, session: TwinSession, recording: TrialRecording) -> None:
+        self._robot, self._session, self.recording = robot, session, recording
+        m = session.model
+        names = session.scene.names
+        self._arm = [b for b in range(m.nbody) if m.body(b).name.startswith("xarm7/")]
+        self._arm_names = [m.body(b).name.removeprefix("xarm7/") for b in self._arm]
+        self._components = [m.body(c.body).id for c in names.components.values()]
+        self._component_names = list(names.components)
+        self._tcp = m.site(names.tcp_site).id
+        self._next = 0.0
+        self.force: Callable[[], np.ndarray | None] = lambda: None
+        self.belief: Callable[[], np.ndarray | None] = lambda: None
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._robot, name)
+
+    def capture(self, camera: str):
+        image = self._robot.capture(camera)
+        if image is not None:
+            self.recording.at(image.time)
+            self.recording.image(camera, image.rgb)
+        return image
+
+    def markers(self, camera: str, time: float, detections: list) -> None:
+        self.recording.at(time)
+        self.recording.markers(camera, detections)
+
+    def wait(self, seconds: float) -> None:
+        self._robot.wait(seconds)
+        now = self._robot.time
+        if now < self._next:
+            return
+        while self._next <= now:  # on the grid 0, period, 2 period, ... (a long wait skips points)
+            self._next += self.recording.config.period
+        d = self._session.data
+        bodies = {
+            "world/arm": (self._arm_names, d.xpos[self._arm], d.xquat[self._arm]),
+            "world/components": (self._component_names, d.xpos[self._components], d.xquat[self._components]),
+        }
+        self.recording.sample(now, bodies, d.site_xpos[self._tcp], self.force())
+
+    def begin(self, caption: Caption) -> None:
+        self.recording.at(self._robot.time)
+        values = "" if caption.q_info is None else f": w {caption.weight_info:.3f}, Q_info {caption.q_info:.4f}, "
+        values += "" if caption.q_exploit is None else f"Q_exploit {caption.q_exploit:.4f}"
+        self.recording.decision(f"action {caption.action}: try {caption.component}{values}", caption.weight_info)
+
+    def end(self, caption: Caption) -> None:
+        self.recording.at(self._robot.time)
+        truth = f" (truth: {caption.truth})" if caption.truth else ""
+        self.recording.decision(f"action {caption.action} {caption.component}: {caption.sensed}{truth}")
+        belief = self.belief()
+        if belief is not None:
+            self.recording.belief(belief)
 
 
 class TrueForceWatch:
@@ -244,6 +323,12 @@ def evaluation_world(
     )
 
 
+def agent_belief(agent: Any) -> np.ndarray | None:
+    """The agent's belief as one-locker categoricals ``(N, 2, 1 + 2N)``, or None for an agent without one."""
+    belief = getattr(agent, "belief", None)
+    return None if belief is None else np.array(belief.single_locker_probs(), dtype=float)
+
+
 def scene_cameras(session: TwinSession) -> SceneCameras:
     """What the rollout video's views look at in ``session``: its cameras, and its lid for the perspective view."""
     length, width, _ = session.spec.box.size
@@ -279,24 +364,31 @@ def run_twin_trial(
     on_action: Callable[[Any], None] | None = None,
     misreport_kind: bool = False,
     max_lockers: int = 1,
+    record: Path | None = None,
 ) -> dict[str, Any]:
     """One end-to-end trial; returns the contract's run entry plus a ``timeline`` and figures.
 
     ``reality`` is the twin's reality profile (default ``ideal``); ``calibration`` the cell's camera
     calibration (default: the twin's nominal, datasheet calibration — exact only under ``ideal``);
     ``misreport_kind``: the pipeline is told one component's kind wrong (:func:`wrong_kind`; in the entry as
-    ``told_kinds``); ``max_lockers``: the most lockers the agent's belief allows one component (1: the paper's)."""
+    ``told_kinds``); ``max_lockers``: the most lockers the agent's belief allows one component (1: the paper's);
+    ``record``: a Rerun recording of the trial written there (:mod:`twin.rerun_log`)."""
     wall = time.perf_counter()
     by_marker = {c.marker: i for i, c in enumerate(spec.components)}
     with TwinSession(spec, seed=seed, reality=reality) as session:
         spec = session.spec  # placed by the profile, if it places boxes
         told_kinds = wrong_kind(spec, seed) if misreport_kind else {}
         robot = session.robot
-        rollout = recorder = detector = None
+        rollout = recorder = detector = recording = logger = None
+        if video is not None or record is not None:
+            detector = RecordingDetector()
         if video is not None:
             rollout = BackgroundRollout(video, session.model, scene_cameras(session))
-            detector = RecordingDetector()
             robot = recorder = RolloutRecorder(robot, session, rollout, detector)
+        if record is not None:
+            recording = TrialRecording(record, f"{spec.name}-seed{seed}")
+            robot = logger = RerunRecorder(robot, session, recording)
+            detector.listeners.append(logger.markers)
         robot = watch = TrueForceWatch(robot, session)
         robot = sensed = SensedDigest(robot)
         world = None
@@ -312,7 +404,12 @@ def run_twin_trial(
             if recorder is not None:
                 recorder.phase = lambda: world.toggler.phase
                 recorder.force = lambda: float(np.linalg.norm(world.toggler.force_in_base))
-                acting = CaptionedWorld(world, recorder, lambda: getattr(agent, "decisions", []))
+            if logger is not None:
+                logger.force = lambda: np.array(world.toggler.force_in_base, dtype=float)
+                logger.belief = lambda: agent_belief(agent)
+            listeners = [x for x in (recorder, logger) if x is not None]
+            if listeners:
+                acting = NarratedWorld(world, listeners, lambda: getattr(agent, "decisions", []))
             result = run_episode(agent, acting, spec.name, seed, max_actions, on_action)
         except (SkillError, SimulationDiverged) as err:  # the cell could not run this trial: say why
             result = RunResult(spec.name, seed, False, len(world.log) if world else 0, 0.0,
@@ -320,10 +417,14 @@ def run_twin_trial(
         except BaseException:
             if rollout is not None:
                 rollout.abort()
+            if recording is not None:
+                recording.abort()
             raise
         if rollout is not None:
             recorder.last_frame()
             rollout.close()
+        if recording is not None:
+            recording.close()
         sim_time = session.time
     entry = result.to_dict()
     entry["wall_time_s"] = time.perf_counter() - wall

@@ -14,6 +14,8 @@
   their ratio; overview render time per 640x480 frame without and with shadows;
 - twin trial: simulated/wall time of one oracle twin trial on a paper test box (ideal cell, no video), the
   first in the process (renderer, scene and IK model built) and a second one (kept from the first);
+- twin trial outputs: wall time of the same oracle trial plain, with ``--video`` and with ``--record``, in turn
+  (medians of 3), and the ratios to plain;
 - scale (``scripts/_bench_scale.py``): each executor's overhead per no-op task, and twin trials per hour of
   the same T oracle trials on one worker, on a local pool (one worker per core) and on a local Ray cluster,
   one after the other in this run, with each one's speed-up over one worker: start-up included, and warm
@@ -199,6 +201,35 @@ def twin_trial_figures(quick: bool) -> dict[str, float]:
     return out
 
 
+def rollout_figures(quick: bool) -> dict[str, float]:
+    """Wall time of the same oracle twin trial (first paper test box, ideal cell) plain, with ``--video`` (the
+    multi-view rollout, drawn in a second process) and with ``--record`` (a Rerun recording), in turn after a
+    warm-up trial, ``repeats`` times each: medians and the ratios to plain (targets x1.5 and x1.3)."""
+    import tempfile
+
+    from _twin_trial import run_twin_trial
+
+    from models.generator import paper_family
+
+    spec = paper_family("test")[0]
+    repeats = 1 if quick else 3
+    walls: dict[str, list[float]] = {"plain": [], "video": [], "record": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        run_twin_trial(spec, 0, "oracle", None, 30, None)  # warm-up: renderer, scene, IK model built
+        for k in range(repeats):
+            for label in walls:
+                video = Path(tmp, f"v{k}.mp4") if label == "video" else None
+                record = Path(tmp, f"r{k}.rrd") if label == "record" else None
+                start = time.perf_counter()
+                run_twin_trial(spec, 0, "oracle", None, 30, video, record=record)
+                walls[label].append(time.perf_counter() - start)
+    out = {f"{label}_wall_s": float(np.median(times)) for label, times in walls.items()}
+    out["video_over_plain"] = out["video_wall_s"] / out["plain_wall_s"]
+    out["record_over_plain"] = out["record_wall_s"] / out["plain_wall_s"]
+    out["repeats"] = repeats
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", required=True, help="output JSON file")
@@ -244,6 +275,12 @@ def main(argv: list[str] | None = None) -> int:
             for label in ("first", "second")
             if f"{label}_sim_s" in trial
         )
+    )
+    results["rollout"] = rollout = rollout_figures(args.quick)
+    print(
+        f"twin trial outputs (oracle, ideal, median of {rollout['repeats']}): plain {rollout['plain_wall_s']:.2f} s, "
+        f"--video {rollout['video_wall_s']:.2f} s (x{rollout['video_over_plain']:.2f}), --record "
+        f"{rollout['record_wall_s']:.2f} s (x{rollout['record_over_plain']:.2f})"
     )
     path = write_json(Path(args.out), results)  # what is measured so far is kept if the scale part fails
     trials = args.scale_trials if args.scale_trials is not None else (4 if args.quick else 40)

@@ -9,7 +9,11 @@
 ``--sim twin`` runs each trial end to end in the MuJoCo twin (ArUco perception, the agent, mink
 primitives, F/T outcomes) and adds a per-action ``timeline`` to each run (sensed outcome beside the
 simulator's truth, F/T peak, perceived position error, simulated and wall time) and summary figures;
-``--video`` writes the overview camera's rollout with marker detections drawn (``rollout.mp4`` for a
+``--record FILE.rrd`` writes a Rerun recording of each twin run (``twin/rerun_log.py``: camera images and
+the pipeline's detections, the arm's and components' poses, the TCP path, the wrist force, the agent's belief
+and decisions on the ``sim_time`` timeline; the ``viz`` extra).
+``--video`` writes the multi-view rollout (``twin/rollout_video.py``: overview with the pipeline's detections,
+three-quarter and wrist views, captions, the wrist force; ``rollout.mp4`` and ``rollout.frames.json`` for a
 single run). ``--reality`` picks the twin's reality profile (sensor noise, calibration error,
 friction, jams, slips, the box placed anywhere reachable; default ``ideal``), ``--calibration`` the
 cell's camera calibration made by ``scripts/calibrate.py`` (default: the nominal, datasheet
@@ -124,16 +128,20 @@ def _tasks(args, specs, reality, calibration, out: Path) -> list:
     for i, spec in enumerate(specs):
         for r in range(args.runs):
             seed = args.seed + r
-            video = None
+            video = record = None
+            single = len(specs) * args.runs == 1
             if args.video:
-                name = "rollout.mp4" if len(specs) * args.runs == 1 else f"rollout-{spec.name}-s{seed}.mp4"
+                name = "rollout.mp4" if single else f"rollout-{spec.name}-s{seed}.mp4"
                 video = str((out / name).resolve())
+            if args.record:
+                path = Path(args.record)
+                record = str(path.resolve() if single else path.with_name(f"{path.stem}-{spec.name}-s{seed}.rrd"))
             tasks.append(_trial_task.trial_task(
                 f"{i:03d}-{spec.name}-seed{seed}", spec, seed, sim=args.sim, agent=args.agent,
                 max_actions=args.max_actions, memory=args.memory, checkpoint=args.checkpoint,
                 reality=reality.to_dict() if reality is not None else None,
                 calibration=calibration.to_dict() if calibration is not None else None, video=video,
-                misreport_kind=args.wrong_kind, max_lockers=args.max_lockers,
+                misreport_kind=args.wrong_kind, max_lockers=args.max_lockers, record=record,
             ))  # fmt: skip
     return tasks
 
@@ -178,6 +186,10 @@ def main(argv: list[str] | None = None) -> int:
         help="symbolic memory/dual agents: believe in sets of up to K lockers per component (default 1: the paper's)",
     )  # fmt: skip
     parser.add_argument("--video", action="store_true", help="record rollout videos (twin only)")
+    parser.add_argument(
+        "--record", default=None, metavar="FILE.rrd",
+        help="a Rerun recording of each twin run (one run: FILE.rrd; more: FILE-<spec>-s<seed>.rrd; the viz extra)",
+    )  # fmt: skip
     parser.add_argument(
         "--wrong-kind", action="store_true",
         help="twin: tell the pipeline one component's kind wrong in every run (drawn from the run's seed)",
@@ -226,6 +238,17 @@ def main(argv: list[str] | None = None) -> int:
             fail(f"--max-lockers: {err}")
     if args.video and args.sim != "twin":
         fail("--video needs --sim twin")
+    if args.record is not None:
+        if args.sim != "twin":
+            fail("--record needs --sim twin")
+        if not args.record.endswith(".rrd"):
+            fail(f"--record {args.record}: a Rerun recording file ends in .rrd")
+        if not Path(args.record).resolve().parent.is_dir():
+            fail(f"--record {args.record}: directory {Path(args.record).resolve().parent} does not exist")
+        try:
+            import rerun  # noqa: F401  (the viz extra: refused here in one line, not in every run)
+        except ImportError:
+            fail("--record needs the rerun-sdk package (the viz extra): pip install -e .[viz]")
     if args.sim != "twin" and (args.reality != "ideal" or args.calibration):
         fail("--reality and --calibration need --sim twin")
     if args.sim != "twin" and args.wrong_kind:
@@ -263,7 +286,7 @@ def main(argv: list[str] | None = None) -> int:
 
     out = Path(args.out)
     # where and how it runs changes no record; --robot is twin here (xarm stops above), as before the flag existed
-    not_results = ("out", "resume", "force", "workers", "ray", "robot", "ip", "cell")
+    not_results = ("out", "resume", "force", "workers", "ray", "robot", "ip", "cell", "record")
     experiment = {"command": "trial", **{k: v for k, v in vars(args).items() if k not in not_results}}
     if args.max_lockers == 1:  # the default leaves the configuration as it was before k existed (resumable)
         del experiment["max_lockers"]
