@@ -15,7 +15,7 @@
 - twin trial: simulated/wall time of one oracle twin trial on a paper test box (ideal cell, no video), the
   first in the process (renderer, scene and IK model built) and a second one (kept from the first);
 - twin trial outputs: wall time of the same oracle trial plain, with ``--video`` and with ``--record``, in turn
-  (medians of 3), and the ratios to plain;
+  (medians of 3), and the ratios to plain; the rollout views' box visibility over every frame of 5 trials;
 - scale (``scripts/_bench_scale.py``): each executor's overhead per no-op task, and twin trials per hour of
   the same T oracle trials on one worker, on a local pool (one worker per core) and on a local Ray cluster,
   one after the other in this run, with each one's speed-up over one worker: start-up included, and warm
@@ -34,6 +34,7 @@ import argparse  # noqa: E402
 import platform  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
+from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 from _cli import fail, versions, write_json  # noqa: E402
@@ -230,6 +231,49 @@ def rollout_figures(quick: bool) -> dict[str, float]:
     return out
 
 
+def box_visibility_figures(quick: bool) -> dict[str, float]:
+    """The rollout video's views against the target "every frame shows the box unoccluded in one view": oracle
+    trials (the 3 paper test boxes and two five-kind chains; quick: one), every frame's state kept, and per frame
+    the best view's share of the box's pixels seen with the arm against the same view without it (MuJoCo's
+    segmentation rendering, :meth:`twin.rollout_video.RolloutDrawer.box_visibility`)."""
+    import _twin_trial
+
+    from models.generator import generate_chain, paper_family
+    from twin.rollout_video import RolloutConfig, RolloutDrawer
+
+    kept: dict[str, Any] = {}
+
+    class Keep:  # stands in for the background drawer: the frames' states, in memory
+        def __init__(self, path, model, cameras, config=None):
+            self.config, self.frames = config or RolloutConfig(), []
+            kept.update(rollout=self, model=model, cameras=cameras)
+
+        def add(self, frame):
+            self.frames.append(frame)
+
+        def close(self):
+            return len(self.frames)
+
+        def abort(self):
+            pass
+
+    specs = [*paper_family("test"), generate_chain(["lever", "slide", "door", "drawer", "wheel"], seed=0),
+             generate_chain(["wheel", "drawer", "lever", "door", "slide"], seed=3)][: 1 if quick else 5]  # fmt: skip
+    drawing = _twin_trial.BackgroundRollout
+    _twin_trial.BackgroundRollout = Keep
+    best: list[float] = []
+    try:
+        for spec in specs:
+            _twin_trial.run_twin_trial(spec, 0, "oracle", None, 12, Path("unused.mp4"))
+            drawer = RolloutDrawer(kept["model"], kept["cameras"], kept["rollout"].config)
+            best += [max(drawer.box_visibility(f.qpos).values()) for f in kept["rollout"].frames]
+            drawer.close()
+    finally:
+        _twin_trial.BackgroundRollout = drawing
+    return {"trials": len(specs), "frames": len(best), "worst_frame_best_view": float(min(best)),
+            "frames_below_0.9": int(sum(b < 0.9 for b in best))}  # fmt: skip
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", required=True, help="output JSON file")
@@ -281,6 +325,11 @@ def main(argv: list[str] | None = None) -> int:
         f"twin trial outputs (oracle, ideal, median of {rollout['repeats']}): plain {rollout['plain_wall_s']:.2f} s, "
         f"--video {rollout['video_wall_s']:.2f} s (x{rollout['video_over_plain']:.2f}), --record "
         f"{rollout['record_wall_s']:.2f} s (x{rollout['record_over_plain']:.2f})"
+    )
+    results["box_visibility"] = seen = box_visibility_figures(args.quick)
+    print(
+        f"rollout views: over {seen['frames']} frames of {seen['trials']} trials the best view showed at least "
+        f"{seen['worst_frame_best_view']:.1%} of the box ({seen['frames_below_0.9']} frames below 90 %)"
     )
     path = write_json(Path(args.out), results)  # what is measured so far is kept if the scale part fails
     trials = args.scale_trials if args.scale_trials is not None else (4 if args.quick else 40)
