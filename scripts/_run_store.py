@@ -56,7 +56,8 @@ class RunStore:
         if force:
             shutil.rmtree(self.records_dir, ignore_errors=True)
             (out / "results.json").unlink(missing_ok=True)
-        stale = [*out.glob(".*.tmp"), *out.glob(".rollout*.mp4"), *self.records_dir.glob(".*.tmp")]
+        stale = [*out.glob(".*.tmp"), *out.glob(".rollout*.mp4"), *out.glob(".rollout-model.*.mjb"),
+                 *out.glob(".*.rrd"), *self.records_dir.glob(".*.tmp")]  # fmt: skip
         for path in stale:  # half-written files of a killed run (a normal end or an error removes its own)
             path.unlink(missing_ok=True)
         if stale:

@@ -32,9 +32,11 @@ import multiprocessing
 import os
 import queue
 import tempfile
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import cv2
 import mujoco
@@ -295,12 +297,20 @@ def _draw_frames(model_path: str, cameras: SceneCameras, config: RolloutConfig, 
     """The second process: draw every frame that arrives, write the MP4, report ``ok`` or the error."""
     os.environ.setdefault("MUJOCO_GL", "egl")
     os.environ["LP_NUM_THREADS"] = "1"  # one core for the drawing: the trial renders its cameras on the other
+    writing: list[VideoWriter] = []
+    _watch_parent(multiprocessing.parent_process(), model_path, writing)
     try:
-        model = mujoco.MjModel.from_binary_path(model_path)
-        os.unlink(model_path)
+        try:
+            model = mujoco.MjModel.from_binary_path(model_path)
+        finally:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(model_path)
         drawer = RolloutDrawer(model, cameras, config)
         index = []
-        with VideoWriter(path, fps=config.fps, preset="veryfast") as video:  # left by an exception: no file
+        # no faststart: ffmpeg's second pass reopens the file by name, and would bring back one a dying trial's
+        # watcher (_watch_parent) removed
+        with VideoWriter(path, fps=config.fps, preset="veryfast", faststart=False) as video:
+            writing.append(video)
             while (frame := inbox.get()) is not None:
                 if isinstance(frame, str):  # ABORT: the trial failed; publish nothing
                     raise VideoError("aborted by the trial")
@@ -317,6 +327,25 @@ def _draw_frames(model_path: str, cameras: SceneCameras, config: RolloutConfig, 
         outbox.put(("ok", frames))
     except BaseException as err:  # noqa: BLE001 (reported to the parent, which raises it)
         outbox.put(("error", f"{type(err).__name__}: {err}"))
+
+
+def _watch_parent(parent: Any, model_path: str, writing: list[VideoWriter]) -> None:
+    """If the trial's process dies (a SIGKILL), discard the partial video and the model file and exit: the frame
+    queue never closes (this process holds a copy of its writing end), and a frame cut in half by the kill leaves
+    a read waiting for ever."""
+    if parent is None:
+        return
+
+    def watch() -> None:
+        parent.join()  # returns when the parent's sentinel closes: it exited or was killed
+        # remove the files, then exit at once: an abort() here would wait on ffmpeg while the main thread runs on
+        # (ffmpeg, its input closed by the exit, finishes into the unlinked file and exits)
+        for path in [model_path, *(v.temporary_path for v in writing)]:
+            with contextlib.suppress(FileNotFoundError, TypeError):
+                os.unlink(path)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="rollout-parent-watch", daemon=True).start()
 
 
 def frames_path(video: str | os.PathLike[str]) -> Path:
@@ -355,7 +384,7 @@ class BackgroundRollout:
         self._process = context.Process(
             target=_draw_frames,
             args=(
-                _save_model(model, self.path.parent),
+                self._model_file,
                 cameras,
                 self.config,
                 str(self.path),

@@ -120,28 +120,37 @@ def test_physics_that_diverges_ends_the_run_with_its_name_and_keeps_the_record(s
 
 
 def test_a_video_killed_in_mid_write_never_appears_under_its_final_name(specs, tmp_path):
-    """SIGKILL while the rollout is being encoded: only a hidden temporary is left, the resume removes it
-    and publishes a whole video under the final name."""
+    """SIGKILL while the rollout is being drawn and encoded (in its second process): no video under the final name,
+    the orphaned drawing process discards its partial file and exits, and the resume publishes a whole video."""
     import imageio_ffmpeg
+
+    from twin.rollout_video import RolloutConfig
 
     out = tmp_path / "out"
     command = [sys.executable, ROOT / "scripts/trial.py", "--specs", specs / "paper-test-0.json", "--sim", "twin",
                "--agent", "oracle", "--runs", 1, "--seed", 0, "--max-actions", 6, "--video", "--out", out]  # fmt: skip
     proc = subprocess.Popen(list(map(str, command)), stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 300
-    while time.monotonic() < deadline and proc.poll() is None and not list(out.glob(".rollout*")):
+    while time.monotonic() < deadline and proc.poll() is None and not list(out.glob(".rollout.*.mp4")):
         time.sleep(0.05)
     time.sleep(1.0)  # frames are being written
     assert proc.poll() is None, "the trial ended before the kill"
     proc.send_signal(signal.SIGKILL)
     proc.wait()
-    assert not (out / "rollout.mp4").exists() and list(out.glob(".rollout*")), "only the hidden partial is left"
+    assert not (out / "rollout.mp4").exists(), "a killed trial's video never appears under its final name"
+    deadline = time.monotonic() + 30  # the drawing process sees its queue close, discards its file and exits
+    while time.monotonic() < deadline and list(out.glob(".rollout*")):
+        time.sleep(0.1)
+    assert not list(out.glob(".rollout*")), "the orphaned drawing process left its partial files"
     resumed = python(*command[1:], "--resume")
     assert resumed.returncode == 0, resumed.stderr
-    assert not list(out.glob(".rollout*")), "the killed run's partial video is removed"
+    assert not list(out.glob(".rollout*"))
     reader = imageio_ffmpeg.read_frames(str(out / "rollout.mp4"))
     meta = next(reader)
-    assert meta["size"] == (640, 480) and sum(1 for _ in reader) > 100, "a whole video: every frame decodes"
+    config = RolloutConfig()
+    width, height = config.view_size
+    assert meta["size"] == (3 * width, height + config.caption_height + config.plot_height)
+    assert sum(1 for _ in reader) > 50, "a whole video: every frame decodes"
 
 
 def test_ctrl_c_to_a_pool_trial_stops_after_the_runs_in_flight_and_keeps_them(specs, tmp_path):

@@ -125,7 +125,7 @@ def test_random_graphs_are_deterministic_valid_solvable_and_local(n, multi, seed
 
 
 @pytest.mark.parametrize(
-    "kinds", [["door", "wheel"], ["door", "door"], ["slide", "slide", "door"], ["door"], ["door", "lever"]]
+    "kinds", [["door", "wheel"], ["door", "door"], ["slide", "slide", "door"], ["door"], ["door", "trapdoor"]]
 )
 def test_chain_with_forbidden_neighbours_or_kinds_is_a_clear_error(kinds):
     with pytest.raises(GeneratorError) as info:

@@ -98,7 +98,7 @@ def test_box_stands_at_its_pose_with_components_at_their_lid_poses():
 
 
 def test_unknown_kind_is_a_clear_error_listing_known_kinds():
-    spec = PuzzleSpec("odd", (Component("lever-1", "lever", (0.0, 0.0, 0.0), 0),), (), Goal("lever-1"),
+    spec = PuzzleSpec("odd", (Component("trapdoor-1", "trapdoor", (0.0, 0.0, 0.0), 0),), (), Goal("trapdoor-1"),
                       Box((0.3, 0.3, 0.08), (0.45, 0.0, 0.0)))  # fmt: skip
     with pytest.raises(UnknownKindError, match="door"):
         build_scene(spec)

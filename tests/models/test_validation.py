@@ -48,8 +48,8 @@ def test_missing_format_is_rejected(spec_dict):
 
 
 def test_unknown_kind_names_the_component_and_lists_known_kinds(spec_dict):
-    spec_dict["components"][0]["kind"] = "drawer"
-    only_problem(spec_dict, "'door-1'", "drawer", "door", "slide", "wheel")
+    spec_dict["components"][0]["kind"] = "trapdoor"
+    only_problem(spec_dict, "'door-1'", "trapdoor", "door", "slide", "wheel", "lever", "drawer")
 
 
 def test_duplicate_names_are_rejected(spec_dict):
@@ -159,7 +159,7 @@ def test_a_duplicate_json_key_is_rejected(spec_dict):
 
 def test_every_problem_is_listed_at_once(spec_dict):
     spec_dict["format"] = "other"
-    spec_dict["components"][0]["kind"] = "drawer"
+    spec_dict["components"][0]["kind"] = "trapdoor"
     spec_dict["locks"][0]["locked_state"] = 7
     spec_dict["goal"]["component"] = "ghost"
     with pytest.raises(SpecError) as info:

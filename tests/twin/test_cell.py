@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from models.generator import paper_family
-from models.kinds import KIND_NAMES
+from models.kinds import KIND_NAMES, registered_kinds
 from twin.cell import draw_cell
 from twin.reality import IDENTITY, PRESETS, PhysicsReality, RealityProfile, ScaleRange
 from twin.session import TwinSession
@@ -33,7 +33,7 @@ def test_kind_factors_are_one_per_kind_and_drawn_from_the_cell_seed_only():
     for table, scale in ((kinds.joint_damping, realistic.physics.kind_joint_damping_scale),
                          (kinds.joint_friction, realistic.physics.kind_joint_friction_scale),
                          (kinds.latch_compliance, realistic.physics.kind_latch_compliance_scale)):  # fmt: skip
-        assert list(table) == list(KIND_NAMES)
+        assert list(table) == list(registered_kinds())  # the paper's first, drawn as before; then each new kind
         assert all(scale.low <= f <= scale.high for f in table.values())
     assert kinds != other
 
@@ -116,3 +116,19 @@ def test_realistic_draws_the_box_hardware_per_cell_and_only_jitter_per_trial():
     assert (physics.kind_latch_compliance_scale.low, physics.kind_latch_compliance_scale.high) == (1.0, 2.0)
     for jitter in (physics.joint_damping_scale, physics.joint_friction_scale, physics.latch_compliance_scale):
         assert jitter.high - jitter.low == pytest.approx(0.1)
+
+
+def test_registering_a_kind_changes_no_paper_kinds_hardware(monkeypatch):
+    """A kind beyond the paper's draws its factors from a stream of its own: the paper kinds' factors are the ones
+    a registry of the paper's kinds alone draws, and each new kind's do not depend on which others exist."""
+    import twin.cell
+
+    realistic = PRESETS["realistic"]
+    full = draw_cell(realistic, CAMERAS).kinds
+    monkeypatch.setattr(twin.cell, "registered_kinds", lambda: KIND_NAMES)
+    paper_only = draw_cell(realistic, CAMERAS).kinds
+    monkeypatch.setattr(twin.cell, "registered_kinds", lambda: (*KIND_NAMES, "lever"))
+    with_lever = draw_cell(realistic, CAMERAS).kinds
+    for table in ("joint_damping", "joint_friction", "latch_compliance"):
+        assert getattr(paper_only, table) == {k: getattr(full, table)[k] for k in KIND_NAMES}
+        assert getattr(with_lever, table)["lever"] == getattr(full, table)["lever"]
