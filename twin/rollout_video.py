@@ -59,8 +59,8 @@ class RolloutConfig:
     period: float = 1.0
     """Simulated time between frames [s]: one frame per simulated second (a toggle of ~12 s gets ~12). A frame
     costs ~15 ms of a core (three renders of ~4 ms: the arm's meshes, whatever the size); drawn beside the
-    trial on the other core, a video at this rate made a 3.1 s trial 4.6 s (x1.42), at 2 frames per simulated
-    second 6.8 s (x2.1)."""
+    trial on the other core, a video at this rate made a 2.9 s ``trial.py`` run 3.9 s (x1.34), at 2 frames per
+    simulated second x2.1."""
     fps: float = 5.0
     """Playback rate [frames/s]: with ``period`` 1 s, five times real time."""
     view_size: tuple[int, int] = (320, 240)
@@ -293,24 +293,37 @@ class RolloutDrawer:
         self.renderer.close()
 
 
-def _draw_frames(model_path: str, cameras: SceneCameras, config: RolloutConfig, path: str, inbox, outbox) -> None:
-    """The second process: draw every frame that arrives, write the MP4, report ``ok`` or the error."""
+def _serve(inbox, outbox) -> None:
+    """The drawing process: one video per job, for as long as the trial's process lives. A job is
+    ``(model_path, cameras, config, path)`` then its frames then ``None`` (publish) or :data:`ABORT` (discard);
+    ``None`` instead of a job ends the process. A failed job ends it too (its parent starts another)."""
     os.environ.setdefault("MUJOCO_GL", "egl")
     os.environ["LP_NUM_THREADS"] = "1"  # one core for the drawing: the trial renders its cameras on the other
-    writing: list[VideoWriter] = []
-    _watch_parent(multiprocessing.parent_process(), model_path, writing)
-    try:
+    current: dict[str, Any] = {"model": None, "video": None}
+    _watch_parent(multiprocessing.parent_process(), current)
+    while (job := inbox.get()) is not None:
         try:
-            model = mujoco.MjModel.from_binary_path(model_path)
-        finally:
-            with contextlib.suppress(FileNotFoundError):
-                os.unlink(model_path)
-        drawer = RolloutDrawer(model, cameras, config)
-        index = []
+            outbox.put(("ok", _draw_video(*job, inbox, current)))
+        except BaseException as err:  # noqa: BLE001 (reported to the parent, which raises it)
+            outbox.put(("error", f"{type(err).__name__}: {err}"))
+            return
+
+
+def _draw_video(model_path: str, cameras: SceneCameras, config: RolloutConfig, path: str, inbox, current) -> int:
+    """One job of :func:`_serve`: draw every frame that arrives, write the MP4 and its index; the frame count."""
+    current["model"] = model_path
+    try:
+        model = mujoco.MjModel.from_binary_path(model_path)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(model_path)
+    drawer = RolloutDrawer(model, cameras, config)
+    index = []
+    try:
         # no faststart: ffmpeg's second pass reopens the file by name, and would bring back one a dying trial's
         # watcher (_watch_parent) removed
         with VideoWriter(path, fps=config.fps, preset="veryfast", faststart=False) as video:
-            writing.append(video)
+            current["video"] = video
             while (frame := inbox.get()) is not None:
                 if isinstance(frame, str):  # ABORT: the trial failed; publish nothing
                     raise VideoError("aborted by the trial")
@@ -320,16 +333,16 @@ def _draw_frames(model_path: str, cameras: SceneCameras, config: RolloutConfig, 
                               "sensed": c.sensed, "truth": c.truth, "phase": c.phase,
                               "previous": c.previous})  # fmt: skip
             frames = video.frame_count
+    finally:
+        current["video"] = None
         drawer.close()
-        sidecar = {"video": Path(path).name, "period_s": config.period, "fps": config.fps, "views": list(VIEWS),
-                   "view_size": list(config.view_size), "frames": index}  # fmt: skip
-        write_atomically(frames_path(path), lambda tmp: tmp.write_text(json.dumps(sidecar, indent=1)))
-        outbox.put(("ok", frames))
-    except BaseException as err:  # noqa: BLE001 (reported to the parent, which raises it)
-        outbox.put(("error", f"{type(err).__name__}: {err}"))
+    sidecar = {"video": Path(path).name, "period_s": config.period, "fps": config.fps, "views": list(VIEWS),
+               "view_size": list(config.view_size), "frames": index}  # fmt: skip
+    write_atomically(frames_path(path), lambda tmp: tmp.write_text(json.dumps(sidecar, indent=1)))
+    return frames
 
 
-def _watch_parent(parent: Any, model_path: str, writing: list[VideoWriter]) -> None:
+def _watch_parent(parent: Any, current: dict[str, Any]) -> None:
     """If the trial's process dies (a SIGKILL), discard the partial video and the model file and exit: the frame
     queue never closes (this process holds a copy of its writing end), and a frame cut in half by the kill leaves
     a read waiting for ever."""
@@ -340,12 +353,44 @@ def _watch_parent(parent: Any, model_path: str, writing: list[VideoWriter]) -> N
         parent.join()  # returns when the parent's sentinel closes: it exited or was killed
         # remove the files, then exit at once: an abort() here would wait on ffmpeg while the main thread runs on
         # (ffmpeg, its input closed by the exit, finishes into the unlinked file and exits)
-        for path in [model_path, *(v.temporary_path for v in writing)]:
+        video = current["video"]
+        for path in (current["model"], None if video is None else video.temporary_path):
             with contextlib.suppress(FileNotFoundError, TypeError):
                 os.unlink(path)
         os._exit(1)
 
     threading.Thread(target=watch, name="rollout-parent-watch", daemon=True).start()
+
+
+class _Server:
+    """The drawing process and its queues, kept across the videos of one trial process (a worker running trial
+    after trial pays its start-up, ~0.7 s, once)."""
+
+    def __init__(self) -> None:
+        context = multiprocessing.get_context("spawn")  # a fresh process: no GL context inherited
+        self.inbox, self.outbox = context.Queue(maxsize=512), context.Queue()
+        self.process = context.Process(target=_serve, args=(self.inbox, self.outbox), daemon=True)
+        self.process.start()
+
+    def alive(self) -> bool:
+        return self.process.is_alive()
+
+    def stop(self) -> None:
+        with contextlib.suppress(Exception):
+            self.inbox.cancel_join_thread()
+        if self.process.is_alive():
+            self.process.terminate()
+        self.process.join(timeout=10)
+
+
+_server: _Server | None = None
+
+
+def _drawing_server() -> _Server:
+    global _server
+    if _server is None or not _server.alive():
+        _server = _Server()
+    return _server
 
 
 def frames_path(video: str | os.PathLike[str]) -> Path:
@@ -365,11 +410,12 @@ def _save_model(model: mujoco.MjModel, directory: Path) -> str:
 
 
 class BackgroundRollout:
-    """Draws and writes a rollout video in a second process while the trial runs.
+    """Draws and writes a rollout video in a second process while the trial runs (one process per trial process,
+    kept for its next videos).
 
     ``add(frame)`` hands a frame over (it returns at once); ``close()`` waits for the last frames, publishes
     the MP4 and raises :class:`VideoError` if the drawing failed; ``abort()`` (or leaving a ``with`` block by an
-    exception) stops the process and leaves no file.
+    exception) discards the video and leaves no file.
     """
 
     def __init__(self, path: str | os.PathLike[str], model: mujoco.MjModel, cameras: SceneCameras,
@@ -378,59 +424,51 @@ class BackgroundRollout:
         if not self.path.parent.is_dir():
             raise VideoError(f"cannot write {self.path}: directory {self.path.parent} does not exist")
         self.config = config or RolloutConfig()
-        context = multiprocessing.get_context("spawn")  # a fresh process: no GL context inherited
+        self._server = _drawing_server()
         self._model_file = _save_model(model, self.path.parent)  # the process reads and removes it
-        self._inbox, self._outbox = context.Queue(maxsize=512), context.Queue()
-        self._process = context.Process(
-            target=_draw_frames,
-            args=(
-                self._model_file,
-                cameras,
-                self.config,
-                str(self.path),
-                self._inbox,
-                self._outbox,
-            ),
-            daemon=True,
-        )
-        self._process.start()
+        self._server.inbox.put((self._model_file, cameras, self.config, str(self.path)))
         self.frames_sent = 0
 
     def add(self, frame: RolloutFrame) -> None:
-        self._inbox.put(frame)
+        """Hand ``frame`` over; :class:`VideoError` if the drawing process has died (checked every 16 frames)."""
+        if self.frames_sent % 16 == 0 and not self._server.alive():
+            self._dead()
+        self._server.inbox.put(frame)
         self.frames_sent += 1
+
+    def _dead(self) -> None:
+        self._server.stop()
+        self._remove_model_file()
+        raise VideoError(f"the rollout drawing process died (exit code {self._server.process.exitcode})")
 
     def close(self, timeout: float = 600.0) -> int:
         """Finish the video; returns its frame count."""
-        self._inbox.put(None)
-        deadline = time.monotonic() + timeout
-        while True:
-            try:
-                status, value = self._outbox.get(timeout=1.0)
-                break
-            except queue.Empty:
-                if not self._process.is_alive():  # died without a word (killed, or could not start)
-                    self._remove_model_file()
-                    raise VideoError(f"the rollout drawing process died (exit code {self._process.exitcode})") from None
-                if time.monotonic() > deadline:
-                    self.abort()
-                    raise VideoError(f"the rollout drawing process gave no answer in {timeout:.0f} s") from None
-        self._process.join(timeout=30)
+        self._server.inbox.put(None)
+        status, value = self._answer(timeout)
         self._remove_model_file()
         if status != "ok":
             raise VideoError(f"drawing the rollout video failed: {value}")
         return int(value)
 
+    def _answer(self, timeout: float) -> tuple[str, Any]:
+        deadline = time.monotonic() + timeout
+        while True:
+            try:
+                return self._server.outbox.get(timeout=1.0)
+            except queue.Empty:
+                if not self._server.alive():  # died without a word (killed, or could not start)
+                    self._dead()
+                if time.monotonic() > deadline:
+                    self._server.stop()
+                    self._remove_model_file()
+                    raise VideoError(f"the rollout drawing process gave no answer in {timeout:.0f} s") from None
+
     def abort(self) -> None:
-        """Stop drawing and leave no file (the process discards its partial video; killed if it hangs)."""
+        """Discard the video and leave no file (the process drops its partial video; stopped if it hangs)."""
         with contextlib.suppress(Exception):
-            self._inbox.put(ABORT, timeout=1.0)
-        self._process.join(timeout=30)
-        if self._process.is_alive():
-            self._process.terminate()
-            self._process.join(timeout=10)
-        with contextlib.suppress(Exception):
-            self._inbox.cancel_join_thread()
+            self._server.inbox.put(ABORT, timeout=1.0)
+            self._answer(30.0)  # the job's "error: aborted": the process ends (the next video starts another)
+        self._server.stop()
         self._remove_model_file()
 
     def _remove_model_file(self) -> None:
