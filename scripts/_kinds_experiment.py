@@ -152,7 +152,7 @@ def run_kinds(out: Path, config: KindsConfig, workers: int | None) -> dict[str, 
         one_seed = [*settings[: settings.index("--runs") + 1], "1", *settings[settings.index("--runs") + 2 :]]
         name = f"twin-random-{config.profiles[-1]}"
         results[name] = _trial(out / name, sets["random"][: config.twin_random], one_seed)
-    optimum = {load_spec(p).name: _optimum(p) for paths in sets.values() for p in paths}
+    optimum = dict(_optimum(load_spec(p)) for paths in sets.values() for p in paths)
     summary = {
         "config": asdict(config),
         "kinds": list(registry_family().kinds),
@@ -166,9 +166,10 @@ def run_kinds(out: Path, config: KindsConfig, workers: int | None) -> dict[str, 
     return summary
 
 
-def _optimum(path: Path) -> int:
-    plan = LockTable.from_spec(load_spec(path)).shortest_solution()
-    return len(plan) if plan is not None else 0
+def _optimum(spec: PuzzleSpec) -> tuple[str, int]:
+    """``(name, fewest actions that solve it)``: the lock table's shortest solution."""
+    plan = LockTable.from_spec(spec).shortest_solution()
+    return spec.name, len(plan) if plan is not None else 0
 
 
 def _figures(result: dict[str, Any], optimum: dict[str, int]) -> dict[str, Any]:

@@ -25,6 +25,8 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import quote
 
+from _cli import one_line
+
 OUTCOME_COLOURS = {"moved": "#2e9d4a", "blocked": "#9aa3ad", "failed": "#d1495b"}
 OTHER_COLOUR = "#8e6bbf"
 """Colour of a sensed outcome not in :data:`OUTCOME_COLOURS`."""
@@ -55,7 +57,7 @@ def _read_json(path: Path) -> Any:
     try:
         return json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
-        raise ReportError(f"cannot read {path}: {' '.join(str(err).split())}") from None
+        raise ReportError(f"cannot read {path}: {one_line(err)}") from None
 
 
 def load_results_dir(path: str | Path) -> ResultsDir:
@@ -85,6 +87,8 @@ def load_results_dir(path: str | Path) -> ResultsDir:
         if not isinstance(listed, list) or not all(isinstance(r, dict) for r in listed):
             raise ReportError(f"{results_path}: 'runs' must be a list of run objects")
         runs = [(f"run-{i:03d}", r) for i, r in enumerate(listed)]
+    if not runs:
+        raise ReportError(f"{path} holds no runs: its results.json lists none and runs/ has no record")
     for key, record in runs:
         for name in ("solved", "num_actions"):
             if name not in record:
@@ -162,9 +166,9 @@ def summary_table(data: ResultsDir) -> str:
     if not rows:  # no results.json: from the records
         solved = [r["solved"] for _, r in data.runs]
         rows = [[esc("success rate"), pct(sum(solved) / len(solved))], [esc("runs"), fmt(len(solved))]]
-    for key in ("failed_tries_by_reason",):
-        if res.get(key):
-            rows.append([esc("failed tries by reason"), esc(", ".join(f"{k}: {v}" for k, v in res[key].items()))])
+    if res.get("failed_tries_by_reason"):
+        reasons = res["failed_tries_by_reason"].items()
+        rows.append([esc("failed tries by reason"), esc(", ".join(f"{k}: {v}" for k, v in reasons))])
     for line in res.get("unsolved_reasons") or []:
         rows.append([esc("unsolved"), esc(line)])
     return _table(["figure", "value"], rows, "summary")

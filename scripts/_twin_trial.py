@@ -48,6 +48,7 @@ class RolloutRecorder:
     def __init__(self, robot, session: TwinSession, rollout: BackgroundRollout, detector: RecordingDetector) -> None:
         self._robot, self._session, self._rollout, self._detector = robot, session, rollout, detector
         self._period = rollout.config.period
+        self._dt = session.model.opt.timestep  # [s] read once: a model attribute is a binding call per tick
         self._window = rollout.config.plot_window
         self._next = 0.0
         self.caption = Caption()
@@ -62,7 +63,7 @@ class RolloutRecorder:
     def wait(self, seconds: float) -> None:
         # a long wait (a look, a settle) is cut at the frame times, in whole physics steps (the session rounds a
         # wait to whole steps, at least one): the same steps, so the same trial, and no frame late
-        dt = self._session.model.opt.timestep
+        dt = self._dt
         steps = max(1, round(seconds / dt))
         while steps:
             chunk = min(steps, max(1, math.ceil((self._next - self._robot.time) / dt - 1e-6)))
@@ -87,14 +88,6 @@ class RolloutRecorder:
 
     def end(self, caption: Caption) -> None:
         self.caption = caption
-
-    @staticmethod
-    def ended(caption: Caption) -> str:
-        """How the action of ``caption`` ended, for the next action's caption ("" before the first)."""
-        if not caption.action or not caption.sensed:
-            return ""
-        truth = f" (truth: {caption.truth})" if caption.truth else ""
-        return f"action {caption.action} {caption.component}: {caption.sensed}{truth}"
 
     def last_frame(self) -> None:
         """The trial's last frame, whatever the time: it shows how the last action ended."""
@@ -152,7 +145,7 @@ class NarratedWorld:
         decisions = self._decisions()
         decision = decisions[-1] if decisions else None
         caption = Caption(
-            previous=RolloutRecorder.ended(self._last),
+            previous=self._last.ending(),
             action=len(world.log) + 1,
             component=f"{name} ({world.marker_map[marker]})",
             weight_info=None if decision is None else float(decision.weight_info),

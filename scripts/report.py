@@ -25,7 +25,7 @@ import subprocess
 import time
 from pathlib import Path
 
-from _cli import fail
+from _cli import fail, one_line
 from _report_html import ReportError, build_page, load_results_dir
 
 from models.atomic import write_text_atomically
@@ -56,7 +56,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     directory = Path(args.dir)
     page = Path(args.out) if args.out else directory / "report.html"
-    if page.exists() and page.is_dir():
+    if page.is_dir():
         fail(f"--out {page} is a directory: give a file name (FILE.html)")
     try:
         data = load_results_dir(directory)
@@ -65,7 +65,7 @@ def main(argv: list[str] | None = None) -> int:
     except ReportError as err:
         fail(str(err))
     except OSError as err:
-        fail(f"cannot write {page}: {' '.join(str(err).split())}")
+        fail(f"cannot write {page}: {one_line(err)}")
     size = page.stat().st_size
     line = (
         f"{data.kind} report: {len(data.runs)} run(s), {len(data.cells)} cell(s), {len(data.videos)} video(s) "

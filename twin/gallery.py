@@ -42,6 +42,7 @@ import imageio.v3 as iio
 import mujoco
 import numpy as np
 
+from models.atomic import write_atomically
 from models.kinds import get_kind
 from models.scene import ROBOT, Scene, SceneConfig, build_scene
 from models.spec import PuzzleSpec
@@ -347,7 +348,8 @@ class Gallery:
         paths = []
         for view in self.views():
             path = out / f"{view.name}.png"
-            iio.imwrite(path, self.render(view))
+            image = self.render(view)
+            write_atomically(path, lambda tmp, image=image: iio.imwrite(tmp, image, extension=".png"))
             paths.append(path)
         return paths
 

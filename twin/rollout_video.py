@@ -113,6 +113,13 @@ class Caption:
     """How the action before this one ended (e.g. ``action 1 door-0: moved (truth: moved)``): the frames
     after an action ends are the next action's, or the trial's last frame."""
 
+    def ending(self) -> str:
+        """How this caption's action ended, as the next caption's :attr:`previous` says it ("" before it ended)."""
+        if not self.action or not self.sensed:
+            return ""
+        truth = f" (truth: {self.truth})" if self.truth else ""
+        return f"action {self.action} {self.component}: {self.sensed}{truth}"
+
 
 @dataclass(frozen=True)
 class RolloutFrame:

@@ -261,3 +261,32 @@ def test_exports_carry_the_features_on_their_lockers(name, tmp_path):
         extra = sum(f.mesh.volume for f in features if f.locker == c.name)
         assert parts[c.name].volume == pytest.approx(bare[c.name].volume + extra, rel=1e-3)
     assert np.allclose(parts[BOX_PART].bounds, bare[BOX_PART].bounds, atol=1e-6)
+
+
+@pytest.mark.parametrize("kinds", [["lever", "slide", "door"], ["drawer", "wheel", "slide"]])
+def test_a_raised_or_sliding_lockers_features_ride_on_its_moving_body(kinds):
+    """A lever's and a drawer's moving parts are a child body above their fixed parts: their features go there,
+    at the part's height, and keep their place on it as its joint turns or slides."""
+    from models.generator import generate_chain
+
+    spec = generate_chain(kinds, seed=1)
+    locker = spec.components[0]
+    model = compiled(spec, lock_features=True)
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    geoms = [g for g in range(model.ngeom) if model.geom(g).name.startswith(f"{locker.name}:lock:")]
+    assert geoms
+    joint = model.joint(f"{locker.name}:joint")
+    handle = model.site(f"{locker.name}:handle_site").id
+    for g in geoms:
+        assert model.geom_bodyid[g] == model.jnt_bodyid[joint.id]  # the body the joint moves
+    feature = next(f for f in lock_features(spec) if f.locker == locker.name)
+    assert data.geom_xpos[geoms[0]][2] == pytest.approx(feature.mesh.centroid[2], abs=2e-3)  # at the part's height
+    before = data.geom_xpos[geoms[0]] - data.site_xpos[handle]
+    data.qpos[joint.qposadr[0]] = model.jnt_range[joint.id, 1]
+    mujoco.mj_forward(model, data)
+    after = data.geom_xpos[geoms[0]] - data.site_xpos[handle]
+    if model.jnt_type[joint.id] == mujoco.mjtJoint.mjJNT_SLIDE:
+        np.testing.assert_allclose(after, before, atol=1e-9)  # translated with the tray
+    else:
+        assert np.linalg.norm(after) == pytest.approx(np.linalg.norm(before), abs=1e-9)  # turned with the arm

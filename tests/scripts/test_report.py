@@ -255,7 +255,7 @@ def test_a_twin_trial_report_links_its_video_and_draws_its_timeline(made, tmp_pa
     assert [link for tag, link in parsed.links if tag == "video"] == ["../flipped/rollout.mp4"]
 
 
-@pytest.mark.parametrize("what", ["missing", "file", "empty", "specs", "bad json"])
+@pytest.mark.parametrize("what", ["missing", "file", "empty", "specs", "bad json", "no runs"])
 def test_anything_but_a_trial_or_sweep_directory_is_refused_in_one_line(made, tmp_path, what):
     target = tmp_path / "x"
     if what == "file":
@@ -268,6 +268,9 @@ def test_anything_but_a_trial_or_sweep_directory_is_refused_in_one_line(made, tm
         shutil.copytree(made / "trial", target)
         (target / "results.json").write_text("{not json")
         (target / "report.html").unlink(missing_ok=True)  # from an earlier test's report
+    elif what == "no runs":
+        target.mkdir()
+        (target / "results.json").write_text("{}")
     result = script("report.py", target)
     assert result.returncode == 2
     assert result.stderr.startswith("error: ") and result.stderr.count("\n") == 1, result.stderr

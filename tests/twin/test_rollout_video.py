@@ -13,12 +13,11 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
 
-from _twin_trial import RolloutRecorder, run_twin_trial, scene_cameras  # noqa: E402
+from _twin_trial import run_twin_trial, scene_cameras  # noqa: E402
 
 from models.generator import generate_chain, paper_family  # noqa: E402
 from twin.errors import VideoError  # noqa: E402
 from twin.rollout_video import (  # noqa: E402
-    VIEWS,
     BackgroundRollout,
     Caption,
     RolloutConfig,
@@ -166,4 +165,3 @@ def test_a_failed_drawing_is_a_video_error_and_an_abort_leaves_no_file(tmp_path)
         assert not list(tmp_path.glob("*.mp4"))
     with pytest.raises(VideoError, match="does not exist"):
         BackgroundRollout(tmp_path / "missing" / "c.mp4", session.model, cameras)
-    assert VIEWS == ("overview", "three-quarter", "wrist") and RolloutRecorder is not None
