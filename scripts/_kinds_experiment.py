@@ -40,6 +40,7 @@ import numpy as np
 from _cli import write_json
 
 from models import LockTable, PuzzleSpec, load_spec, save_spec
+from models.atomic import write_atomically, write_text_atomically
 from models.generator import RandomGraphConfig, generate_chain, generate_random
 from models.kinds import registry_family
 
@@ -131,27 +132,38 @@ def run_kinds(out: Path, config: KindsConfig, workers: int | None) -> dict[str, 
     memory = out / "memory.sqlite"
     train = [str(SCRIPTS / "train.py"), "--specs", *map(str, sets["train"]), "--episodes", str(len(sets["train"]))]
     _run([*train, "--memory", str(memory), "--seed", "0", *(["--resume"] if memory.exists() else [])])
-    agent = ["--agent", "memory", "--memory", str(memory), "--runs", str(config.runs)]
-    agent += ["--max-actions", str(config.max_actions)]
-    parallel = ["--workers", str(workers)] if workers else []
-    symbolic = ["--sim", "symbolic", "--seed", "500", *agent]
-    results = {
-        "symbolic-chains": _trial(out / "symbolic-chains", sets["train"] + sets["test"], symbolic),
-        "symbolic-random": _trial(out / "symbolic-random", sets["random"], symbolic),
-    }
-    for profile in config.profiles:
+
+    def agent(runs: int) -> list[str]:
+        return ["--agent", "memory", "--memory", str(memory), "--runs", str(runs), "--max-actions",
+                str(config.max_actions)]  # fmt: skip
+
+    def twin(profile: str, runs: int) -> list[str]:
         reality = ["--reality", profile]
         if profile != "ideal":
             calibration = out / f"calibration-{profile}.json"
             if not calibration.exists():
                 _run([str(SCRIPTS / "calibrate.py"), "--out", str(calibration), "--reality", profile])
             reality += ["--calibration", str(calibration)]
-        settings = ["--sim", "twin", "--seed", "0", *agent, *reality, *parallel]
-        results[f"twin-{profile}"] = _trial(out / f"twin-{profile}", sets["test"], settings)
-    if config.twin_random:
-        one_seed = [*settings[: settings.index("--runs") + 1], "1", *settings[settings.index("--runs") + 2 :]]
+        return [
+            "--sim",
+            "twin",
+            "--seed",
+            "0",
+            *agent(runs),
+            *reality,
+            *(["--workers", str(workers)] if workers else []),
+        ]
+
+    symbolic = ["--sim", "symbolic", "--seed", "500", *agent(config.runs)]
+    results = {
+        "symbolic-chains": _trial(out / "symbolic-chains", sets["train"] + sets["test"], symbolic),
+        "symbolic-random": _trial(out / "symbolic-random", sets["random"], symbolic),
+    }
+    for profile in config.profiles:
+        results[f"twin-{profile}"] = _trial(out / f"twin-{profile}", sets["test"], twin(profile, config.runs))
+    if config.twin_random and config.profiles:
         name = f"twin-random-{config.profiles[-1]}"
-        results[name] = _trial(out / name, sets["random"][: config.twin_random], one_seed)
+        results[name] = _trial(out / name, sets["random"][: config.twin_random], twin(config.profiles[-1], 1))
     optimum = dict(_optimum(load_spec(p)) for paths in sets.values() for p in paths)
     summary = {
         "config": asdict(config),
@@ -161,7 +173,7 @@ def run_kinds(out: Path, config: KindsConfig, workers: int | None) -> dict[str, 
         "wall_time_s": time.time() - start,
     }
     write_json(out / "kinds.json", summary)
-    (out / "kinds.md").write_text(table(summary))
+    write_text_atomically(out / "kinds.md", table(summary))
     plot(summary, out / "kinds.png")
     return summary
 
@@ -227,7 +239,5 @@ def plot(summary: dict[str, Any], path: Path) -> None:
     right.set_xticklabels(names, rotation=20, ha="right")
     right.legend(loc="lower right", framealpha=0.9)
     fig.tight_layout()
-    tmp = path.with_suffix(".tmp.png")
-    fig.savefig(tmp, dpi=120)
+    write_atomically(path, lambda tmp: fig.savefig(tmp, dpi=120, format="png"))
     plt.close(fig)
-    tmp.replace(path)

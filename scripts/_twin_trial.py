@@ -4,6 +4,7 @@ perception, the agent, the primitives, physics — with a timeline and, optional
 from __future__ import annotations
 
 import collections
+import contextlib
 import hashlib
 import math
 import time
@@ -48,7 +49,6 @@ class RolloutRecorder:
     def __init__(self, robot, session: TwinSession, rollout: BackgroundRollout, detector: RecordingDetector) -> None:
         self._robot, self._session, self._rollout, self._detector = robot, session, rollout, detector
         self._period = rollout.config.period
-        self._dt = session.model.opt.timestep  # [s] read once: a model attribute is a binding call per tick
         self._window = rollout.config.plot_window
         self._next = 0.0
         self.caption = Caption()
@@ -61,33 +61,21 @@ class RolloutRecorder:
         return getattr(self._robot, name)
 
     def wait(self, seconds: float) -> None:
-        # a long wait (a look, a settle) is cut at the frame times, in whole physics steps (the session rounds a
-        # wait to whole steps, at least one): the same steps, so the same trial, and no frame late
-        dt = self._dt
-        steps = max(1, round(seconds / dt))
-        while steps:
-            chunk = min(steps, max(1, math.ceil((self._next - self._robot.time) / dt - 1e-6)))
-            self._robot.wait(chunk * dt)
-            steps -= chunk
-            self._after_wait()
-
-    def _after_wait(self) -> None:
+        self._robot.wait(seconds)  # never cut: where a wait is cut moves the twin's latch updates
         now = self._robot.time
         force = self.force()
         if force is not None:
             self._forces.append((now, force))
             while self._forces and self._forces[0][0] < now - self._window:
                 self._forces.popleft()
-        if now >= self._next:
-            while self._next <= now:  # on the fixed grid 0, period, 2 period, ... (a tick may overshoot one)
-                self._next += self._period
-            self._frame(now)
+        while self._next <= now:  # a frame per grid time 0, period, 2 period, ... this wait passed: the state
+            self._frame(self._next)  # at its end (a 10 ms control tick; a look or a settle waits up to ~1 s)
+            self._next += self._period
 
     def begin(self, caption: Caption) -> None:
         self.caption = caption
 
-    def end(self, caption: Caption) -> None:
-        self.caption = caption
+    end = begin
 
     def last_frame(self) -> None:
         """The trial's last frame, whatever the time: it shows how the last action ended."""
@@ -134,9 +122,6 @@ class NarratedWorld:
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._world, name)
-
-    def observe(self):
-        return self._world.observe()
 
     def try_toggle(self, index: int):
         world = self._world
@@ -372,52 +357,45 @@ def run_twin_trial(
         spec = session.spec  # placed by the profile, if it places boxes
         told_kinds = wrong_kind(spec, seed) if misreport_kind else {}
         robot = session.robot
-        rollout = recorder = detector = recording = logger = None
-        if video is not None or record is not None:
-            detector = RecordingDetector()
-        if video is not None:
-            rollout = BackgroundRollout(video, session.model, scene_cameras(session))
-            robot = recorder = RolloutRecorder(robot, session, rollout, detector)
-        if record is not None:
-            recording = TrialRecording(record, f"{spec.name}-seed{seed}")
-            robot = logger = RerunRecorder(robot, session, recording)
-            detector.listeners.append(logger.markers)
-        robot = watch = TrueForceWatch(robot, session)
-        robot = sensed = SensedDigest(robot)
-        world = None
-        pose_errors: dict[str, float] = {}
-        try:
-            world = evaluation_world(session, robot, calibration, seed, told_kinds, detector)
-            watch.doing = lambda: f"{world.toggler.phase}, action {len(world.log) + 1}"
-            for c in spec.components:  # perceived closed pose against the simulator's (evaluation only)
-                truth = session.data.site(session.scene.names.components[c.name].frame_site).xpos
-                pose_errors[c.name] = float(np.linalg.norm(world.closed_poses[c.marker][:2] - truth[:2]))
-            agent = make_agent(agent_name, spec, memory, checkpoint, belief=CELL_BELIEF, max_lockers=max_lockers)
-            acting: Any = world
+        # the video and the recording are published when this block ends, discarded if it raises
+        with contextlib.ExitStack() as outputs:
+            recorder = detector = logger = None
+            if video is not None or record is not None:
+                detector = RecordingDetector()
+            if video is not None:
+                rollout = outputs.enter_context(BackgroundRollout(video, session.model, scene_cameras(session)))
+                robot = recorder = RolloutRecorder(robot, session, rollout, detector)
+            if record is not None:
+                recording = outputs.enter_context(TrialRecording(record, f"{spec.name}-seed{seed}"))
+                robot = logger = RerunRecorder(robot, session, recording)
+                detector.listeners.append(logger.markers)
+            robot = watch = TrueForceWatch(robot, session)
+            robot = sensed = SensedDigest(robot)
+            world = None
+            pose_errors: dict[str, float] = {}
+            try:
+                world = evaluation_world(session, robot, calibration, seed, told_kinds, detector)
+                watch.doing = lambda: f"{world.toggler.phase}, action {len(world.log) + 1}"
+                for c in spec.components:  # perceived closed pose against the simulator's (evaluation only)
+                    truth = session.data.site(session.scene.names.components[c.name].frame_site).xpos
+                    pose_errors[c.name] = float(np.linalg.norm(world.closed_poses[c.marker][:2] - truth[:2]))
+                agent = make_agent(agent_name, spec, memory, checkpoint, belief=CELL_BELIEF, max_lockers=max_lockers)
+                acting: Any = world
+                if recorder is not None:
+                    recorder.phase = lambda: world.toggler.phase
+                    recorder.force = lambda: math.sqrt(world.toggler.force_in_base @ world.toggler.force_in_base)
+                if logger is not None:
+                    logger.force = lambda: np.array(world.toggler.force_in_base, dtype=float)
+                    logger.belief = lambda: agent_belief(agent)
+                listeners = [x for x in (recorder, logger) if x is not None]
+                if listeners:
+                    acting = NarratedWorld(world, listeners, lambda: getattr(agent, "decisions", []))
+                result = run_episode(agent, acting, spec.name, seed, max_actions, on_action)
+            except (SkillError, SimulationDiverged) as err:  # the cell could not run this trial: say why
+                result = RunResult(spec.name, seed, False, len(world.log) if world else 0, 0.0,
+                                   ended=f"{type(err).__name__}: {err}")  # fmt: skip
             if recorder is not None:
-                recorder.phase = lambda: world.toggler.phase
-                recorder.force = lambda: float(np.linalg.norm(world.toggler.force_in_base))
-            if logger is not None:
-                logger.force = lambda: np.array(world.toggler.force_in_base, dtype=float)
-                logger.belief = lambda: agent_belief(agent)
-            listeners = [x for x in (recorder, logger) if x is not None]
-            if listeners:
-                acting = NarratedWorld(world, listeners, lambda: getattr(agent, "decisions", []))
-            result = run_episode(agent, acting, spec.name, seed, max_actions, on_action)
-        except (SkillError, SimulationDiverged) as err:  # the cell could not run this trial: say why
-            result = RunResult(spec.name, seed, False, len(world.log) if world else 0, 0.0,
-                               ended=f"{type(err).__name__}: {err}")  # fmt: skip
-        except BaseException:
-            if rollout is not None:
-                rollout.abort()
-            if recording is not None:
-                recording.abort()
-            raise
-        if rollout is not None:
-            recorder.last_frame()
-            rollout.close()
-        if recording is not None:
-            recording.close()
+                recorder.last_frame()
         sim_time = session.time
     entry = result.to_dict()
     entry["wall_time_s"] = time.perf_counter() - wall

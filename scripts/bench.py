@@ -34,7 +34,6 @@ import argparse  # noqa: E402
 import platform  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
-from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 from _cli import fail, versions, write_json  # noqa: E402
@@ -239,34 +238,19 @@ def box_visibility_figures(quick: bool) -> dict[str, float]:
     import _twin_trial
 
     from models.generator import generate_chain, paper_family
-    from twin.rollout_video import RolloutConfig, RolloutDrawer
-
-    kept: dict[str, Any] = {}
-
-    class Keep:  # stands in for the background drawer: the frames' states, in memory
-        def __init__(self, path, model, cameras, config=None):
-            self.config, self.frames = config or RolloutConfig(), []
-            kept.update(rollout=self, model=model, cameras=cameras)
-
-        def add(self, frame):
-            self.frames.append(frame)
-
-        def close(self):
-            return len(self.frames)
-
-        def abort(self):
-            pass
+    from twin.rollout_video import FrameCollector, RolloutDrawer
 
     specs = [*paper_family("test"), generate_chain(["lever", "slide", "door", "drawer", "wheel"], seed=0),
              generate_chain(["wheel", "drawer", "lever", "door", "slide"], seed=3)][: 1 if quick else 5]  # fmt: skip
     drawing = _twin_trial.BackgroundRollout
-    _twin_trial.BackgroundRollout = Keep
+    _twin_trial.BackgroundRollout = FrameCollector  # the frames' states kept, not drawn
     best: list[float] = []
     try:
         for spec in specs:
             _twin_trial.run_twin_trial(spec, 0, "oracle", None, 12, Path("unused.mp4"))
-            drawer = RolloutDrawer(kept["model"], kept["cameras"], kept["rollout"].config)
-            best += [max(drawer.box_visibility(f.qpos).values()) for f in kept["rollout"].frames]
+            kept = FrameCollector.last
+            drawer = RolloutDrawer(kept.model, kept.cameras, kept.config)
+            best += [max(drawer.box_visibility(f.qpos).values()) for f in kept.frames]
             drawer.close()
     finally:
         _twin_trial.BackgroundRollout = drawing

@@ -73,12 +73,9 @@ class TrialRecording:
         self._bodies: dict[str, tuple[list[str], list[np.ndarray], list[np.ndarray]]] = {}
         self._tcp_path: list[np.ndarray] = []
         self._forces: list[np.ndarray] = []
-        self.counts: dict[str, int] = {}
-        """Entity path -> rows logged (what a test reads back)."""
 
     def _log(self, entity: str, archetype: Any, static: bool = False) -> None:
         self.stream.log(entity, archetype, static=static)
-        self.counts[entity] = self.counts.get(entity, 0) + 1
 
     def at(self, time: float) -> None:
         """Set the ``sim_time`` of what is logged next [s]."""
@@ -117,28 +114,23 @@ class TrialRecording:
         rr, n = self.rr, len(self._times)
         if not n:
             return
-        index = [rr.TimeColumn("sim_time", duration=np.array(self._times))]
-
-        def send(entity: str, columns: Any) -> None:
-            self.stream.send_columns(entity, indexes=index, columns=columns)
-            self.counts[entity] = self.counts.get(entity, 0) + n
-
+        times = np.array(self._times)
+        every = [rr.TimeColumn("sim_time", duration=times)]
+        send = self.stream.send_columns
         for entity, (names, positions, quats) in self._bodies.items():
             p, q = np.stack(positions), np.stack(quats)  # (T, B, 3), (T, B, 4)
-            points = rr.Points3D.columns(positions=p.reshape(-1, 3)).partition([len(names)] * n)
-            send(entity, points)
+            send(entity, every, rr.Points3D.columns(positions=p.reshape(-1, 3)).partition([len(names)] * n))
             for b, name in enumerate(names):
                 xyzw = q[:, b][:, [1, 2, 3, 0]]
-                send(f"{entity}/{_safe(name)}", rr.Transform3D.columns(translation=p[:, b], quaternion=xyzw))
-        send("world/tcp", rr.Points3D.columns(positions=np.stack(self._tcp_path)).partition([1] * n))
+                send(f"{entity}/{_safe(name)}", every, rr.Transform3D.columns(translation=p[:, b], quaternion=xyzw))
+        send("world/tcp", every, rr.Points3D.columns(positions=np.stack(self._tcp_path)).partition([1] * n))
         forces = np.stack(self._forces)
-        sensed = ~np.isnan(forces[:, 0])
+        sensed = ~np.isnan(forces[:, 0])  # (no force before the primitives sensed one)
         if sensed.any():
-            index = [rr.TimeColumn("sim_time", duration=np.array(self._times)[sensed])]
-            n = int(sensed.sum())
+            when = [rr.TimeColumn("sim_time", duration=times[sensed])]
             for axis, values in zip("xyz", forces[sensed].T, strict=True):
-                send(f"robot/force/{axis}", rr.Scalars.columns(scalars=values))
-            send("robot/force/norm", rr.Scalars.columns(scalars=np.linalg.norm(forces[sensed], axis=1)))
+                send(f"robot/force/{axis}", when, rr.Scalars.columns(scalars=values))
+            send("robot/force/norm", when, rr.Scalars.columns(scalars=np.linalg.norm(forces[sensed], axis=1)))
 
     def belief(self, single_locker_probs: np.ndarray) -> None:
         """The agent's belief ``(N, 2, 1 + 2N)`` as a ``(2N, 1 + 2N)`` grey image (white: probability 1)."""
@@ -161,6 +153,15 @@ class TrialRecording:
         self.stream.disconnect()
         os.replace(self._temporary, self.path)
         return self.path
+
+    def __enter__(self) -> TrialRecording:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
 
     def abort(self) -> None:
         """Stop and leave no file."""

@@ -42,7 +42,8 @@ import cv2
 import mujoco
 import numpy as np
 
-from models.atomic import write_atomically
+from models.atomic import write_text_atomically
+from models.scene import BOX
 from twin.errors import VideoError
 from twin.video import VideoWriter
 
@@ -200,7 +201,7 @@ class RolloutDrawer:
             if segmentation:
                 self.renderer.disable_segmentation_rendering()
 
-    def box_visibility(self, qpos: np.ndarray, box_prefix: str = "box/", arm_group: int = 1) -> dict[str, float]:
+    def box_visibility(self, qpos: np.ndarray, box_prefix: str = BOX, arm_group: int = 1) -> dict[str, float]:
         """Evaluation: per view, the fraction of the box's pixels (lid and components: geoms of bodies named
         ``box_prefix...``) that are seen with the arm as it stands at ``qpos``, against the same view with the
         arm's visual geoms (group ``arm_group``) hidden: 1.0 unoccluded, 0.0 hidden. A view that shows no
@@ -345,7 +346,7 @@ def _draw_video(model_path: str, cameras: SceneCameras, config: RolloutConfig, p
         drawer.close()
     sidecar = {"video": Path(path).name, "period_s": config.period, "fps": config.fps, "views": list(VIEWS),
                "view_size": list(config.view_size), "frames": index}  # fmt: skip
-    write_atomically(frames_path(path), lambda tmp: tmp.write_text(json.dumps(sidecar, indent=1)))
+    write_text_atomically(frames_path(path), json.dumps(sidecar, indent=1))
     return frames
 
 
@@ -490,3 +491,32 @@ class BackgroundRollout:
             self.close()
         else:
             self.abort()
+
+
+class FrameCollector:
+    """Stands in for :class:`BackgroundRollout` (same constructor and methods) and keeps the frames' states in
+    memory instead of drawing them: for evaluations that look at every frame (``bench.py``'s box visibility).
+    The latest one made is :attr:`FrameCollector.last`, with the model and cameras it was given."""
+
+    last: FrameCollector | None = None
+
+    def __init__(self, path: str | os.PathLike[str], model: mujoco.MjModel, cameras: SceneCameras,
+                 config: RolloutConfig | None = None) -> None:  # fmt: skip
+        self.model, self.cameras, self.config = model, cameras, config or RolloutConfig()
+        self.frames: list[RolloutFrame] = []
+        FrameCollector.last = self
+
+    def add(self, frame: RolloutFrame) -> None:
+        self.frames.append(frame)
+
+    def close(self) -> int:
+        return len(self.frames)
+
+    def abort(self) -> None:
+        pass
+
+    def __enter__(self) -> FrameCollector:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        pass
