@@ -65,6 +65,20 @@ def polygon_gap(a: np.ndarray, b: np.ndarray) -> float:
     return float(best)
 
 
+def clip_below_x(polygon: np.ndarray, x_max: float) -> np.ndarray:
+    """The part of a convex polygon ``(n, 2)`` [m] at ``x <= x_max``, a convex polygon ``(m, 2)`` in the
+    same order (empty ``(0, 2)`` if none of it is there)."""
+    kept: list[np.ndarray] = []
+    for k in range(len(polygon)):
+        a, b = polygon[k], polygon[(k + 1) % len(polygon)]
+        if a[0] <= x_max:
+            kept.append(a)
+        if (a[0] - x_max) * (b[0] - x_max) < 0.0:  # the edge crosses x = x_max
+            t = (x_max - a[0]) / (b[0] - a[0])
+            kept.append(np.array([x_max, a[1] + t * (b[1] - a[1])]))
+    return np.array(kept, dtype=float).reshape(-1, 2)
+
+
 def rectangle(x_min: float, x_max: float, y_min: float, y_max: float) -> np.ndarray:
     """Counter-clockwise corners of an axis-aligned rectangle, shape ``(4, 2)`` [m]."""
     return np.array([[x_min, y_min], [x_max, y_min], [x_max, y_max], [x_min, y_max]], dtype=float)

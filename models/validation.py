@@ -2,7 +2,9 @@
 
 Two kind families exist (SPEC.md extended, issue 14): puzzle boxes (``box`` required, the registered kinds of
 :mod:`models.kinds` — door, slide, wheel and any kind module added there —, planar poses ``[x, y, yaw]``,
-footprints inside the lid and not overlapping) and disassembly scenes (no ``box``, kinds of
+footprints inside the lid and not overlapping; a kind mounted at the lid's edge,
+:attr:`models.kinds.template.KindTemplate.edge_x`, has its front face on the lid edge its +x points out of
+and only its footprint's part behind that face on the lid) and disassembly scenes (no ``box``, kinds of
 :mod:`models.disassembly_kinds`, 6-DOF poses ``[x, y, z, roll, pitch, yaw]``, no footprint rules). A spec
 without a box that has a disassembly kind is a disassembly scene; one family's kind in the other's spec is a
 problem naming the component. The generic rules (names, locks, goal, reachability) apply to both.
@@ -30,6 +32,13 @@ OVERLAP_TOLERANCE = 1e-6
 """Footprints may touch; they overlap when they interpenetrate by more than this [m]."""
 INSIDE_TOLERANCE = 1e-6
 """A footprint may reach the lid edge up to this much beyond it [m] (rounding in files)."""
+EDGE_TOLERANCE = 1e-4
+"""An edge-mounted component's front face may lie this far off its lid edge [m] (rounding in files)."""
+EDGE_ANGLE_TOLERANCE = 1e-3
+"""An edge-mounted component's yaw may be this far off a multiple of 90 degrees [rad] (rounding in files)."""
+LID_SIDES = ((1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0))
+"""Outward normals of the lid's four edges in the lid frame: +x, -x, +y, -y."""
+SIDE_NAMES = {(1.0, 0.0): "+x", (-1.0, 0.0): "-x", (0.0, 1.0): "+y", (0.0, -1.0): "-y"}
 
 
 MAX_MAGNITUDE = 1000.0
@@ -272,11 +281,25 @@ def _check_geometry(data: dict[str, Any], components: dict[str, dict[str, Any]])
     for name, comp in components.items():
         if not _is_box_kind(comp["kind"]):
             continue
-        polygon = get_kind(comp["kind"]).footprint_in_lid(tuple(comp["pose"]))
-        footprints[name] = polygon
+        template = get_kind(comp["kind"])
+        pose = tuple(comp["pose"])
+        polygon = template.footprint_in_lid(pose)
+        footprints[name] = polygon  # overlaps: the whole footprint, an edge-mounted one's swept part included
+        outward = None
+        if template.at_edge:
+            outward, problem = _check_edge(name, comp["kind"], template.edge_x, pose, half_x, half_y)
+            if problem is not None:
+                problems.append(problem)
+            polygon = template.on_lid_footprint_in_lid(pose)  # its swept part lies beyond the lid edge
+        # on the lid: how far the footprint reaches past each edge (past its own edge, an edge-mounted
+        # component's front is checked above)
         beyond = max(
-            float(abs(polygon[:, 0]).max() - half_x),
-            float(abs(polygon[:, 1]).max() - half_y),
+            float(abs(polygon[:, 0]).max() - half_x)
+            if outward is None or outward[1] != 0.0
+            else float((-outward[0] * polygon[:, 0]).max() - half_x),
+            float(abs(polygon[:, 1]).max() - half_y)
+            if outward is None or outward[0] != 0.0
+            else float((-outward[1] * polygon[:, 1]).max() - half_y),
         )
         if beyond > INSIDE_TOLERANCE:
             problems.append(
@@ -293,6 +316,39 @@ def _check_geometry(data: dict[str, Any], components: dict[str, dict[str, Any]])
             if gap < -OVERLAP_TOLERANCE:
                 problems.append(SpecProblem(f"component {a!r}", f"overlaps component {b!r} by {-gap * 1000:.1f} mm"))
     return problems
+
+
+def _check_edge(
+    name: str, kind: str, edge_x: float, pose: tuple[float, ...], half_x: float, half_y: float
+) -> tuple[tuple[float, float] | None, SpecProblem | None]:
+    """An edge-mounted component's placement: its +x must point out of the lid perpendicular to an edge (yaw a
+    multiple of 90 degrees) and its front face (x = ``edge_x`` in its frame) lie on that edge. Returns the
+    outward axis (None when the yaw faces no edge) and the problem, if any."""
+    x, y, yaw = pose
+    where = f"component {name!r}"
+    quarter = math.pi / 2.0
+    turns = round(yaw / quarter)
+    if abs(yaw - turns * quarter) > EDGE_ANGLE_TOLERANCE:
+        return None, SpecProblem(
+            where,
+            f"a {kind} is mounted at the lid's edge, its +x pointing out of the lid perpendicular to an edge: its "
+            f"yaw must be a multiple of 90 degrees, got {math.degrees(yaw):.1f} degrees",
+        )
+    outward = LID_SIDES[(0, 2, 1, 3)[turns % 4]]
+    half = half_x if outward[0] != 0.0 else half_y
+    front = outward[0] * x + outward[1] * y + edge_x  # the front face's coordinate along the outward axis
+    off = front - half
+    if abs(off) <= EDGE_TOLERANCE:
+        return outward, None
+    side = SIDE_NAMES[outward]
+    inward = outward[0] * x + outward[1] * y < 0.0
+    return outward, SpecProblem(
+        where,
+        f"a {kind} is mounted at the lid's edge: its front face (x = {edge_x * 1000:.0f} mm in its frame) must lie "
+        f"on the lid edge its +x points out of, but its +x points to {side} and its front face is "
+        f"{abs(off) * 1000:.1f} mm {'inside' if off < 0 else 'beyond'} the {side} edge"
+        + (" (it points into the lid, toward the far edge: turn it to point out)" if inward else ""),
+    )
 
 
 def _check_reachable(data: dict[str, Any]) -> list[SpecProblem]:

@@ -116,7 +116,7 @@ def assemble(
     lid = box.lid_size if box.lid_size is not None else layout.lid_size()
     components = tuple(
         Component(name=names[i], kind=kinds[i], pose=file_precision(pose), marker=i)
-        for i, pose in enumerate(layout.poses_in_lid())
+        for i, pose in enumerate(layout.poses_in_lid(box.lid_size))
     )
     locks = tuple(LockRule(names[a], sa, names[b], sb) for a, sa, b, sb in locks_by_index)
     return PuzzleSpec(

@@ -1,14 +1,18 @@
-"""The ``drawer`` kind: a tray that is pulled out of a fixed housing along +x by ``travel`` [m] to open.
+"""The ``drawer`` kind: a tray pulled out of the box's side wall along +x by ``travel`` [m] to open.
 
-Frame origin: the marker centre when closed, on the tray's top face; +x points out of the housing, toward
-the handle at the tray's front (the robot pulls it, where a slide's knob behind its marker is pushed).
-Travel 45 mm. Parts: a fixed housing (a back block the tray comes out of and two side rails, in the
-component body on the lid) and the tray, its handle and marker in the child body ``<name>:tray``.
-Footprint: housing, rails and the tray's swept area,
-``[-DRAWER_BACK - HOUSING_DEPTH, DRAWER_FRONT + travel] x [-RAIL_OUTER, RAIL_OUTER]``.
+A drawer is mounted at the lid's edge (:attr:`models.kinds.template.KindTemplate.edge_x`): its +x points out
+of the lid, perpendicular to that edge, and the front face of its closed tray (x = ``DRAWER_FRONT`` in its
+frame) is flush with the box's side wall, i.e. on the lid edge in plan, so pulling it slides the tray out past
+the box's side. The housing behind the tray stays on the lid, and the tray's top is at lid level with its
+marker on top, where the overview camera reads it.
 
-A drawer here comes out of a housing standing on the lid, not out of the box's own side wall: the
-generators place every component on the lid, where the overview camera reads its marker.
+Frame origin: the marker centre when closed, on the tray's top face; +x points out of the housing and out of
+the lid, toward the handle at the tray's front (the robot pulls it, where a slide's knob behind its marker is
+pushed). Travel 45 mm. Parts: a fixed housing (a back block the tray comes out of and two side rails ending
+at the front face, in the component body on the lid) and the tray, its handle and marker in the child body
+``<name>:tray``. Footprint: housing, rails and the tray's swept area,
+``[-DRAWER_BACK - HOUSING_DEPTH, DRAWER_FRONT + travel] x [-RAIL_OUTER, RAIL_OUTER]``; the part at
+x <= ``DRAWER_FRONT`` lies on the lid, the part beyond is swept outside the lid, past its edge.
 """
 
 from __future__ import annotations
@@ -49,6 +53,7 @@ DRAWER = KindTemplate(
     marker_size=MARKER_SIZE,
     handle_xy=(HANDLE_OFFSET, 0.0),
     footprint=rectangle(-DRAWER_BACK - HOUSING_DEPTH, DRAWER_FRONT + TRAVEL, -RAIL_OUTER, RAIL_OUTER),
+    edge_x=DRAWER_FRONT,
 )
 DYNAMICS = JointDynamics(damping=1.0, frictionloss=0.3)
 """A tray in rails: as a slide's plate."""

@@ -19,7 +19,7 @@ from typing import Literal
 
 import numpy as np
 
-from models.geometry import transform_points
+from models.geometry import clip_below_x, transform_points
 
 MARKER_SIZE = 0.036
 """Side of every component's ArUco marker (black square) [m]: ~38 px from the overview camera."""
@@ -58,6 +58,28 @@ class KindTemplate:
     """Height of the moving plate's bottom above the lid, state 0 [m]: 0 for parts lying on the lid; a part
     raised on fixed supports (a lever on its bracket) has its marker, handle and joint this much higher,
     and its builder puts the moving parts in a child body at this height."""
+    edge_x: float | None = None
+    """For a kind mounted at the lid's edge, the x [m] in the component frame of its front face in state 0
+    (closed); None (the default) for a kind that stands anywhere on the lid. An edge-mounted component sits
+    with this front face on a lid edge (flush with the box's side wall, in plan) and its +x pointing out of the
+    lid, perpendicular to that edge: the part of its footprint at x <= ``edge_x`` lies on the lid, the part
+    beyond is swept outside the lid, past the box's side, as it opens."""
+
+    @property
+    def at_edge(self) -> bool:
+        """Whether the kind is mounted at the lid's edge (:attr:`edge_x` is set)."""
+        return self.edge_x is not None
+
+    def on_lid_footprint(self) -> np.ndarray:
+        """The part of :attr:`footprint` on the lid, in the component frame [m]: all of it for a kind that
+        stands anywhere on the lid, the part at x <= :attr:`edge_x` for an edge-mounted one."""
+        if self.edge_x is None:
+            return self.footprint
+        return clip_below_x(self.footprint, self.edge_x)
+
+    def on_lid_footprint_in_lid(self, pose: tuple[float, float, float]) -> np.ndarray:
+        """:meth:`on_lid_footprint` in the lid frame for a component at ``pose`` ``[x, y, yaw]``."""
+        return transform_points(pose, self.on_lid_footprint())
 
     def footprint_in_lid(self, pose: tuple[float, float, float]) -> np.ndarray:
         """The footprint polygon in the lid frame for a component at ``pose`` ``[x, y, yaw]``."""

@@ -1,5 +1,7 @@
-"""The drawer kind (models/kinds/drawer.py): registered from its module alone, a tray pulled out of its fixed
-housing between rails, staying where it is left, held by its latch."""
+"""The drawer kind (models/kinds/drawer.py): registered from its module alone, a tray pulled out of the box's
+side wall (its housing and rails on the lid at the lid's edge), staying where it is left, held by its latch."""
+
+import math
 
 import mujoco
 import numpy as np
@@ -7,22 +9,29 @@ import pytest
 
 from models import Box, Component, Goal, LockRule, PuzzleSpec
 from models.generator import RandomGraphConfig, generate_chain, generate_random, paper_family
+from models.generator.layout import Layout, LayoutConfig
 from models.kinds import KIND_NAMES, PAPER_FAMILY, family_named, registered_kind, registered_kinds, registry_family
-from models.kinds.drawer import DRAWER, TRAVEL
-from models.scene import build_scene
+from models.kinds.drawer import DRAWER, DRAWER_BACK, HOUSING_DEPTH, RAIL_OUTER, TRAVEL
+from models.puzzle_box import lid_to_world
+from models.scene import DEFAULT_BOX_POSE, build_scene
+from models.validation import validate_data
+
+LID = (0.3, 0.3, 0.08)
+"""The hand-made test box: lid length, width and height [m]."""
 
 
 def drawer_and_wheel(locked: bool) -> PuzzleSpec:
-    """A drawer and a wheel beside it; with ``locked``, the wheel closed keeps the drawer closed."""
+    """A drawer at the lid's -y edge pointing out (-y) and a wheel beside it; with ``locked``, the wheel closed
+    keeps the drawer closed."""
     return PuzzleSpec(
         name="drawer-test",
         components=(
-            Component(name="drawer", kind="drawer", pose=(0.0, 0.0, -0.4), marker=0),
-            Component(name="wheel", kind="wheel", pose=(-0.04, 0.11, 0.0), marker=1),
+            Component(name="drawer", kind="drawer", pose=(0.0, -(LID[1] / 2 - DRAWER.edge_x), -math.pi / 2), marker=0),
+            Component(name="wheel", kind="wheel", pose=(0.09, -0.08, 0.0), marker=1),
         ),
         locks=(LockRule("wheel", 0, "drawer", 0),) if locked else (),
         goal=Goal("drawer", 1),
-        box=Box(size=(0.3, 0.3, 0.08)),
+        box=Box(size=LID),
     )
 
 
@@ -98,3 +107,135 @@ def test_chains_with_drawers_are_generated_and_valid():
     model, data = compiled(spec)
     mujoco.mj_step(model, data)
     assert not any(w.number for w in data.warning)
+
+
+def drawers_of(spec: PuzzleSpec) -> list[Component]:
+    return [c for c in spec.components if c.kind == "drawer"]
+
+
+def front_on_edge(spec: PuzzleSpec, drawer: Component) -> tuple[float, float]:
+    """Of the lid edge nearest the drawer's front face: how far the front face lies beyond it [m] (0 when
+    flush) and the cosine between the drawer's +x and that edge's outward normal (1 when it points out)."""
+    x, y, yaw = drawer.pose
+    out = np.array([math.cos(yaw), math.sin(yaw)])
+    front = np.array([x, y]) + DRAWER.edge_x * out
+    half = np.array(spec.box.size[:2]) / 2
+    edges = [(front @ n - half @ abs(n), n) for n in np.array([[1, 0], [-1, 0], [0, 1], [0, -1]], dtype=float)]
+    off, normal = min(edges, key=lambda e: abs(e[0]))
+    return float(off), float(out @ normal)
+
+
+def specs_with_drawers() -> list[PuzzleSpec]:
+    chains = [
+        generate_chain(kinds, seed)
+        for kinds in (
+            ["door", "drawer", "wheel"],
+            ["drawer", "door"],
+            ["wheel", "drawer", "lever"],
+            ["drawer", "lever", "drawer"],
+        )
+        for seed in range(4)
+    ]
+    randoms = [generate_random(RandomGraphConfig(6, family=family_named("all")), seed) for seed in range(20)]
+    return [spec for spec in chains + randoms if drawers_of(spec)]
+
+
+def test_the_hand_made_drawer_box_is_valid():
+    assert validate_data(drawer_and_wheel(locked=True).to_dict()) == []
+
+
+def test_generated_drawers_sit_at_the_lid_edge_pointing_out_and_the_boxes_are_valid():
+    specs = specs_with_drawers()
+    assert len(specs) >= 20
+    for spec in specs:
+        assert validate_data(spec.to_dict()) == [], spec.name
+        for drawer in drawers_of(spec):
+            off, outward = front_on_edge(spec, drawer)
+            assert abs(off) < 2e-6, (spec.name, drawer.name, off)  # flush with the box's side wall
+            assert outward == pytest.approx(1.0, abs=1e-9), (spec.name, drawer.name)  # +x points out of the lid
+
+
+def test_drawers_on_opposite_sides_set_the_lid_between_their_fronts():
+    opposite = []
+    for seed in range(30):
+        spec = generate_chain(["drawer", "lever", "drawer"], seed)
+        yaws = {round(math.degrees(d.pose[2])) % 360 for d in drawers_of(spec)}
+        if yaws in ({0, 180}, {90, 270}):
+            opposite.append(spec)
+            for drawer in drawers_of(spec):
+                assert abs(front_on_edge(spec, drawer)[0]) < 2e-6, (spec.name, drawer.name)
+    assert opposite  # the layout does put drawers on opposite sides
+
+
+def test_the_open_tray_lies_beyond_the_lid_edge():
+    for spec in specs_with_drawers()[:6]:
+        model = build_scene(spec).compile()
+        data = mujoco.MjData(model)
+        T_world_lid = lid_to_world(spec.box.pose or DEFAULT_BOX_POSE, spec.box.size[2])
+        lid_from_world = np.linalg.inv(T_world_lid)
+        half = np.array(spec.box.size[:2]) / 2
+        for drawer in drawers_of(spec):
+            joint = model.joint(f"box/{drawer.name}:joint")
+            mujoco.mj_forward(model, data)
+            closed = (lid_from_world @ np.append(data.geom(f"box/{drawer.name}:plate").xpos, 1))[:2]
+            assert np.all(abs(closed) < half), (spec.name, drawer.name)  # closed: on the lid
+            data.qpos[joint.qposadr[0]] = TRAVEL
+            mujoco.mj_forward(model, data)
+            for where in (data.geom(f"box/{drawer.name}:plate").xpos, data.site(f"box/{drawer.name}:handle_site").xpos):
+                plan = (lid_from_world @ np.append(where, 1))[:2]
+                assert np.any(abs(plan) > half), (spec.name, drawer.name, plan)  # open: past the box's side
+            data.qpos[joint.qposadr[0]] = 0.0
+
+
+def moved_drawer(change) -> tuple[dict, str]:
+    spec = generate_chain(["door", "drawer", "wheel"], seed=2)
+    data = spec.to_dict()
+    drawer = drawers_of(spec)[0]
+    entry = next(c for c in data["components"] if c["name"] == drawer.name)
+    entry["pose"] = list(change(*drawer.pose))
+    return data, drawer.name
+
+
+def test_validation_rejects_a_drawer_moved_inward_from_the_edge():
+    data, name = moved_drawer(lambda x, y, yaw: (x - 0.01 * math.cos(yaw), y - 0.01 * math.sin(yaw), yaw))
+    problems = validate_data(data)
+    assert len(problems) == 1 and problems[0].where == f"component {name!r}", problems
+    assert "front face" in problems[0].message and "10.0 mm inside" in problems[0].message
+
+
+def test_validation_rejects_a_drawer_turned_to_point_inward():
+    # turned half round about its front face's centre: the front stays on the edge line, the drawer points in
+    def turned(x, y, yaw):
+        fx, fy = x + DRAWER.edge_x * math.cos(yaw), y + DRAWER.edge_x * math.sin(yaw)
+        return (fx + DRAWER.edge_x * math.cos(yaw), fy + DRAWER.edge_x * math.sin(yaw), yaw + math.pi)
+
+    data, name = moved_drawer(turned)
+    problems = [p for p in validate_data(data) if "front face" in p.message]
+    assert len(problems) == 1 and problems[0].where == f"component {name!r}", validate_data(data)
+    assert "points into the lid" in problems[0].message
+
+
+def test_validation_rejects_a_drawer_not_facing_an_edge():
+    data, name = moved_drawer(lambda x, y, yaw: (x, y, yaw + 0.3))
+    problems = [p for p in validate_data(data) if p.where == f"component {name!r}"]
+    assert any("multiple of 90 degrees" in p.message for p in problems), problems
+
+
+def test_the_layout_cuts_the_lid_at_a_drawers_front_and_keeps_the_margin_elsewhere():
+    config = LayoutConfig()
+    layout = Layout(config)
+    layout.place_first("drawer")
+    length, width = layout.lid_size()
+    ((x, y, _),) = layout.poses_in_lid()
+    assert x + DRAWER.edge_x == pytest.approx(length / 2, abs=1e-12)  # no margin ahead of the front
+    back_margin = (x - DRAWER_BACK - HOUSING_DEPTH) + length / 2
+    assert config.margin - 1e-12 <= back_margin < config.margin + 0.005  # the margin, rounded up to 5 mm, behind
+    assert width == pytest.approx(math.ceil((2 * (RAIL_OUTER + config.margin)) / 0.005 - 1e-9) * 0.005)
+    assert y == pytest.approx(0.0, abs=1e-12)
+
+
+def test_the_layout_puts_nothing_past_a_drawers_front():
+    layout = Layout(LayoutConfig())
+    layout.place_first("drawer")
+    assert layout.candidate(0, "wheel", 0.0) is None  # straight ahead: in front of the drawer, past its front
+    assert layout.candidate(0, "wheel", math.pi / 2) is not None  # beside it

@@ -91,13 +91,13 @@ def test_validate_reports_malformed_files_one_line_per_problem_without_traceback
 
 def test_validate_lists_every_problem_and_still_checks_the_other_files(tmp_path, spec_dict, write_spec):
     good = write_spec(spec_dict, "good.json")
-    spec_dict["components"][0]["kind"] = "drawer"
+    spec_dict["components"][0]["kind"] = "drawer"  # mid-lid: not on the lid edge, and over the slide
     spec_dict["locks"][0]["locked"] = "ghost"
     bad = write_spec(spec_dict, "bad.json")
     result = generate("validate", bad, good, tmp_path / "missing.json")
     assert result.returncode == 1
     bad_lines = [line for line in result.stdout.splitlines() if line.startswith(str(bad))]
-    assert len(bad_lines) == 2
+    assert len(bad_lines) == 3
     assert f"{good}: valid" in result.stdout
     assert f"{tmp_path / 'missing.json'}: file: cannot read" in result.stdout
 
