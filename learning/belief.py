@@ -243,3 +243,12 @@ class Belief:
             held = table[bits[:, c][:, None], columns[None, :], bits].sum(axis=1)
             free[:, c] = 1.0 - held
         return np.clip(free, 0.0, 1.0)
+
+
+CELL_BELIEF = BeliefConfig(jam_probability=0.05)
+"""The belief's observation model in a physical cell: a free part fails to move on a try now and then
+(it sticks, as the realistic cell's parts do on 2 % of tries; a grasp loses it unnoticed), so one
+"blocked" is strong but not final evidence of a lock. With the symbolic default (0.001) a part that
+jammed on the first try was written off, and the agent tried every other part before it again: +5
+actions (10 instead of 5) on 2 of 60 realistic trials, +11 on one. With 0.05 those took 7, 10 and 6;
+on the symbolic paper test boxes (300 runs) the mean stays 5.00 actions."""

@@ -22,7 +22,8 @@ How the protocol maps onto the SDK (``(code, value)`` returns; a non-zero code r
   magnitude against the cell's ``force_limit``; above it the arm is stopped (``emergency_stop``, i.e.
   ``set_state(4)``), :class:`ForceLimitExceeded` is raised and every later command refused.
 - cameras: one ``cv2.VideoCapture(device)`` per camera, devices from the cell's ``camera_devices``; a failed
-  read is a dropped frame (None). Robot time is the host's monotonic clock since connection [s].
+  read is a dropped frame (None). Robot time is the driver's clock since connection [s]: the host's monotonic
+  clock, or an injected one (``clock``, with ``sleep``: a test double runs the driver on simulated time).
 """
 
 from __future__ import annotations
@@ -100,6 +101,8 @@ class XArmRobot:
         camera_factory: opens a capture from a device (default: ``cv2.VideoCapture``).
         probe: refuses an address where no controller answers (default :func:`probe_controller`).
         sleep: waits a time [s] (default ``time.sleep``); tests pass a fake.
+        clock: reads the time [s] (default ``time.monotonic``): :attr:`time` and :meth:`wait` use it, so a test
+            double whose ``sleep`` advances a simulation and whose ``clock`` reads its time runs on simulated time.
     """
 
     def __init__(
@@ -111,20 +114,21 @@ class XArmRobot:
         camera_factory: Callable[[int | str], Any] | None = None,
         probe: Callable[[str], None] = probe_controller,
         sleep: Callable[[float], None] = time.sleep,
+        clock: Callable[[], float] = time.monotonic,
     ) -> None:
         missing = [c for c in cell.camera_names if c not in cell.camera_devices]
         if missing:
             raise CommandRefused(f"cell config {cell.name!r} names no capture device for camera(s) {missing}")
         self.cell = cell
         self.camera_names: tuple[str, ...] = cell.camera_names
-        self._sleep = sleep
+        self._sleep, self._clock = sleep, clock
         self._camera_factory = camera_factory or _default_camera
         self._captures: dict[str, Any] = {}
         self._bias = np.zeros(6)
         self._stopped: str | None = None
         probe(ip)  # before the SDK: its own connection attempt retries for much longer
         self._arm = (sdk_factory or _default_sdk)(ip)
-        self._t0 = time.monotonic()
+        self._t0 = self._clock()
         # ready for streaming: motors on, servo mode (set_servo_angle_j needs it), motion state
         try:
             for call, args in (("motion_enable", (True,)), ("set_mode", (1,)), ("set_state", (0,))):
@@ -148,8 +152,8 @@ class XArmRobot:
     # -- proprioception ----------------------------------------------------------------------------
     @property
     def time(self) -> float:
-        """Host monotonic time since connection [s]."""
-        return time.monotonic() - self._t0
+        """Time since connection on the driver's clock (the host's monotonic clock by default) [s]."""
+        return self._clock() - self._t0
 
     def joint_positions(self) -> np.ndarray:
         """Arm joint positions [rad], joints 1..7."""
@@ -237,8 +241,8 @@ class XArmRobot:
     def wait(self, seconds: float) -> None:
         """Let ``seconds`` pass [s], reading the wrench at the sensor's rate (the force limit holds meanwhile)."""
         period = 1.0 / self.cell.ft_rate_hz
-        end = time.monotonic() + seconds
-        while (left := end - time.monotonic()) > 0.0:
+        end = self._clock() + seconds
+        while (left := end - self._clock()) > 0.0:
             self.wrench()
             self._sleep(min(period, left))
 

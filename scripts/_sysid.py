@@ -129,8 +129,9 @@ class TruthTrace:
 
 def record_task(settings: dict[str, Any], context: dict[str, Any]) -> dict[str, Any]:
     """Solve one box in the twin with every toggle logged (a runner task); the log goes to ``context["log"]``."""
-    from _twin_trial import CELL_BELIEF, evaluation_world  # MuJoCo and rendering only in the task
+    from _twin_trial import evaluation_world  # MuJoCo and rendering only in the task
 
+    from learning.belief import CELL_BELIEF
     from skills import SkillError
     from skills.toggle_recorder import ToggleRecorder
     from twin.errors import SimulationDiverged

@@ -12,9 +12,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from _twin_trial import CELL_BELIEF, evaluation_world
+from _twin_trial import evaluation_world
 
 from learning import MemoryAgent, RunResult, run_episode
+from learning.belief import CELL_BELIEF
 from learning.dual_controller import DualControllerConfig
 from models import PuzzleSpec
 from models.calibration import CellCalibration
@@ -35,7 +36,7 @@ class TwinTraining:
     @property
     def controller(self) -> DualControllerConfig:
         """The memory agent's controller in a physical cell (its belief expects a free part to stick now and
-        then: ``_twin_trial.CELL_BELIEF``), as in the twin trials it is evaluated by."""
+        then: ``learning.belief.CELL_BELIEF``), as in the twin trials it is evaluated by."""
         return DualControllerConfig(belief=CELL_BELIEF)
 
     def episode(self, agent: MemoryAgent, spec: PuzzleSpec, seed: int, max_actions: int) -> RunResult:

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from learning import RunResult, make_agent, run_episode
-from learning.belief import BeliefConfig
+from learning.belief import CELL_BELIEF
 from learning.memory import MemoryStore
 from models import PuzzleSpec
 from models.calibration import CellCalibration
@@ -29,14 +29,6 @@ from twin.reality import RealityProfile
 from twin.rerun_log import TrialRecording
 from twin.rollout_video import BackgroundRollout, Caption, RolloutFrame, SceneCameras
 from twin.session import TwinSession
-
-CELL_BELIEF = BeliefConfig(jam_probability=0.05)
-"""The belief's observation model in a physical cell: a free part fails to move on a try now and then
-(it sticks, as the realistic cell's parts do on 2 % of tries; a grasp loses it unnoticed), so one
-"blocked" is strong but not final evidence of a lock. With the symbolic default (0.001) a part that
-jammed on the first try was written off, and the agent tried every other part before it again: +5
-actions (10 instead of 5) on 2 of 60 realistic trials, +11 on one. With 0.05 those took 7, 10 and 6;
-on the symbolic paper test boxes (300 runs) the mean stays 5.00 actions."""
 
 
 class RolloutRecorder:

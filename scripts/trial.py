@@ -25,9 +25,15 @@ and agent) one
 component's kind wrong in every run, drawn from the run's seed (the run's ``told_kinds``): the force limits
 must hold when a slide is pulled along a wheel's arc.
 
-``--robot xarm --ip ADDRESS --cell FILE`` is for a real xArm-7 (``real.XArmRobot``, the ``real`` extra): it
-refuses at once, in one line, an address where no arm answers, a missing SDK or a bad cell config; an arm that
-answers is let go again, since trials on a real arm are not wired to the skills yet.
+``--robot xarm --ip ADDRESS --cell FILE --calibration FILE --specs SPEC --runs 1`` runs one trial on a real
+xArm-7 (``real.XArmRobot``, the ``real`` extra) through the same pipeline (``scripts/_real_trial.py``): the box
+on the table is the one spec given; the cell config (``models/cell_config.py``) gives the cameras, the ArUco
+dictionary and marker size, the force limit and latch threshold and the rest posture (the arm goes there
+first); ``--calibration`` is the cell's camera calibration. Its record holds only what was sensed (no ground
+truth: ``solved`` as perceived), written to ``DIR/runs/`` and ``DIR/results.json`` after every action. It
+refuses at once, in one line, an address where no arm answers (first, in about a second), a missing SDK, a bad
+cell config or calibration, more than one spec or run, and the twin-only flags. A stop by the arm's force limit
+ends the trial with one line on stderr and exit 1; what was done is kept in ``DIR``.
 
 Runs are tasks of ``learning.runner``: ``--workers K`` runs them in K worker processes (default: one per
 core for ``--sim twin``; in-process for ``--sim symbolic``, whose runs last less than handing them over),
@@ -50,10 +56,12 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import _trial_task
-from _cli import fail, one_line
+from _cli import fail, one_line, write_json
 from _interrupt import StopRequests
 from _run_store import Periodic, RunStore
 from tqdm import tqdm
@@ -70,22 +78,88 @@ SIMS = ("symbolic", "twin")
 ROBOTS = ("twin", "xarm")
 
 
-def _connect_xarm(args) -> None:
-    """``--robot xarm``: refuse clearly what cannot run (no --ip or --cell, no SDK, no arm answering); an arm that
-    answers is connected and let go again, since the skills pipeline is not wired to a real arm yet."""
+def _real_main(args, arm: Callable[[str, Any], Any] | None = None) -> int:
+    """``--robot xarm``: one trial on the real arm (``scripts/_real_trial.py``), refusing clearly, in one line, what
+    cannot run; an address where no arm answers is refused first, in about a second. ``arm(ip, cell)`` connects
+    to the arm (default ``real.XArmRobot``, after probing the address; a test passes one over a test double)."""
     if args.ip is None or args.cell is None:
         fail("--robot xarm needs --ip ADDRESS (the arm's controller) and --cell FILE (the cell config)")
     if args.sim != "twin":
         fail("--robot xarm runs the perception and skills pipeline: give --sim twin")
+    from models.calibration import CalibrationError, CellCalibration
     from models.cell_config import CellConfigError, load_cell_config
-    from real import RealError, XArmRobot
+    from real import RealError, XArmRobot, probe_controller
 
     try:
         cell = load_cell_config(args.cell)
-        XArmRobot(args.ip, cell).close()
+        if arm is None:
+            probe_controller(args.ip)
     except (CellConfigError, RealError) as err:
         fail(f"--robot xarm: {one_line(err)}")
-    fail(f"--robot xarm: the arm at {args.ip} answered, but trials on a real arm are not wired to the skills yet")
+    twin_only = [flag for flag, given in (
+        ("--video", args.video), ("--record", args.record is not None), ("--wrong-kind", args.wrong_kind),
+        ("--reality", args.reality != "ideal"), ("--workers", args.workers is not None),
+        ("--ray", args.ray is not None), ("--resume", args.resume),
+    ) if given]  # fmt: skip
+    if twin_only:
+        fail(f"--robot xarm runs one trial on the arm: {', '.join(twin_only)} are for twin trials")
+    if len(args.specs) != 1:
+        fail(f"--robot xarm tries the one box on the table: give one spec, got {len(args.specs)}")
+    if args.runs != 1:
+        fail(f"--robot xarm runs one trial per command: give --runs 1, got {args.runs}")
+    if args.max_actions < 1 or args.seed < 0:
+        fail("--max-actions must be >= 1 and --seed >= 0")
+    if args.calibration is None:
+        fail("--robot xarm needs --calibration FILE: the cell's camera calibration (scripts/calibrate.py)")
+    try:
+        spec = load_spec(args.specs[0])
+        calibration = CellCalibration.load(args.calibration)
+        for camera in (cell.overview_camera, cell.wrist_camera):
+            calibration.camera(camera)
+    except (SpecError, CalibrationError) as err:
+        fail(f"--robot xarm: {one_line(err)}")
+    if args.agent not in AGENT_NAMES:
+        fail(f"unknown agent {args.agent!r}. Available agents: {sorted(AGENT_NAMES)}")
+    if (args.agent == "memory") != (args.memory is not None):
+        fail("--memory goes with --agent memory (and only with it): train one with scripts/train.py")
+    from _real_trial import cell_configs, run_real_trial
+
+    try:
+        cell_configs(cell)
+        memory = MemoryStore.open_existing(args.memory) if args.memory else None
+        make_agent(args.agent, spec, memory, args.checkpoint, max_lockers=args.max_lockers)
+    except (ValueError, LearningError) as err:
+        fail(f"--robot xarm: {one_line(err)}")
+
+    out = Path(args.out)
+    experiment = {"command": "trial", "robot": "xarm", "ip": args.ip, "cell": cell.to_dict(),
+                  "calibration": str(Path(args.calibration).resolve()), "spec": spec.to_dict(), "agent": args.agent,
+                  "memory": args.memory, "checkpoint": args.checkpoint, "seed": args.seed,
+                  "max_actions": args.max_actions, "max_lockers": args.max_lockers}  # fmt: skip
+    store = RunStore(out, experiment, force=args.force)
+    key = f"000-{spec.name}-seed{args.seed}"
+
+    def write(record: dict) -> None:  # the record as it grows: a stop or a crash keeps every action done
+        write_json(store.records.path(key), {"key": key, "record": record})
+        store.write_results({**summarise([record], args.max_actions), "runs_done": 0, "runs_planned": 1})
+
+    try:
+        with (arm or XArmRobot)(args.ip, cell) as robot:
+            record = run_real_trial(robot, calibration, spec, cell, args.agent, args.seed, args.max_actions,
+                                    memory=memory, checkpoint=args.checkpoint, on_record=write,
+                                    max_lockers=args.max_lockers)  # fmt: skip
+    except RealError as err:  # the arm refused or failed a call mid-trial (a stop is in the record instead)
+        fail(f"--robot xarm: {one_line(err)}; what was done is kept in {out}", code=1)
+    store.write_results({**summarise([record], args.max_actions), "runs_done": 1, "runs_planned": 1})
+    if record["stopped"]:
+        print(f"error: the arm was stopped after {record['num_actions']} action(s): {one_line(record['stopped'])}; "
+              f"kept in {out}", file=sys.stderr)  # fmt: skip
+        return 1
+    print(f"{args.agent} on the arm at {args.ip}: {'solved' if record['solved'] else 'not solved'} (as perceived) "
+          f"in {record['num_actions']} action(s), {record['wall_time_s']:.0f} s -> {out / 'results.json'}")  # fmt: skip
+    if record["ended"]:
+        print(f"unsolved: {record['ended']}")
+    return 0
 
 
 def twin_figures(runs: list) -> dict:
@@ -170,7 +244,9 @@ class _ActionBar:
             self.bar = None
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None = None) -> int:
+    """The command line (see the module docstring); ``arm(ip, cell)`` connects ``--robot xarm`` (default
+    ``real.XArmRobot``: tests pass one over a test double of the SDK)."""
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--specs", nargs="+", required=True, help="puzzle spec files")
     parser.add_argument("--memory", default=None, help="memory file from train.py (memory agent; read only)")
@@ -197,14 +273,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--reality", default="ideal", help="twin reality profile: ideal, realistic, harsh or a JSON file"
     )
-    parser.add_argument("--calibration", default=None, help="camera calibration from scripts/calibrate.py (twin)")
+    parser.add_argument(
+        "--calibration", default=None, help="camera calibration from scripts/calibrate.py (twin; needed for xarm)"
+    )
     parser.add_argument(
         "--workers", type=int, default=None, help="worker processes (default: one per core for twin, 1 = in-process)"
     )
     parser.add_argument("--ray", default=None, metavar="auto|ADDRESS", help="run on Ray: auto = a local cluster")
     parser.add_argument(
         "--robot", choices=ROBOTS, default="twin",
-        help="twin: the MuJoCo twin (default); xarm: a real xArm-7 at --ip (connects, then stops: not wired yet)",
+        help="twin: the MuJoCo twin (default); xarm: one trial on a real xArm-7 at --ip (--cell, --calibration)",
     )  # fmt: skip
     parser.add_argument("--ip", default=None, metavar="ADDRESS", help="the xArm controller's address (--robot xarm)")
     parser.add_argument(
@@ -214,8 +292,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--force", action="store_true", help="delete the results already in --out first")
     args = parser.parse_args(argv)
     if args.robot == "xarm":
-        _connect_xarm(args)
-    elif args.ip is not None or args.cell is not None:
+        return _real_main(args, arm)
+    if args.ip is not None or args.cell is not None:
         fail("--ip and --cell go with --robot xarm")
     # The memory is read, never written, during trials: evaluation does not change what was learned.
 

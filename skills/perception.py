@@ -19,14 +19,16 @@ from __future__ import annotations
 import math
 from collections import Counter
 from dataclasses import dataclass
+from typing import Any
 
 import cv2
 import numpy as np
 
 from models import geometry
 from models.calibration import CameraCalibration
+from models.cell_config import CellConfig, aruco_dictionary_name
 from models.kinds import MARKER_SIZE
-from models.markers import aruco_dictionary
+from models.markers import ARUCO_DICTIONARY, aruco_dictionary
 from models.robot import CameraImage
 from skills.errors import MarkersNotFound, UnknownMarker
 
@@ -44,6 +46,14 @@ class PerceptionConfig:
     reproject within ~0.3 px; a marker half occluded, blurred or mis-decoded does not)."""
     max_view_angle_deg: float = 55.0
     """Largest angle between the marker's normal and the line of sight for a trusted pose [deg]."""
+    dictionary: str = aruco_dictionary_name(ARUCO_DICTIONARY)
+    """OpenCV's name of the markers' ArUco dictionary (default the project's, ``DICT_4X4_250``): a marker of
+    another dictionary is not read."""
+
+    @classmethod
+    def for_cell(cls, cell: CellConfig, **overrides: Any) -> PerceptionConfig:
+        """How a cell's markers are read: its dictionary and marker size (the rest as given, or the defaults)."""
+        return cls(**{"dictionary": cell.aruco_dictionary, "marker_size": cell.marker_size, **overrides})
 
 
 @dataclass(frozen=True)
@@ -98,7 +108,8 @@ class MarkerDetector:
         self.config = config or PerceptionConfig()
         parameters = cv2.aruco.DetectorParameters()
         parameters.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
-        self._detector = cv2.aruco.ArucoDetector(aruco_dictionary(), parameters)
+        dictionary = aruco_dictionary(getattr(cv2.aruco, self.config.dictionary))
+        self._detector = cv2.aruco.ArucoDetector(dictionary, parameters)
         half = self.config.marker_size / 2
         # marker corners in the marker frame, in the order IPPE_SQUARE expects
         self._object_points = np.array([[-half, half, 0], [half, half, 0], [half, -half, 0], [-half, -half, 0]])

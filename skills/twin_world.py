@@ -40,7 +40,7 @@ from models.robot import Robot
 from skills.door_clearance import lean_away, near_open_door
 from skills.joint_model import JointModel, joint_model
 from skills.perception import MarkerDetection, MarkerDetector, kind_of, lid_height, upright_pose
-from skills.primitives import STOPPED_DESCENDING, Toggler, ToggleResult
+from skills.primitives import STOPPED_DESCENDING, PrimitiveConfig, Toggler, ToggleResult
 from skills.scene_survey import SceneSurvey, SurveyConfig
 
 MOVED_DISTANCE = 0.01
@@ -78,6 +78,9 @@ class WorldConfig:
     onto cautiously [m]: the fingers, 42 mm apart and 30 mm wide, reach ~30 mm from it, and the door's pose
     is known to ~5 mm."""
     survey: SurveyConfig = field(default_factory=SurveyConfig)
+    primitives: PrimitiveConfig = field(default_factory=PrimitiveConfig)
+    """The primitives' config (force limit, latch threshold...): a real cell's comes from its cell config
+    (``PrimitiveConfig.for_cell``)."""
 
 
 @dataclass
@@ -126,7 +129,7 @@ class TwinWorld:
 
     def __post_init__(self) -> None:
         self.detector = self.detector or MarkerDetector()
-        self.toggler = Toggler(self.robot)
+        self.toggler = Toggler(self.robot, self.config.primitives)
         lifts = {m: get_kind(kind).lift for m, kind in self.marker_map.items()}  # a lever's marker stands higher
         self.survey = SceneSurvey(
             self.robot, self.calibration, self.toggler, self.detector, self.config.survey, marker_lifts=lifts

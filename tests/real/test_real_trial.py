@@ -1,0 +1,254 @@
+"""Trials on a real xArm-7 through the same pipeline, proven against the twin standing in for the arm: the driver
+(``real.XArmRobot``) runs on :class:`twin_sdk.TwinSDK`, a double of the SDK backed by a twin session, on
+simulated time. The pipeline (``scripts/_real_trial.py``) sees only what the driver gives; these tests read the
+session's truth beside it."""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from twin_sdk import TwinSDK, rpy_of, twin_xarm_cell
+
+from models.cell_config import EXAMPLE, CellConfig, save_cell_config
+from models.generator import paper_family
+from models.spec import save_spec
+from real import XArmRobot
+from real.xarm_driver import _rpy_matrix
+from skills.errors import MarkersNotFound
+from skills.perception import MarkerDetector, PerceptionConfig
+from skills.twin_world import TwinWorld
+from twin.nominal_calibration import nominal_calibration
+from twin.session import TwinSession
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
+
+import trial  # noqa: E402  (scripts/ is not a package)
+from _real_trial import cell_configs, run_real_trial  # noqa: E402
+
+SPEC = paper_family("test")[0]
+
+
+def arm_on(session: TwinSession, cell) -> tuple[XArmRobot, TwinSDK]:
+    """The real driver over the twin, as ``trial.py --robot xarm`` makes it over an arm."""
+    sdk = TwinSDK(session, cell)
+    robot = XArmRobot(
+        "twin", cell, sdk_factory=sdk.factory, camera_factory=sdk.camera, probe=lambda ip: None,
+        sleep=sdk.sleep, clock=sdk.clock,
+    )  # fmt: skip
+    return robot, sdk
+
+
+EXAMPLE_CELL = CellConfig.from_dict({**EXAMPLE, "camera_devices": {"overview": 0, "wrist": 1}})
+"""The example cell with capture devices (for the driver without cameras)."""
+
+
+class _QuietSDK:
+    """Every command succeeds; the F/T sensor reads zero."""
+
+    def __init__(self, ip):
+        pass
+
+    def __getattr__(self, name):
+        return lambda *args, **kwargs: 0
+
+    def get_ft_sensor_data(self):
+        return 0, [0.0] * 6
+
+
+def test_the_driver_runs_on_an_injected_clock():
+    now = [100.0]
+    sleeps: list[float] = []
+
+    def sleep(dt):
+        sleeps.append(dt)
+        now[0] += dt
+
+    robot = XArmRobot("10.0.0.5", EXAMPLE_CELL, sdk_factory=_QuietSDK, probe=lambda ip: None, sleep=sleep,
+                      clock=lambda: now[0])  # fmt: skip
+    assert robot.time == 0.0
+    robot.wait(0.035)
+    assert robot.time == pytest.approx(0.035) and sleeps == pytest.approx([0.01, 0.01, 0.01, 0.005])
+
+
+def test_the_double_gives_the_twins_readings_in_the_sdks_units_and_frames():
+    with TwinSession(SPEC, seed=0, reality="ideal") as session:
+        cell = twin_xarm_cell(session)
+        robot, sdk = arm_on(session, cell)
+        twin = session.robot
+        robot.command_joint_positions(np.array(cell.rest_posture) + 0.2)
+        robot.command_gripper(0.4)
+        robot.wait(1.0)
+        assert robot.time == pytest.approx(1.0) and session.time == pytest.approx(1.0, abs=1e-9)
+        np.testing.assert_allclose(robot.joint_positions(), twin.joint_positions())
+        np.testing.assert_allclose(robot.tcp_pose_in_base(), twin.tcp_pose_in_base(), atol=1e-12)
+        assert robot.gripper_opening() == pytest.approx(twin.gripper_opening())
+        # untared, the same load in the base frame (the gripper's weight, 7.37 N down) through the driver's
+        # TCP-frame reading as through the twin's sensor-frame one
+        force_real = robot.ft_rotation_in_base() @ robot.wrench()[:3]
+        force_twin = twin.ft_rotation_in_base() @ twin.wrench()[:3]
+        np.testing.assert_allclose(force_real, force_twin, atol=1e-9)
+        assert force_real[2] == pytest.approx(-7.37, abs=0.05)
+        robot.tare()
+        assert np.linalg.norm(robot.wrench()[:3]) < 0.05
+        image = robot.capture(cell.overview_camera)
+        np.testing.assert_array_equal(image.rgb, twin.capture(cell.overview_camera).rgb)
+    R = _rpy_matrix(0.3, -0.4, 2.5)
+    np.testing.assert_allclose(_rpy_matrix(*rpy_of(R)), R, atol=1e-12)
+    assert "emergency_stop" not in sdk.calls
+
+
+def test_a_paper_box_is_solved_through_the_real_driver_and_every_sensed_outcome_is_the_truth():
+    start = time.perf_counter()
+    with TwinSession(SPEC, seed=0, reality="ideal") as session:
+        cell = twin_xarm_cell(session)
+        robot, sdk = arm_on(session, cell)
+        truth: list[np.ndarray] = [session.component_states().copy()]  # the test reads the session, the trial not
+        record = run_real_trial(
+            robot, nominal_calibration(session), session.spec, cell, "oracle", 0, 12,
+            on_action=lambda _: truth.append(session.component_states().copy()),
+        )  # fmt: skip
+        final = session.component_states()
+        goal = session.spec.index_of(session.spec.goal.component)
+    wall = time.perf_counter() - start
+    assert record["solved"] and not record["stopped"] and record["ended"] == ""
+    assert int(final[goal]) == SPEC.goal.state  # solved as perceived, and truly
+    index = {c.name: i for i, c in enumerate(SPEC.components)}
+    assert len(record["timeline"]) == record["num_actions"] == len(truth) - 1 >= 1
+    for k, action in enumerate(record["timeline"]):
+        i = index[action["component"]]
+        assert action["moved"] == bool(truth[k + 1][i] != truth[k][i]), action
+        assert "true_moved" not in action  # nothing of the simulator's in the record
+    assert "emergency_stop" not in sdk.calls and "set_servo_angle_j" in sdk.calls
+    assert record["robot_time_s"] > 30.0  # simulated time, on the driver's clock
+    print(f"end-to-end trial through the real driver: {wall:.1f} s wall, {record['robot_time_s']:.0f} s robot time")
+    assert wall < 60.0
+
+
+def test_a_low_force_limit_in_the_cell_config_stops_the_arm_and_ends_the_trial(tmp_path, capsys):
+    with TwinSession(SPEC, seed=0, reality="ideal") as session:
+        # the random agent pulls latched parts: at 36 N one pull stops the arm (the primitives' own guard at the
+        # same limit acts on the filtered force, later than the driver's on the raw reading)
+        cell = twin_xarm_cell(session, force_limit=36.0)
+        files = _cli_files(tmp_path, session, cell)
+        sdks: list[TwinSDK] = []
+
+        def connect(ip, cell_read):
+            robot, sdk = arm_on(session, cell_read)
+            sdks.append(sdk)
+            return robot
+
+        code = trial.main([*files, "--agent", "random", "--max-actions", "15"], arm=connect)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 1
+    assert len(err) == 1 and "the arm was stopped after" in err[0] and "force_limit 36.0 N" in err[0], err
+    assert "emergency_stop" in sdks[0].calls and sdks[0].stopped
+    after = sdks[0].calls[sdks[0].calls.index("emergency_stop") + 1 :]
+    assert "set_servo_angle_j" not in after and "set_gripper_position" not in after  # nothing moved after it
+    record = json.loads(next((tmp_path / "out/runs").glob("*.json")).read_text())["record"]
+    assert record["stopped"].startswith("wrist force") and record["ended"].startswith("ForceLimitExceeded")
+    assert not record["solved"] and record["num_actions"] == len(record["timeline"]) >= 1  # what was done is kept
+    results = json.loads((tmp_path / "out/results.json").read_text())
+    assert results["runs_done"] == 1 and results["runs"][0]["stopped"] == record["stopped"]
+
+
+def test_trial_py_runs_a_real_trial_and_writes_what_was_sensed(tmp_path, capsys):
+    with TwinSession(SPEC, seed=0, reality="ideal") as session:
+        cell = twin_xarm_cell(session)
+        files = _cli_files(tmp_path, session, cell)
+        rest = np.array(cell.rest_posture)
+
+        def connect(ip, cell_read):  # an arm handed over away from the cell's rest posture
+            robot, _ = arm_on(session, cell_read)
+            for k in range(1, 101):
+                robot.command_joint_positions(rest + k / 100 * np.array([0.6, 0.3, 0.0, 0.3, 0.0, -0.2, 0.4]))
+                robot.wait(0.02)
+            return robot
+
+        code = trial.main([*files, "--agent", "oracle", "--max-actions", "10"], arm=connect)
+        np.testing.assert_allclose(session.robot.joint_positions(), rest, atol=0.01)  # back at rest at the end
+    out = capsys.readouterr()
+    assert code == 0, out.err
+    assert "oracle on the arm at twin: solved (as perceived) in 5 action(s)" in out.out
+    results = json.loads((tmp_path / "out/results.json").read_text())
+    assert results["success_rate"] == 1.0 and results["runs_done"] == 1
+    config = json.loads((tmp_path / "out/config.json").read_text())
+    assert config["robot"] == "xarm" and config["cell"]["name"] == "twin-as-xarm"
+
+
+def test_the_detector_reads_the_cells_dictionary_only():
+    with TwinSession(SPEC, seed=0, reality="ideal") as session:
+        other = twin_xarm_cell(session, aruco_dictionary="DICT_6X6_250")
+        image = session.robot.capture(other.overview_camera)
+        assert len(MarkerDetector(PerceptionConfig.for_cell(twin_xarm_cell(session))).detect_pixels(image.rgb)) == 5
+        assert MarkerDetector(PerceptionConfig.for_cell(other)).detect_pixels(image.rgb) == []
+        assert PerceptionConfig.for_cell(twin_xarm_cell(session)) == PerceptionConfig()  # the twin's: the defaults
+        robot, _ = arm_on(session, other)
+        record = run_real_trial(robot, nominal_calibration(session), session.spec, other, "oracle", 0, 5)
+    assert not record["solved"] and record["num_actions"] == 0 and not record["stopped"]
+    cameras = [other.overview_camera, other.wrist_camera]
+    missing = f"missing marker ids [0, 1, 2, 3, 4] after looking from {cameras}"
+    assert record["ended"] == f"{MarkersNotFound.__name__}: {missing}"
+
+
+def test_trial_py_refuses_more_than_one_spec_and_a_missing_calibration(tmp_path, capsys):
+    with TwinSession(SPEC, seed=0, reality="ideal") as session:
+        cell = twin_xarm_cell(session)
+        files = _cli_files(tmp_path, session, cell)
+    spec = files[files.index("--specs") + 1]
+    without_calibration = files[: files.index("--calibration")] + files[files.index("--calibration") + 2 :]
+    for argv, expected in (
+        ([*files[:2], spec, *files[2:]], "--robot xarm tries the one box on the table: give one spec, got 2"),
+        (without_calibration, "--robot xarm needs --calibration FILE"),
+    ):
+        with pytest.raises(SystemExit) as stop:
+            trial.main([*argv, "--agent", "oracle", "--max-actions", "5"], arm=lambda ip, c: pytest.fail("connected"))
+        err = capsys.readouterr().err.strip().splitlines()
+        assert stop.value.code == 2 and len(err) == 1 and expected in err[0], err
+    assert not (tmp_path / "out").exists()
+
+
+def _cli_files(tmp_path: Path, session: TwinSession, cell) -> list[str]:
+    """``trial.py --robot xarm`` arguments with the session's spec, the cell config and its nominal calibration."""
+    spec = save_spec(session.spec, tmp_path / "box.json")
+    calibration = nominal_calibration(session).save(tmp_path / "calibration.json")
+    cell_file = save_cell_config(cell, tmp_path / "cell.json")
+    return ["--specs", str(spec), "--sim", "twin", "--runs", "1", "--seed", "0", "--out", str(tmp_path / "out"),
+            "--robot", "xarm", "--ip", "twin", "--cell", str(cell_file), "--calibration", str(calibration)]  # fmt: skip
+
+
+def test_the_worlds_primitives_run_the_cells_thresholds():
+    with TwinSession(SPEC, seed=0, reality="ideal") as session:
+        cell = twin_xarm_cell(session, force_limit=45.0, blocked_force=15.0)
+        world_config, perception = cell_configs(cell)
+        spec = session.spec
+        world = TwinWorld(
+            session.robot, nominal_calibration(session), {c.marker: c.kind for c in spec.components},
+            spec.components[spec.index_of(spec.goal.component)].marker, config=world_config,
+            detector=MarkerDetector(perception),
+        )  # fmt: skip
+    assert (world.toggler.config.force_limit, world.toggler.config.blocked_force, world.toggler.limit) == (45, 15, 45)
+    assert world.survey.toggler is world.toggler  # the survey moved the arm with them too
+
+
+def test_blocked_tries_are_sensed_as_the_twin_holds_them():
+    """The random agent pulls latched parts: every ``blocked`` and ``moved`` the driver's F/T and cameras gave is
+    the twin's truth."""
+    with TwinSession(paper_family("test")[1], seed=1, reality="ideal") as session:
+        cell = twin_xarm_cell(session)
+        robot, _ = arm_on(session, cell)
+        truth: list[np.ndarray] = [session.component_states().copy()]
+        record = run_real_trial(
+            robot, nominal_calibration(session), session.spec, cell, "random", 1, 15,
+            on_action=lambda _: truth.append(session.component_states().copy()),
+        )  # fmt: skip
+        index = {c.name: i for i, c in enumerate(session.spec.components)}
+    outcomes = [a["outcome"] for a in record["timeline"]]
+    assert "blocked" in outcomes and "moved" in outcomes and len(outcomes) == len(truth) - 1
+    for k, action in enumerate(record["timeline"]):
+        i = index[action["component"]]
+        assert action["moved"] == bool(truth[k + 1][i] != truth[k][i]), action
