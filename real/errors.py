@@ -23,8 +23,16 @@ class CommandRefused(RealError):
     """A command the driver refuses before it reaches the arm (non-finite, out of range, after a stop)."""
 
 
-class ForceLimitExceeded(RealError):
+class ArmStopped(RealError):
+    """The driver stopped the arm (``emergency_stop``) for a safety limit; every later command is refused."""
+
+
+class ForceLimitExceeded(ArmStopped):
     """The wrist force passed the cell's limit; the arm was stopped."""
+
+
+class WorkspaceExceeded(ArmStopped):
+    """The TCP left the cell's workspace box; the arm was stopped."""
 
 
 class UnknownCamera(RealError, KeyError):
@@ -35,6 +43,7 @@ class UnknownCamera(RealError, KeyError):
 
 
 __all__ = [
+    "ArmStopped",
     "ArmUnreachable",
     "CommandRefused",
     "ForceLimitExceeded",
@@ -42,4 +51,5 @@ __all__ = [
     "SDKCallFailed",
     "SDKMissing",
     "UnknownCamera",
+    "WorkspaceExceeded",
 ]

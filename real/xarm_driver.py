@@ -19,8 +19,10 @@ How the protocol maps onto the SDK (``(code, value)`` returns; a non-zero code r
   minus this driver's last tare; ``tare`` also zeroes the controller's offset (``set_ft_sensor_zero``). The
   sensor frame is taken to be aligned with the TCP frame (a TCP offset without rotation).
 - safety: every wrench read, every command and every slice of :meth:`XArmRobot.wait` checks the tared force
-  magnitude against the cell's ``force_limit``; above it the arm is stopped (``emergency_stop``, i.e.
-  ``set_state(4)``), :class:`ForceLimitExceeded` is raised and every later command refused.
+  magnitude against the cell's ``force_limit``, and every command and slice the TCP's position against the
+  cell's workspace box (``workspace_min`` .. ``workspace_max``); past either the arm is stopped
+  (``emergency_stop``, i.e. ``set_state(4)``), :class:`ForceLimitExceeded` or :class:`WorkspaceExceeded` is
+  raised and every later command refused.
 - cameras: one ``cv2.VideoCapture(device)`` per camera, devices from the cell's ``camera_devices``; a failed
   read is a dropped frame (None). Robot time is the driver's clock since connection [s]: the host's monotonic
   clock, or an injected one (``clock``, with ``sleep``: a test double runs the driver on simulated time).
@@ -39,12 +41,14 @@ import numpy as np
 from models.cell_config import CellConfig
 from models.robot import CameraImage
 from real.errors import (
+    ArmStopped,
     ArmUnreachable,
     CommandRefused,
     ForceLimitExceeded,
     SDKCallFailed,
     SDKMissing,
     UnknownCamera,
+    WorkspaceExceeded,
 )
 
 XARM_CONTROL_PORT = 502
@@ -206,15 +210,25 @@ class XArmRobot:
             self._sleep(1.0 / self.cell.ft_rate_hz)
         self._bias = np.mean(readings, axis=0)
 
-    def _stop(self, why: str) -> None:
+    def _stop(self, why: str, error: type[ArmStopped] = ForceLimitExceeded) -> None:
         self._stopped = why
         self._arm.emergency_stop()  # set_state(4): the controller stops the motion at once
-        raise ForceLimitExceeded(f"{why}: the arm was stopped (emergency_stop)")
+        raise error(f"{why}: the arm was stopped (emergency_stop)")
+
+    def _check_workspace(self) -> None:
+        """Stop the arm if its TCP has left the cell's workspace box."""
+        p = self.tcp_pose_in_base()[:3, 3]
+        low, high = np.asarray(self.cell.workspace_min), np.asarray(self.cell.workspace_max)
+        outside = np.flatnonzero((p < low) | (p > high))
+        if outside.size:
+            axes = ", ".join(f"{'xyz'[i]}={p[i]:.3f} not in [{low[i]:.3f}, {high[i]:.3f}]" for i in outside)
+            self._stop(f"TCP outside the cell's workspace ({axes} m)", WorkspaceExceeded)
 
     def _check_commandable(self) -> None:
         if self._stopped is not None:
             raise CommandRefused(f"the arm was stopped ({self._stopped}); clear it and connect again")
         self.wrench()  # the force limit holds at every command
+        self._check_workspace()  # so does the workspace
 
     # -- commands ----------------------------------------------------------------------------------
     def command_joint_positions(self, q: np.ndarray) -> None:
@@ -239,11 +253,13 @@ class XArmRobot:
         self._code("set_gripper_position", self._arm.set_gripper_position(pos, wait=False))
 
     def wait(self, seconds: float) -> None:
-        """Let ``seconds`` pass [s], reading the wrench at the sensor's rate (the force limit holds meanwhile)."""
+        """Let ``seconds`` pass [s], reading the wrench and the TCP at the sensor's rate (the force limit and the
+        workspace hold meanwhile)."""
         period = 1.0 / self.cell.ft_rate_hz
         end = self._clock() + seconds
         while (left := end - self._clock()) > 0.0:
             self.wrench()
+            self._check_workspace()
             self._sleep(min(period, left))
 
     # -- cameras -----------------------------------------------------------------------------------

@@ -5,8 +5,8 @@ outcomes — over any :class:`models.robot.Robot` (``real.XArmRobot``), configur
 
 Nothing here reads a simulator: there is no ground truth, so the record holds only what was sensed (each
 action's outcome as the F/T sensor and the cameras told it, whether the goal was reached as perceived, the
-wall and robot time). A stop by the arm's force limit (:class:`real.errors.ForceLimitExceeded`) ends the trial:
-the record says so (``stopped``) and keeps every action finished before it.
+wall and robot time). A stop by the arm's safety limits (:class:`real.errors.ArmStopped`: its force limit, its
+workspace) ends the trial: the record says so (``stopped``) and keeps every action finished before it.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from models import PuzzleSpec
 from models.calibration import CellCalibration
 from models.cell_config import CellConfig
 from models.robot import Robot
-from real.errors import ForceLimitExceeded
+from real.errors import ArmStopped
 from skills import SkillError
 from skills.perception import MarkerDetector, PerceptionConfig
 from skills.primitives import PrimitiveConfig, Toggler
@@ -128,7 +128,7 @@ def run_real_trial(
         )
         agent = make_agent(agent_name, spec, memory, checkpoint, belief=CELL_BELIEF, max_lockers=max_lockers)
         result = run_episode(agent, world, spec.name, seed, max_actions, progress)
-    except ForceLimitExceeded as err:  # the arm was stopped: what was done before stays in the record
+    except ArmStopped as err:  # the arm was stopped (force, workspace): what was done before stays in the record
         stopped = str(err)
         result = _unfinished(spec, seed, world, wall, f"{type(err).__name__}: {err}")
     except SkillError as err:  # the cell could not run this trial (markers not seen...): say why

@@ -33,7 +33,7 @@ first); ``--calibration`` is the cell's camera calibration. Its record holds onl
 truth: ``solved`` as perceived), written to ``DIR/runs/`` and ``DIR/results.json`` after every action. It
 refuses at once, in one line, an address where no arm answers (first, in about a second), a missing SDK, a bad
 cell config or calibration, more than one spec or run, and the twin-only flags. A stop by the arm's force limit
-ends the trial with one line on stderr and exit 1; what was done is kept in ``DIR``.
+or workspace ends the trial with one line on stderr and exit 1; what was done is kept in ``DIR``.
 
 Runs are tasks of ``learning.runner``: ``--workers K`` runs them in K worker processes (default: one per
 core for ``--sim twin``; in-process for ``--sim symbolic``, whose runs last less than handing them over),

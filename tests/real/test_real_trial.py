@@ -48,7 +48,7 @@ EXAMPLE_CELL = CellConfig.from_dict({**EXAMPLE, "camera_devices": {"overview": 0
 
 
 class _QuietSDK:
-    """Every command succeeds; the F/T sensor reads zero."""
+    """Every command succeeds; the F/T sensor reads zero, the TCP stands at (0.3, 0, 0.2) m."""
 
     def __init__(self, ip):
         pass
@@ -58,6 +58,9 @@ class _QuietSDK:
 
     def get_ft_sensor_data(self):
         return 0, [0.0] * 6
+
+    def get_position(self, **kwargs):
+        return 0, [300.0, 0.0, 200.0, 0.0, 0.0, 0.0]
 
 
 def test_the_driver_runs_on_an_injected_clock():

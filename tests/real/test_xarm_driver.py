@@ -11,7 +11,17 @@ import pytest
 
 from models.cell_config import EXAMPLE, CellConfig, save_cell_config
 from models.robot import Robot
-from real import ArmUnreachable, CommandRefused, ForceLimitExceeded, SDKMissing, UnknownCamera, XArmRobot, xarm_driver
+from real import (
+    ArmStopped,
+    ArmUnreachable,
+    CommandRefused,
+    ForceLimitExceeded,
+    SDKMissing,
+    UnknownCamera,
+    WorkspaceExceeded,
+    XArmRobot,
+    xarm_driver,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 CELL = CellConfig.from_dict({**EXAMPLE, "name": "test-cell", "camera_devices": {"overview": 0, "wrist": 1}})
@@ -52,8 +62,10 @@ class FakeSDK:
     def get_ft_sensor_data(self, **kwargs):
         return self._get("get_ft_sensor_data", self._next(self.ft), kwargs)
 
-    def get_position(self, **kwargs):  # 90 deg about z, at (300, -100, 200) mm
-        return self._get("get_position", [300.0, -100.0, 200.0, 0.0, 0.0, np.pi / 2], kwargs)
+    position = [300.0, -100.0, 200.0, 0.0, 0.0, np.pi / 2]  # 90 deg about z, at (300, -100, 200) mm
+
+    def get_position(self, **kwargs):
+        return self._get("get_position", list(self.position), kwargs)
 
     def names(self):
         return [c[0] for c in self.calls]
@@ -140,6 +152,18 @@ def test_force_above_the_cells_limit_stops_the_arm_and_refuses_commands():
     assert "emergency_stop" in sdk.names() and "set_servo_angle_j" not in sdk.names()
     with pytest.raises(CommandRefused, match="stopped"):
         robot.command_gripper(0.0)
+
+
+def test_a_tcp_outside_the_cells_workspace_stops_the_arm_and_refuses_commands():
+    robot, sdk = make()
+    robot.command_gripper(0.5)  # the TCP at (0.3, -0.1, 0.2) m: inside the example cell's box
+    sdk.position = [300.0, -100.0, 650.0, 0.0, 0.0, 0.0]  # 0.65 m up: above the box's 0.58 m
+    with pytest.raises(WorkspaceExceeded, match=r"z=0.650 not in \[0.000, 0.580\]"):
+        robot.command_joint_positions(np.array(CELL.rest_posture))
+    assert "emergency_stop" in sdk.names() and "set_servo_angle_j" not in sdk.names()
+    with pytest.raises(CommandRefused, match="stopped"):
+        robot.command_gripper(0.0)
+    assert isinstance(WorkspaceExceeded("x"), ArmStopped) and isinstance(ForceLimitExceeded("x"), ArmStopped)
 
 
 def test_cameras_give_rgb_frames_and_none_for_a_dropped_frame():
