@@ -18,7 +18,7 @@ from models.cell_config import EXAMPLE, CellConfig, save_cell_config
 from models.generator import paper_family
 from models.spec import save_spec
 from real import XArmRobot
-from real.xarm_driver import _rpy_matrix
+from real.xarm_driver import XARM7_JOINT_LIMITS, _rpy_matrix
 from skills.errors import MarkersNotFound
 from skills.perception import MarkerDetector, PerceptionConfig
 from skills.twin_world import TwinWorld
@@ -255,3 +255,9 @@ def test_blocked_tries_are_sensed_as_the_twin_holds_them():
     for k, action in enumerate(record["timeline"]):
         i = index[action["component"]]
         assert action["moved"] == bool(truth[k + 1][i] != truth[k][i]), action
+
+
+def test_the_drivers_joint_ranges_are_the_twins():
+    """The driver refuses targets outside the ranges the skills' IK plans in: the twin's arm model's."""
+    with TwinSession(SPEC, seed=0, reality="ideal") as session:
+        np.testing.assert_allclose(XARM7_JOINT_LIMITS, session.robot.joint_limits(), atol=1e-4)
