@@ -110,6 +110,13 @@ class ReplayResult:
     """``(n, 4, 4)`` TCP pose in the base frame [m]."""
     joint: np.ndarray
     """``(n,)`` the component's joint position [rad or m] (0 closed, ``travel`` open)."""
+    rotation: np.ndarray
+    """``(n, 3, 3)`` orientation of the F/T sensor frame in the base frame: a tare is an offset fixed in it."""
+
+    def tared(self, zero: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """``(force [N], torque [N·m])`` in the base frame less the tare ``zero``, an offset fixed in the sensor
+        frame (as a sensor tares), turned with the sensor at each tick."""
+        return self.force - self.rotation @ zero[0], self.torque - self.rotation @ zero[1]
 
 
 def pinch_window(log: ToggleLog) -> slice:
@@ -193,7 +200,7 @@ class ToggleReplay:
         m.dof_frictionloss[self._dof] = friction * scales.friction
         m.eq_solref[self._latch, 0] = solref * scales.latch
         n = self.window.stop - self.window.start if ticks is None else min(ticks, self.window.stop - self.window.start)
-        out = ReplayResult(np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 4, 4)), np.empty(n))
+        out = ReplayResult(np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 4, 4)), np.empty(n), np.empty((n, 3, 3)))
         if self._checkpoint is None:
             self._settle(self.window.start - 1)
             servos = Servos(d, self._arm_act, self._gripper_act, ArmReality(command_latency=c.command_latency),
@@ -229,7 +236,7 @@ class ToggleReplay:
             self._advance(round((log.time[k] - log.time[k - 1]) / dt), servos, ft)
             R = d.site_xmat[self._site].reshape(3, 3)
             load = ft.read(float(d.time))
-            out.force[i], out.torque[i] = R @ load[:3], R @ load[3:]
+            out.force[i], out.torque[i], out.rotation[i] = R @ load[:3], R @ load[3:], R
             out.tcp[i, :3, :3] = d.site_xmat[self._tcp].reshape(3, 3)
             out.tcp[i, :3, 3] = d.site_xpos[self._tcp]
             out.tcp[i, 3] = (0.0, 0.0, 0.0, 1.0)

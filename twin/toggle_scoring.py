@@ -9,10 +9,15 @@ prediction: the RMS joint-load error [N]; the same less what an error of the par
 carries the world's true joint trajectory for evaluation (``truth["joint"]``, which nothing here fits on) — the
 RMS error of the predicted part motion along the grasp point's path [m].
 
-Zeroes: the replayed wrench's is its mean over the window's first ticks (the arm at rest above the part, where
-the pipeline tared the sensor); the logged wrench's is the median, over the free descent onto the handle (~200
-readings), of its difference from the replayed one — the pipeline's own tare averages 10 readings, whose noise
-(0.03 N realistic) a hinge's ~0.2 m lever from the sensor turns into ~0.1 N of joint load.
+Zero: the logged wrench is tared as the sensor tares, by an offset fixed in the sensor's frame (the pipeline's
+tare, before the descent), and turns with the sensor: logged = R (w - b) with R the sensor's orientation. The
+replay is tared alike, by the offset ``b`` in the sensor frame that best explains the logged wrench over the free
+descent onto the handle (~200 readings: the median of ``R^T (replayed - logged)``), so both are compared with the
+same offset, turned with the sensor at every tick. (An offset held fixed in the base frame instead, as a tare is
+not, reads ~0.2 N of a sensor-frame offset across the motion as the gripper turns 85 degrees with a wheel: in the
+ideal world, 0.076 N of a wheel's 0.076 N of joint-load error.) The pipeline's own tare averages 10 readings, so
+its noise (0.03 N realistic) a hinge's ~0.2 m lever from the sensor turns into ~0.1 N of joint load: the replay's
+offset, from ~200 readings, is taken from the data instead of from that tare.
 """
 
 from __future__ import annotations
@@ -44,7 +49,7 @@ class PreparedToggle:
     """``(n,)`` ticks compared."""
     signals: SignalConfig
     zero: tuple[np.ndarray, np.ndarray]
-    """The replayed wrench's zero ``(force [N], torque [N·m])`` (see the module docstring)."""
+    """The replayed wrench's tare ``(force [N], torque [N·m])``, in the sensor frame (see the module docstring)."""
     basis: np.ndarray
     """``(m, k)`` on the compared ticks: how the logged joint load changes per unit error of the perceived pose
     (:func:`~twin.pose_error.pose_basis`)."""
@@ -55,7 +60,7 @@ class PreparedToggle:
         """The replay's ``(joint load [N], tared force [N], joint position)`` under ``scales``, over the window up
         to its last compared tick (nothing after it is compared: the replay stops there)."""
         out = self.replay.run(scales, ticks=int(np.flatnonzero(self.mask)[-1]) + 1)
-        force, torque = out.force - self.zero[0], out.torque - self.zero[1]
+        force, torque = out.tared(self.zero)
         return joint_load(self.log, force, torque, out.tcp, self.signals), force, out.joint
 
     def residuals(self, scales: KindScales, load: np.ndarray | None = None, pose: bool = False) -> np.ndarray:
@@ -98,10 +103,13 @@ def prepare(
             skipped.append(f"{log.component}: no tick to compare")
             continue
         out = r.run()  # nominal: it also simulates (and keeps) the free descent
-        zero = out.force[: signals.tare_ticks].mean(axis=0), out.torque[: signals.tare_ticks].mean(axis=0)
-        free = slice(0, r.descent)  # the log's zero: its median difference from the replay over the free descent
-        force = log.force[w] - np.median(log.force[w][free] - (out.force[free] - zero[0]), axis=0)
-        torque = log.torque[w] - np.median(log.torque[w][free] - (out.torque[free] - zero[1]), axis=0)
+        free = slice(0, r.descent)  # the replay's tare: what best explains the log over the free descent
+        R = out.rotation[free]
+        zero = (
+            np.median(np.einsum("kji,kj->ki", R, out.force[free] - log.force[w][free]), axis=0),
+            np.median(np.einsum("kji,kj->ki", R, out.torque[free] - log.torque[w][free]), axis=0),
+        )
+        force, torque = log.force[w], log.torque[w]
         load = joint_load(log, force, torque, log.tcp[w], signals)
         basis, weights = pose_basis(log, force, torque, log.tcp[w], signals, pose)
         ready.append(PreparedToggle(log, r, load, force, mask, signals, zero, basis[mask], weights))

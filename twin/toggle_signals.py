@@ -10,8 +10,8 @@ path misses the true one by the perception error (on a wheel, whose gripper turn
 the path against a free knob, with a couple cancelling it), the pads' torsional friction on a door's pivoting
 post (~2 N at the handle, with an equal and opposite couple).
 
-Treatment, as the pipeline senses (``skills.primitives``): the wrench comes tared (the caller's zero,
-``SignalConfig.tare_ticks``); the load is computed per tick and passed through a causal running median of
+Treatment, as the pipeline senses (``skills.primitives``): the wrench comes tared (the caller's zero:
+:mod:`twin.toggle_scoring`); the load is computed per tick and passed through a causal running median of
 ``median_ticks`` (the pipeline's filter), then a causal running mean of ``smooth_ticks`` (the F/T noise averaged
 down to the load's slow part); it is compared over the pinch's actuation only, and for a part that moved only
 while it moved clear of its ends (:func:`compared_mask`): the first ticks of a grasp are the pads' impact on a
@@ -33,12 +33,6 @@ from models.xarm7 import TCP_OFFSET
 class SignalConfig:
     """How wrenches are treated before comparing them."""
 
-    tare_ticks: int = 5
-    """A replayed wrench's zero is its mean over this many ticks at the start of the window (the arm at rest above
-    the part, where the pipeline tared the sensor) [-]. A logged wrench's zero is the median, over the free
-    descent onto the handle (~200 readings), of its difference from the replayed one: the pipeline's own tare
-    averages 10 readings, whose noise (0.03 N, realistic) a hinge's ~0.2 m lever from the sensor turns into
-    ~0.1 N of joint load."""
     median_ticks: int = 5
     """Length of the causal running median of the joint load [ticks] (the pipeline's ``force_filter_samples``)..."""
     smooth_ticks: int = 20

@@ -12,6 +12,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 from _sysid import TruthTrace  # noqa: E402  (scripts/ is not a package)
 from _twin_trial import evaluation_world  # noqa: E402
 
+from models import PuzzleSpec  # noqa: E402
 from models.generator import paper_family  # noqa: E402
 from models.toggle_log import ToggleLog  # noqa: E402
 from skills.toggle_recorder import ToggleRecorder  # noqa: E402
@@ -34,12 +35,14 @@ def known_hardware(damping: float, friction: float) -> RealityProfile:
     return dataclasses.replace(ideal, name=f"hardware-{damping:g}-{friction:g}", physics=physics)
 
 
-def record(profile: RealityProfile | str, parts: tuple[str, ...], seed: int = 0) -> list[ToggleLog]:
-    """Open ``parts`` of :data:`SPEC` in that order through the pipeline, every toggle logged, each log with the
+def record(
+    profile: RealityProfile | str, parts: tuple[str, ...], seed: int = 0, spec: PuzzleSpec = SPEC
+) -> list[ToggleLog]:
+    """Open ``parts`` of ``spec`` in that order through the pipeline, every toggle logged, each log with the
     world's true joint trajectory of its part and the cell's true factors as its (evaluation-only) truth."""
-    with TwinSession(SPEC, seed=seed, reality=profile) as session:
+    with TwinSession(spec, seed=seed, reality=profile) as session:
         trace = TruthTrace(session.robot, session)
-        recorder = ToggleRecorder(trace, {"spec": SPEC.name, "seed": seed})
+        recorder = ToggleRecorder(trace, {"spec": spec.name, "seed": seed})
         world = evaluation_world(session, recorder, seed=seed)
         recorder.attach(world)
         names = [world.names[m] for m in world.markers]
