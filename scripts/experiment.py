@@ -7,7 +7,7 @@ the reality gap in the twin.
     python scripts/experiment.py faults --out DIR [--quick] [--runs R]
     python scripts/experiment.py twin-learning --out DIR [--quick] [--runs R] [--seeds S] [--workers W | --ray ...]
                                  [--agents memory,dqn,model-based]
-    python scripts/experiment.py sysid --out DIR [--workers W] [--quick]
+    python scripts/experiment.py sysid --out DIR [--workers W] [--cells 0,1,2] [--quick]
     python scripts/experiment.py disassembly --agents memory,dual,dqn,model-based --out DIR [--quick] [--runs R]
                                  [--seeds S] [--workers W | --ray ...]
     python scripts/experiment.py kinds --out DIR [--quick] [--runs R] [--workers W]
@@ -99,7 +99,12 @@ def main(argv: list[str] | None = None) -> int:
         "as the authors' release: an ablation)",
     )  # fmt: skip
     parser.add_argument("--memory", default=None, help="reality: the memory agent's store (default: trained in DIR)")
+    parser.add_argument(
+        "--cells", default=None, metavar="SEEDS", help="sysid: the cells' seeds, comma-separated (default 0,1,2)"
+    )
     args = parser.parse_args(argv)
+    if args.cells is not None and args.protocol != SYSID:
+        fail("--cells goes with the sysid protocol")
 
     if args.protocol == REALITY:
         return _reality(args)
@@ -241,10 +246,18 @@ def _sysid(args: argparse.Namespace) -> int:
 
     given = [f"--{name}" for name in ("agents", "runs", "seeds", "ray", "memory") if getattr(args, name) is not None]
     if given:
-        fail(f"the sysid protocol takes only --out, --workers and --quick, got {' '.join(given)}")
+        fail(f"the sysid protocol takes only --out, --workers, --cells and --quick, got {' '.join(given)}")
     if args.workers is not None and args.workers < 1:
         fail(f"--workers must be >= 1, got {args.workers}")
     config = SysIdConfig().quick() if args.quick else SysIdConfig()
+    if args.cells is not None:
+        try:
+            cells = tuple(int(c) for c in args.cells.split(","))
+        except ValueError:
+            fail(f"--cells takes comma-separated integers (cell seeds), got {args.cells!r}")
+        if not cells or min(cells) < 0 or len(set(cells)) != len(cells):
+            fail(f"--cells takes distinct cell seeds >= 0, got {args.cells!r}")
+        config = replace(config, cell_seeds=cells)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         fail(f"--out {out} is a file, not a directory")

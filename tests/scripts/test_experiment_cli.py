@@ -170,15 +170,22 @@ def test_quick_twin_learning_trains_each_start_in_the_twin_measures_its_checkpoi
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (("--runs", "3"), "takes only --out, --workers and --quick"),
-        (("--agents", "memory"), "takes only --out, --workers and --quick"),
+        (("--runs", "3"), "takes only --out, --workers, --cells and --quick"),
+        (("--agents", "memory"), "takes only --out, --workers, --cells and --quick"),
         (("--workers", "0"), "--workers must be >= 1"),
+        (("--cells", "3,x"), "--cells takes comma-separated integers"),
+        (("--cells", "3,3"), "--cells takes distinct cell seeds >= 0"),
     ],
 )
 def test_sysid_command_line_mistakes_are_one_line_and_exit_2(tmp_path, args, message):
     result = experiment("sysid", "--out", tmp_path / "out", *args)
     assert result.returncode == 2 and message in result.stderr, result.stderr
     assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr
+
+
+def test_cells_go_with_the_sysid_protocol_only(tmp_path):
+    result = experiment("kinds", "--out", tmp_path / "out", "--cells", "3")
+    assert result.returncode == 2 and "--cells goes with the sysid protocol" in result.stderr, result.stderr
 
 
 def test_sysid_refuses_an_output_that_is_a_file(tmp_path):
