@@ -18,9 +18,10 @@ How the protocol maps onto the SDK (``(code, value)`` returns; a non-zero code r
 - wrench: ``get_ft_sensor_data()`` (the controller's filtered, load-compensated F/T reading, sensor frame)
   minus this driver's last tare; ``tare`` also zeroes the controller's offset (``set_ft_sensor_zero``). The
   sensor frame is taken to be aligned with the TCP frame (a TCP offset without rotation).
-- safety: every wrench read, every command and every slice of :meth:`XArmRobot.wait` checks the tared force
-  magnitude against the cell's ``force_limit``, and every command and slice the TCP's position against the
-  cell's workspace box (``workspace_min`` .. ``workspace_max``); past either the arm is stopped
+- safety: every wrench read checks the tared force magnitude against the cell's ``force_limit``, and every
+  command and every slice of :meth:`XArmRobot.wait` both it and the TCP's position against the cell's workspace
+  box (``workspace_min`` .. ``workspace_max``), on readings at most one F/T sample period old (the sensor's
+  rate: a control tick's commands and wait share one check); past either the arm is stopped
   (``emergency_stop``, i.e. ``set_state(4)``), :class:`ForceLimitExceeded` or :class:`WorkspaceExceeded` is
   raised and every later command refused.
 - cameras: one ``cv2.VideoCapture(device)`` per camera, devices from the cell's ``camera_devices``; a failed
@@ -130,6 +131,7 @@ class XArmRobot:
         self._captures: dict[str, Any] = {}
         self._bias = np.zeros(6)
         self._stopped: str | None = None
+        self._guarded_at: float | None = None
         probe(ip)  # before the SDK: its own connection attempt retries for much longer
         self._arm = (sdk_factory or _default_sdk)(ip)
         self._t0 = self._clock()
@@ -224,11 +226,21 @@ class XArmRobot:
             axes = ", ".join(f"{'xyz'[i]}={p[i]:.3f} not in [{low[i]:.3f}, {high[i]:.3f}]" for i in outside)
             self._stop(f"TCP outside the cell's workspace ({axes} m)", WorkspaceExceeded)
 
+    def _guard(self) -> None:
+        """The safety limits: the force limit on a fresh F/T reading and the workspace on the TCP, checked at most
+        once per F/T sample period (the sensor has no newer reading sooner; a control tick's commands and the wait
+        after them share one check instead of costing two SDK round trips each)."""
+        now = self._clock()
+        if self._guarded_at is not None and now - self._guarded_at < (1.0 - 1e-6) / self.cell.ft_rate_hz:
+            return
+        self._guarded_at = now
+        self.wrench()
+        self._check_workspace()
+
     def _check_commandable(self) -> None:
         if self._stopped is not None:
             raise CommandRefused(f"the arm was stopped ({self._stopped}); clear it and connect again")
-        self.wrench()  # the force limit holds at every command
-        self._check_workspace()  # so does the workspace
+        self._guard()  # the force limit and the workspace hold at every command
 
     # -- commands ----------------------------------------------------------------------------------
     def command_joint_positions(self, q: np.ndarray) -> None:
@@ -258,8 +270,7 @@ class XArmRobot:
         period = 1.0 / self.cell.ft_rate_hz
         end = self._clock() + seconds
         while (left := end - self._clock()) > 0.0:
-            self.wrench()
-            self._check_workspace()
+            self._guard()
             self._sleep(min(period, left))
 
     # -- cameras -----------------------------------------------------------------------------------

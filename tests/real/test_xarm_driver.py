@@ -83,8 +83,14 @@ class FakeCapture:
         pass
 
 
-def make(**sdk_kwargs):
+def make(clock=None, **sdk_kwargs):
+    """A driver on a fake SDK; its clock, unless given, moves one F/T period (10 ms) per reading."""
     sdks = []
+    ticks = [0.0]
+
+    def ticking():
+        ticks[0] += 0.01
+        return ticks[0]
 
     def factory(ip):
         sdks.append(FakeSDK(ip, **sdk_kwargs))
@@ -94,7 +100,7 @@ def make(**sdk_kwargs):
     bgr[..., 0] = 255  # blue in OpenCV's BGR
     robot = XArmRobot(
         "10.0.0.5", CELL, sdk_factory=factory, probe=lambda ip: None, sleep=lambda s: None,
-        camera_factory=lambda device: FakeCapture([bgr] if device == 0 else []),
+        camera_factory=lambda device: FakeCapture([bgr] if device == 0 else []), clock=clock or ticking,
     )  # fmt: skip
     return robot, sdks[0]
 
@@ -164,6 +170,19 @@ def test_a_tcp_outside_the_cells_workspace_stops_the_arm_and_refuses_commands():
     with pytest.raises(CommandRefused, match="stopped"):
         robot.command_gripper(0.0)
     assert isinstance(WorkspaceExceeded("x"), ArmStopped) and isinstance(ForceLimitExceeded("x"), ArmStopped)
+
+
+def test_a_ticks_commands_share_one_safety_check():
+    """The F/T sensor has no newer reading within its sample period: the commands of one control tick read the
+    wrench and the TCP once, the next period reads them again."""
+    now = [5.0]
+    robot, sdk = make(clock=lambda: now[0])
+    robot.command_joint_positions(np.array(CELL.rest_posture))
+    robot.command_gripper(0.5)
+    assert sdk.names().count("get_ft_sensor_data") == 1 and sdk.names().count("get_position") == 1
+    now[0] += 1.0 / CELL.ft_rate_hz
+    robot.command_gripper(0.6)
+    assert sdk.names().count("get_ft_sensor_data") == 2 and sdk.names().count("get_position") == 2
 
 
 def test_cameras_give_rgb_frames_and_none_for_a_dropped_frame():
