@@ -119,6 +119,7 @@ def _mjcf(args: argparse.Namespace) -> None:
 
 
 def _mesh(args: argparse.Namespace) -> None:
+    from models.lock_features import layout_lock_features
     from models.mesh_export import export_meshes  # MuJoCo and trimesh only when asked
 
     try:
@@ -129,6 +130,10 @@ def _mesh(args: argparse.Namespace) -> None:
         fail(f"{args.spec}: spec {spec.name!r} is a disassembly scene (no box); only puzzle boxes export as meshes")
     paths = export_meshes(spec, args.out)
     print(f"wrote {len(paths)} files in {args.out}: {', '.join(p.name for p in paths[:3])} and one STL per part")
+    layout = layout_lock_features(spec)
+    print(f"lock features: {len(layout.features)} shown, {len(layout.skipped)} without room on their locker")
+    for skipped in layout.skipped:  # a lock the physics enforces but the model cannot show: say so
+        print(f"  not shown: {skipped.locker} -> {skipped.locked}: {skipped.reason}")
 
 
 def _validate(args: argparse.Namespace) -> int:

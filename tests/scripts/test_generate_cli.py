@@ -10,6 +10,7 @@ import trimesh
 
 from models import save_spec
 from models.generator import paper_family
+from models.lock_features import layout_lock_features
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -196,6 +197,10 @@ def test_mesh_writes_glb_obj_and_stl_per_part(tmp_path):
     length, width, height = spec.box.size
     lo, hi = trimesh.load(tmp_path / "out" / f"{spec.name}-box.stl", force="mesh").bounds
     assert abs((hi - lo)[0] - length) < 1e-6 and abs(lo[2] + height) < 1e-6 and abs(hi[2]) < 1e-6
+    layout = layout_lock_features(spec)  # what the user is told of the locks the meshes show, and of any not shown
+    told = f"lock features: {len(layout.features)} shown, {len(layout.skipped)} without room on their locker"
+    assert told in result.stdout and len(layout.features) > 0, result.stdout
+    assert result.stdout.count("not shown:") == len(layout.skipped)
 
 
 def test_a_missing_spec_is_one_line_and_exit_2(tmp_path):
