@@ -6,7 +6,7 @@ The file (format tag :data:`CELL_CONFIG_FORMAT`) is flat; every key is a field o
      "camera_names": ["overview", "wrist"], "overview_camera": "overview", "wrist_camera": "wrist",
      "camera_devices": {"overview": 0, "wrist": "/dev/video2"},
      "aruco_dictionary": "DICT_4X4_250", "marker_size": 0.036,
-     "force_limit": 60.0, "blocked_force": 20.0,
+     "force_limit": 60.0, "blocked_force": 20.0, "stop_force": 90.0,
      "gripper_open": 850.0, "gripper_closed": 0.0,
      "rest_posture": [-1.5708, -0.247, 0.0, 0.909, 0.0, 1.156, 0.0],
      "workspace_min": [-0.62, -0.62, 0.0], "workspace_max": [0.62, 0.62, 0.58],
@@ -31,6 +31,9 @@ from models.atomic import write_text_atomically
 from models.errors import ModelsError
 
 CELL_CONFIG_FORMAT = "puzzlebox-cell/1"
+STOP_FORCE_FACTOR = 1.5
+"""A driver's hard stop, by default, over the skills' ``force_limit`` [-] (60 N: 90 N, within the xArm F/T's
+150 N range)."""
 EXAMPLE: dict = {
     "format": CELL_CONFIG_FORMAT,
     "name": "lab-a",
@@ -42,6 +45,7 @@ EXAMPLE: dict = {
     "marker_size": 0.036,
     "force_limit": 60.0,
     "blocked_force": 20.0,
+    "stop_force": 90.0,
     "gripper_open": 850.0,
     "gripper_closed": 0.0,
     "rest_posture": [-1.5708, -0.247, 0.0, 0.909, 0.0, 1.156, 0.0],
@@ -110,6 +114,15 @@ class CellConfig:
     """Rate at which the wrist F/T sensor delivers new readings [Hz]."""
     camera_devices: dict[str, int | str] = field(default_factory=dict)
     """OpenCV capture device of each camera of a real cell (an index or a device path); empty in the twin."""
+    stop_force: float | None = None
+    """Wrist force magnitude at which a real arm's driver stops the arm (emergency stop) on any raw reading [N];
+    None: :data:`STOP_FORCE_FACTOR` times ``force_limit``. Above ``force_limit``, where the skills end a try on
+    a filtered reading: at the same value a raw impact would stop the whole trial where the skills end a try."""
+
+    @property
+    def hard_stop_force(self) -> float:
+        """The force at which a driver stops the arm [N] (:attr:`stop_force`, or its default)."""
+        return self.stop_force if self.stop_force is not None else STOP_FORCE_FACTOR * self.force_limit
 
     def __post_init__(self) -> None:
         values = {f.name: getattr(self, f.name) for f in fields(self)}
@@ -150,7 +163,7 @@ class CellConfig:
         unknown = sorted(set(data) - set(known) - {"format"})
         if unknown:
             problems.append(f"unknown key(s) {unknown}; known keys: {['format', *known]}")
-        optional = {f.name for f in fields(cls) if f.default_factory is not MISSING}
+        optional = {f.name for f in fields(cls) if f.default_factory is not MISSING or f.default is not MISSING}
         missing = [k for k in known if k not in data and k not in optional]
         if missing:
             problems.append(f"missing key(s) {missing}")
@@ -180,7 +193,9 @@ def save_cell_config(config: CellConfig, path: str | Path) -> Path:
 
 # -- validation ------------------------------------------------------------------------------------
 _VECTORS = {"rest_posture": 7, "workspace_min": 3, "workspace_max": 3}
-_NUMBERS = ("marker_size", "force_limit", "blocked_force", "gripper_open", "gripper_closed", "ft_rate_hz")
+_NUMBERS = (
+    "marker_size", "force_limit", "blocked_force", "gripper_open", "gripper_closed", "ft_rate_hz", "stop_force",
+)  # fmt: skip
 _NAMES = ("name", "overview_camera", "wrist_camera", "aruco_dictionary")
 
 
@@ -194,6 +209,8 @@ def _normalise(values: dict[str, Any]) -> list[str]:
     for key in _NAMES:
         if key in values and not (isinstance(values[key], str) and values[key]):
             problems.append(f"{key}: expected a non-empty string, got {values.pop(key)!r}")
+    if values.get("stop_force", 0.0) is None:
+        values.pop("stop_force")  # optional: None is its default
     for key in _NUMBERS:
         if key in values:
             if _finite(values[key]):
@@ -257,6 +274,11 @@ def _check(v: dict[str, Any]) -> list[str]:
             f"force_limit ({v['force_limit']} N) must exceed blocked_force ({v['blocked_force']} N): a latch must be "
             "felt before the arm is stopped"
         )
+    if v.get("stop_force") is not None and "force_limit" in v and v["stop_force"] <= v["force_limit"]:
+        problems.append(
+            f"stop_force ({v['stop_force']} N) must exceed force_limit ({v['force_limit']} N): the skills end a try "
+            "before the driver stops the arm"
+        )
     if "gripper_open" in v and v.get("gripper_open") == v.get("gripper_closed"):
         problems.append(f"gripper_open and gripper_closed must differ, both are {v['gripper_open']}")
     if "workspace_min" in v and "workspace_max" in v:
@@ -268,6 +290,7 @@ def _check(v: dict[str, Any]) -> list[str]:
 
 __all__ = [
     "CELL_CONFIG_FORMAT",
+    "STOP_FORCE_FACTOR",
     "CellConfig",
     "CellConfigError",
     "aruco_dictionary_name",

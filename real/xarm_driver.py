@@ -18,7 +18,8 @@ How the protocol maps onto the SDK (``(code, value)`` returns; a non-zero code r
 - wrench: ``get_ft_sensor_data()`` (the controller's filtered, load-compensated F/T reading, sensor frame)
   minus this driver's last tare; ``tare`` also zeroes the controller's offset (``set_ft_sensor_zero``). The
   sensor frame is taken to be aligned with the TCP frame (a TCP offset without rotation).
-- safety: every wrench read checks the tared force magnitude against the cell's ``force_limit``, and every
+- safety: every wrench read checks the tared force magnitude against the cell's hard stop (``stop_force``, by
+  default 1.5 times the skills' ``force_limit``, which ends a try first on a filtered reading), and every
   command and every slice of :meth:`XArmRobot.wait` both it and the TCP's position against the cell's workspace
   box (``workspace_min`` .. ``workspace_max``), on readings at most one F/T sample period old (the sensor's
   rate: a control tick's commands and wait share one check); past either the arm is stopped
@@ -196,11 +197,11 @@ class XArmRobot:
 
     def wrench(self) -> np.ndarray:
         """``[Fx, Fy, Fz, Tx, Ty, Tz]`` in the sensor frame [N, N·m], minus the last tare; stops the arm and
-        raises :class:`ForceLimitExceeded` above the cell's ``force_limit``."""
+        raises :class:`ForceLimitExceeded` above the cell's hard stop (``CellConfig.hard_stop_force``)."""
         w = self._read_ft() - self._bias
         force = float(np.linalg.norm(w[:3]))
-        if force > self.cell.force_limit:
-            self._stop(f"wrist force {force:.1f} N > the cell's force_limit {self.cell.force_limit:.1f} N")
+        if force > self.cell.hard_stop_force:
+            self._stop(f"wrist force {force:.1f} N > the cell's stop_force {self.cell.hard_stop_force:.1f} N")
         return w
 
     def tare(self, samples: int = 10) -> None:

@@ -80,3 +80,14 @@ def test_twin_config_matches_the_constants_twin_and_skills_use(tmp_path):
     import cv2
 
     assert getattr(cv2.aruco, config.aruco_dictionary) == ARUCO_DICTIONARY
+
+
+def test_the_drivers_stop_force_stands_above_the_skills_force_limit():
+    cell = CellConfig.from_dict(EXAMPLE)
+    assert cell.force_limit < cell.hard_stop_force == 90.0
+    without = {k: v for k, v in EXAMPLE.items() if k != "stop_force"}  # a file written before the key existed
+    assert CellConfig.from_dict(without).hard_stop_force == 1.5 * EXAMPLE["force_limit"]
+    with pytest.raises(CellConfigError, match=r"stop_force \(60.0 N\) must exceed force_limit \(60.0 N\)"):
+        CellConfig.from_dict({**EXAMPLE, "stop_force": 60.0})
+    with pytest.raises(CellConfigError, match="stop_force: expected a finite number"):
+        CellConfig.from_dict({**EXAMPLE, "stop_force": "high"})

@@ -132,11 +132,12 @@ def test_a_paper_box_is_solved_through_the_real_driver_and_every_sensed_outcome_
     assert wall < 60.0
 
 
-def test_a_low_force_limit_in_the_cell_config_stops_the_arm_and_ends_the_trial(tmp_path, capsys):
+def test_a_low_stop_force_in_the_cell_config_stops_the_arm_and_ends_the_trial(tmp_path, capsys):
     with TwinSession(SPEC, seed=0, reality="ideal") as session:
-        # the random agent pulls latched parts: at 36 N one pull stops the arm (the primitives' own guard at the
-        # same limit acts on the filtered force, later than the driver's on the raw reading)
-        cell = twin_xarm_cell(session, force_limit=36.0)
+        # the random agent pulls latched parts: with the driver's hard stop at 36.5 N one pull stops the arm (the
+        # primitives' own guard, at the 36 N force limit, acts on the filtered force, later than the driver's on
+        # the raw reading)
+        cell = twin_xarm_cell(session, force_limit=36.0, stop_force=36.5)
         files = _cli_files(tmp_path, session, cell)
         sdks: list[TwinSDK] = []
 
@@ -148,7 +149,7 @@ def test_a_low_force_limit_in_the_cell_config_stops_the_arm_and_ends_the_trial(t
         code = trial.main([*files, "--agent", "random", "--max-actions", "15"], arm=connect)
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 1
-    assert len(err) == 1 and "the arm was stopped after" in err[0] and "force_limit 36.0 N" in err[0], err
+    assert len(err) == 1 and "the arm was stopped after" in err[0] and "stop_force 36.5 N" in err[0], err
     assert "emergency_stop" in sdks[0].calls and sdks[0].stopped
     after = sdks[0].calls[sdks[0].calls.index("emergency_stop") + 1 :]
     assert "set_servo_angle_j" not in after and "set_gripper_position" not in after  # nothing moved after it

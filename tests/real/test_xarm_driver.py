@@ -150,10 +150,13 @@ def test_wrench_is_tared_in_the_sensor_frame():
     assert robot.wrench() == pytest.approx([5.0, 0.0, 0.0, 0.0, 0.5, 0.0])
 
 
-def test_force_above_the_cells_limit_stops_the_arm_and_refuses_commands():
-    robot, sdk = make(ft=[[0.0] * 6, [0.0, 0.0, 61.0, 0, 0, 0]])
+def test_force_above_the_cells_stop_force_stops_the_arm_and_refuses_commands():
+    # 61 N: past the skills' 60 N force limit, which ends a try on a filtered reading, not the driver's hard stop
+    robot, sdk = make(ft=[[0.0] * 6, [0.0, 0.0, 61.0, 0, 0, 0], [0.0, 0.0, 91.0, 0, 0, 0]])
     robot.command_gripper(0.5)  # 0 N: accepted
-    with pytest.raises(ForceLimitExceeded, match="61.0 N > the cell's force_limit 60.0 N"):
+    robot.command_gripper(0.6)  # 61 N: accepted
+    assert "emergency_stop" not in sdk.names()
+    with pytest.raises(ForceLimitExceeded, match="91.0 N > the cell's stop_force 90.0 N"):
         robot.command_joint_positions(np.array(CELL.rest_posture))
     assert "emergency_stop" in sdk.names() and "set_servo_angle_j" not in sdk.names()
     with pytest.raises(CommandRefused, match="stopped"):
