@@ -22,6 +22,7 @@ from models.disassembly_kinds import DISASSEMBLY_KIND_NAMES, DISASSEMBLY_KINDS, 
 from models.errors import ReachabilityUndecided, SpecProblem
 from models.geometry import polygon_gap
 from models.kinds import get_kind, registered_kinds
+from models.kinds.template import KindTemplate
 from models.lock_table import LockTable
 from models.markers import MAX_MARKER_ID
 from models.spec import SPEC_FORMAT, build_from_valid_data
@@ -36,8 +37,6 @@ EDGE_TOLERANCE = 1e-4
 """An edge-mounted component's front face may lie this far off its lid edge [m] (rounding in files)."""
 EDGE_ANGLE_TOLERANCE = 1e-3
 """An edge-mounted component's yaw may be this far off a multiple of 90 degrees [rad] (rounding in files)."""
-LID_SIDES = ((1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0))
-"""Outward normals of the lid's four edges in the lid frame: +x, -x, +y, -y."""
 SIDE_NAMES = {(1.0, 0.0): "+x", (-1.0, 0.0): "-x", (0.0, 1.0): "+y", (0.0, -1.0): "-y"}
 
 
@@ -287,7 +286,7 @@ def _check_geometry(data: dict[str, Any], components: dict[str, dict[str, Any]])
         footprints[name] = polygon  # overlaps: the whole footprint, an edge-mounted one's swept part included
         outward = None
         if template.at_edge:
-            outward, problem = _check_edge(name, comp["kind"], template.edge_x, pose, half_x, half_y)
+            outward, problem = _check_edge(name, comp["kind"], template, pose, half_x, half_y)
             if problem is not None:
                 problems.append(problem)
             polygon = template.on_lid_footprint_in_lid(pose)  # its swept part lies beyond the lid edge
@@ -319,7 +318,7 @@ def _check_geometry(data: dict[str, Any], components: dict[str, dict[str, Any]])
 
 
 def _check_edge(
-    name: str, kind: str, edge_x: float, pose: tuple[float, ...], half_x: float, half_y: float
+    name: str, kind: str, template: KindTemplate, pose: tuple[float, ...], half_x: float, half_y: float
 ) -> tuple[tuple[float, float] | None, SpecProblem | None]:
     """An edge-mounted component's placement: its +x must point out of the lid perpendicular to an edge (yaw a
     multiple of 90 degrees) and its front face (x = ``edge_x`` in its frame) lie on that edge. Returns the
@@ -327,16 +326,15 @@ def _check_edge(
     x, y, yaw = pose
     where = f"component {name!r}"
     quarter = math.pi / 2.0
-    turns = round(yaw / quarter)
-    if abs(yaw - turns * quarter) > EDGE_ANGLE_TOLERANCE:
+    if abs(yaw - round(yaw / quarter) * quarter) > EDGE_ANGLE_TOLERANCE:
         return None, SpecProblem(
             where,
             f"a {kind} is mounted at the lid's edge, its +x pointing out of the lid perpendicular to an edge: its "
             f"yaw must be a multiple of 90 degrees, got {math.degrees(yaw):.1f} degrees",
         )
-    outward = LID_SIDES[(0, 2, 1, 3)[turns % 4]]
+    outward, front = template.front_in_lid((x, y, yaw))  # its +x's lid axis, its front's coordinate along it
+    edge_x = template.edge_x
     half = half_x if outward[0] != 0.0 else half_y
-    front = outward[0] * x + outward[1] * y + edge_x  # the front face's coordinate along the outward axis
     off = front - half
     if abs(off) <= EDGE_TOLERANCE:
         return outward, None

@@ -65,9 +65,9 @@ class Layout:
 
     def _add(self, kind: str, pose: tuple[float, float, float]) -> None:
         template = get_kind(kind)
-        front = _front(kind, pose)
+        front = template.front_in_lid(pose)
         if front is not None:
-            self._fronts.append((len(self.kinds), *front))
+            self._fronts.append((len(self.kinds), np.array(front[0]), front[1]))
         self.kinds.append(kind)
         self.poses.append(pose)
         self._footprints.append(template.footprint_in_lid(pose))
@@ -78,7 +78,7 @@ class Layout:
         direction and, if it is edge-mounted itself, has its own front line outermost in its +x direction."""
         template = get_kind(kind)
         footprint, on_lid = template.footprint_in_lid(pose), template.on_lid_footprint_in_lid(pose)
-        front = _front(kind, pose)
+        front = template.front_in_lid(pose)
         for _, axis, line in self._fronts:
             # an edge-mounted component on the same side sweeps past the shared line: only its part on the lid counts
             same_side = front is not None and np.array_equal(front[0], axis)
@@ -221,14 +221,3 @@ class Layout:
 def _round_up(value: float, step: float) -> float:
     """``value`` rounded up to a multiple of ``step``, printed without float noise."""
     return round(math.ceil(value / step - 1e-9) * step, 6)
-
-
-def _front(kind: str, pose: tuple[float, float, float]) -> tuple[np.ndarray, float] | None:
-    """For an edge-mounted ``kind`` at ``pose`` (yaw a multiple of 90 degrees): the unit axis its +x points
-    along and its front line's coordinate along that axis [m]; None for a kind that stands anywhere."""
-    edge_x = get_kind(kind).edge_x
-    if edge_x is None:
-        return None
-    x, y, yaw = pose
-    axis = np.array([round(math.cos(yaw)), round(math.sin(yaw))], dtype=float)
-    return axis, float(axis @ np.array([x, y])) + edge_x

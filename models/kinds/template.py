@@ -14,6 +14,7 @@ above the surface were grasped in every randomized run).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -76,6 +77,16 @@ class KindTemplate:
         if self.edge_x is None:
             return self.footprint
         return clip_below_x(self.footprint, self.edge_x)
+
+    def front_in_lid(self, pose: tuple[float, float, float]) -> tuple[tuple[float, float], float] | None:
+        """For an edge-mounted kind at ``pose`` ``[x, y, yaw]`` (yaw taken to the nearest multiple of 90
+        degrees): the lid axis its +x points along, ``(±1, 0)`` or ``(0, ±1)``, and its front face's
+        coordinate along that axis [m]; None for a kind that stands anywhere on the lid."""
+        if self.edge_x is None:
+            return None
+        x, y, yaw = pose
+        axis = (float(round(math.cos(yaw))), float(round(math.sin(yaw))))
+        return axis, axis[0] * x + axis[1] * y + self.edge_x
 
     def on_lid_footprint_in_lid(self, pose: tuple[float, float, float]) -> np.ndarray:
         """:meth:`on_lid_footprint` in the lid frame for a component at ``pose`` ``[x, y, yaw]``."""
