@@ -12,6 +12,7 @@ import os
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
+from typing import Self
 
 _UMASK = os.umask(0o022)
 os.umask(_UMASK)  # read once: a file written atomically gets the permissions a plain open() would give it
@@ -41,3 +42,23 @@ def write_atomically(path: str | Path, write: Callable[[Path], object]) -> Path:
 def write_text_atomically(path: str | Path, text: str) -> Path:
     """Write ``text`` (UTF-8) to ``path`` atomically."""
     return write_atomically(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+
+
+class PublishedOnExit:
+    """A writer used in a ``with`` block: on a clean exit :meth:`close` publishes what it wrote, on an error
+    :meth:`abort` discards it (a crash never leaves a half-made output). Subclasses define both."""
+
+    def close(self) -> object:
+        raise NotImplementedError
+
+    def abort(self) -> None:
+        raise NotImplementedError
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, exc_type: type[BaseException] | None, *exc_info: object) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()

@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from models.atomic import PublishedOnExit
 from twin.errors import TwinError
 
 
@@ -55,7 +56,7 @@ def _rerun() -> Any:
     return rerun
 
 
-class TrialRecording:
+class TrialRecording(PublishedOnExit):
     """One trial's Rerun recording (see the module docstring)."""
 
     def __init__(self, path: str | os.PathLike[str], name: str, config: RecordConfig | None = None) -> None:
@@ -153,15 +154,6 @@ class TrialRecording:
         self.stream.disconnect()
         os.replace(self._temporary, self.path)
         return self.path
-
-    def __enter__(self) -> TrialRecording:
-        return self
-
-    def __exit__(self, exc_type, exc, tb) -> None:
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()
 
     def abort(self) -> None:
         """Stop and leave no file."""

@@ -42,7 +42,7 @@ import cv2
 import mujoco
 import numpy as np
 
-from models.atomic import write_text_atomically
+from models.atomic import PublishedOnExit, write_text_atomically
 from models.scene import BOX
 from twin.errors import VideoError
 from twin.video import VideoWriter
@@ -417,7 +417,7 @@ def _save_model(model: mujoco.MjModel, directory: Path) -> str:
     return name
 
 
-class BackgroundRollout:
+class BackgroundRollout(PublishedOnExit):
     """Draws and writes a rollout video in a second process while the trial runs (one process per trial process,
     kept for its next videos).
 
@@ -482,15 +482,6 @@ class BackgroundRollout:
     def _remove_model_file(self) -> None:
         with contextlib.suppress(FileNotFoundError):  # the process removed it, unless it died first
             os.unlink(self._model_file)
-
-    def __enter__(self) -> BackgroundRollout:
-        return self
-
-    def __exit__(self, exc_type, exc, tb) -> None:
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()
 
 
 class FrameCollector:

@@ -17,6 +17,7 @@ from pathlib import Path
 import imageio_ffmpeg
 import numpy as np
 
+from models.atomic import PublishedOnExit
 from twin.errors import VideoError
 
 __all__ = ["X264_PRESETS", "VideoWriter"]
@@ -25,7 +26,7 @@ X264_PRESETS = ("ultrafast", "superfast", "veryfast", "faster", "fast", "medium"
 """x264's presets, fastest first."""
 
 
-class VideoWriter:
+class VideoWriter(PublishedOnExit):
     """Writes RGB frames to an MP4 file (H.264, yuv420p) through imageio-ffmpeg.
 
     Example::
@@ -201,15 +202,6 @@ class VideoWriter:
             if temporary is not None:
                 with contextlib.suppress(OSError):
                     temporary.unlink()
-
-    def __enter__(self) -> VideoWriter:
-        return self
-
-    def __exit__(self, exc_type: type[BaseException] | None, *exc_info: object) -> None:
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()
 
     def __del__(self) -> None:
         # An unfinished writer is garbage: like a crash, it must not publish a partial video.
