@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import quote
 
+from _cell_bars import cell_bars
 from _cli import one_line
 
 OUTCOME_COLOURS = {"moved": "#2e9d4a", "blocked": "#9aa3ad", "failed": "#d1495b"}
@@ -355,17 +356,8 @@ def figures(data: ResultsDir) -> list[tuple[str, str]]:
         ax.set_ylabel("runs")
         ax.legend(fontsize=8)
         out.append(("Actions per run", _svg(fig, "actions")))
-    cells = [c for c in data.cells if "success_rate" in c]
-    if cells:
-        fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(max(5.0, 0.35 * len(cells) + 2), 4.5), sharex=True)
-        x = range(len(cells))
-        ax1.bar(x, [c["success_rate"] for c in cells], color="#2e9d4a")
-        ax1.set_ylabel("solved")
-        ax1.set_ylim(0, 1.05)
-        ax2.bar(x, [c["mean_actions"] for c in cells], color="#3b75af")
-        ax2.set_ylabel("mean actions")
-        ax2.set_xticks(list(x), [str(c.get("cell", i)) for i, c in enumerate(cells)], rotation=60, ha="right",
-                       fontsize=7)  # fmt: skip
+    if any("success_rate" in c for c in data.cells):
+        fig = cell_bars(data.cells, height=4.5)
         out.append(("Success and mean actions per cell", _svg(fig, "cells")))
     timeline = [a for _, r in data.runs for a in actions_of(r)[0] if actions_of(r)[1]]
     forces = [(a, float(a["peak_force"])) for a in timeline if a.get("peak_force") is not None]

@@ -17,6 +17,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from _cell_bars import cell_bars
 from _cli import fail
 from _interrupt import StopRequests
 from _run_store import Periodic, RunStore
@@ -68,21 +69,9 @@ def cells_table(rows: list[dict[str, Any]]) -> str:
 
 def cells_plot(rows: list[dict[str, Any]], path: Path) -> Path:
     """Success rate and mean actions per cell, one bar each, grouped as the grid is."""
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    done = [r for r in rows if "success_rate" in r]
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(max(6.0, 0.35 * len(done) + 2), 6), sharex=True)
-    x = range(len(done))
-    ax1.bar(x, [r["success_rate"] for r in done], color="tab:green")
-    ax1.set_ylabel("solved")
-    ax1.set_ylim(0, 1.05)
-    ax2.bar(x, [r["mean_actions"] for r in done], color="tab:blue")
-    ax2.set_ylabel("mean actions")
-    ax2.set_xticks(list(x), [r["cell"] for r in done], rotation=75, ha="right", fontsize=7)
-    fig.tight_layout()
+    fig = cell_bars(rows)
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
