@@ -42,6 +42,10 @@ class BeliefConfig:
     belief). On the paper's chains the floor changes nothing (5.08 mean actions either way)."""
     false_move_probability: float = 0.001
     """delta: probability that a held component is observed to move anyway (a misread outcome)."""
+    family_holding_states: bool = True
+    """Give no prior mass to lockers in a state their kind cannot hold in (:mod:`learning.holding_pairs`: a
+    removed disassembly part holds nothing; every puzzle-box pair can hold, so boxes are unchanged). False:
+    every pair may hold, the paper's hypothesis space."""
 
     def __post_init__(self) -> None:
         for name in ("prior_independent", "jam_probability", "false_move_probability"):
@@ -90,6 +94,12 @@ def block_entropy(p: np.ndarray) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         terms = np.where(p > 0.0, -p * np.log(p), 0.0)
     return terms.sum(axis=-1)
+
+
+def block_confidence(probs: np.ndarray, hypotheses: int) -> np.ndarray:
+    """How resolved each block is: ``1 - entropy / log(hypotheses)`` over the last axis (1 = one hypothesis
+    left, 0 = uniform over ``hypotheses``), clipped to [0, 1]; ``hypotheses`` is the number a block could hold."""
+    return np.clip(1.0 - block_entropy(probs) / np.log(max(hypotheses, 2)), 0.0, 1.0)
 
 
 class Belief:
@@ -186,6 +196,16 @@ class Belief:
     def single_locker_probs(self) -> np.ndarray:
         """The belief itself (:attr:`probs`, not a copy): it already is the one-locker categoricals."""
         return self.probs
+
+    def locker_memberships(self) -> np.ndarray:
+        """The belief itself (:attr:`probs`, not a copy): with one locker, the probability that a pair is *among*
+        the lockers is the probability that it *is* the locker."""
+        return self.probs
+
+    def block_confidence(self) -> np.ndarray:
+        """``(N, 2)``: how resolved each block is (:func:`block_confidence` over the ``2N - 1`` hypotheses a block
+        can hold)."""
+        return block_confidence(self.probs, 2 * self.num_components - 1)
 
     def locker_probs(self) -> np.ndarray:
         """``(N, 2, N, 2)``: ``[c, s_c, m, s_m] = P(Z[c, s_c] = (m, s_m))``."""

@@ -87,5 +87,15 @@ class LockBelief(Protocol):
         ...
 
     def single_locker_probs(self) -> np.ndarray:
-        """``(N, 2, 1 + 2N)``: the belief as the paper's one-locker categoricals (what a memory stores)."""
+        """``(N, 2, 1 + 2N)``: the belief as the paper's one-locker categoricals (for displays)."""
+        ...
+
+    def locker_memberships(self) -> np.ndarray:
+        """``(N, 2, 1 + 2N)``: what a memory stores — ``[c, s, 0]`` = P(``c`` in ``s`` is held by nothing),
+        ``[c, s, 1 + 2m + s']`` = P(``(m, s')`` is among the lockers of ``c`` in ``s``) (with one locker: the
+        belief itself)."""
+        ...
+
+    def block_confidence(self) -> np.ndarray:
+        """``(N, 2)``: how resolved each block is, ``1 - entropy / log(hypotheses a block can hold)``."""
         ...

@@ -60,14 +60,16 @@ class LockerSets:
         """``(S, H)`` bool: set ``h`` holds (some member is active) in each of ``S`` joint states."""
         return self.active_pairs(states_bits)[:, self.members].any(axis=2)
 
+    def member_indicator(self) -> np.ndarray:
+        """``(H, 2N)`` float: 1 where pair ``p`` is a member of set ``h``, else 0 (the empty set's row is 0)."""
+        n = self.num_components
+        indicator = np.zeros((self.count, 2 * n + 1))
+        indicator[np.repeat(np.arange(self.count), self.max_lockers), self.members.ravel()] = 1.0
+        return indicator[:, : 2 * n]
+
     def member_shares(self) -> np.ndarray:
         """``(H, 2N)``: ``1 / |L|`` for each pair in set ``L``, else 0 (the empty set's row is 0)."""
-        n = self.num_components
-        shares = np.zeros((self.count, 2 * n + 1))
-        rows = np.repeat(np.arange(self.count), self.max_lockers)
-        weights = np.repeat(1.0 / np.maximum(self.sizes, 1), self.max_lockers)
-        shares[rows, self.members.ravel()] = weights
-        return shares[:, : 2 * n]
+        return self.member_indicator() / np.maximum(self.sizes, 1)[:, None]
 
 
 def locker_set_count(num_components: int, max_lockers: int) -> int:

@@ -18,10 +18,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from learning.belief import BeliefConfig, block_entropy, default_prior, normalised_blocks, state_bits
+from learning.belief import (
+    BeliefConfig,
+    block_confidence,
+    block_entropy,
+    default_prior,
+    normalised_blocks,
+    state_bits,
+)
 from learning.errors import ConfigError
 from learning.locker_sets import LockerSets, locker_sets
-from learning.set_prior import set_prior
+from learning.set_prior import membership_set_prior, set_prior
 
 CHUNK_ENTRIES = 1 << 21
 """Joint states x hypotheses evaluated per chunk of a table (~17 MB of float64), so that tables over
@@ -55,6 +62,21 @@ class MultiBelief:
         """The belief whose prior is :func:`learning.set_prior.set_prior` of a one-locker prior."""
         n = np.asarray(single_probs).shape[0]
         return cls(set_prior(single_probs, locker_sets(n, max_lockers)), max_lockers, config)
+
+    @classmethod
+    def from_memberships(
+        cls,
+        memberships: np.ndarray,
+        max_lockers: int,
+        config: BeliefConfig | None = None,
+        floor: float = 0.01,
+        holding: np.ndarray | None = None,
+    ) -> MultiBelief:
+        """The belief whose prior is :func:`learning.set_prior.membership_set_prior` of recalled memberships
+        (:meth:`locker_memberships`' form, e.g. a memory's recall); ``holding``: the pairs that can hold."""
+        n = np.asarray(memberships).shape[0]
+        prior = membership_set_prior(memberships, locker_sets(n, max_lockers), floor, holding)
+        return cls(prior, max_lockers, config)
 
     @classmethod
     def uninformed(cls, num_components: int, max_lockers: int, config: BeliefConfig | None = None) -> MultiBelief:
@@ -177,10 +199,22 @@ class MultiBelief:
         return np.clip(1.0 - least_held, 0.0, 1.0)
 
     def single_locker_probs(self) -> np.ndarray:
-        """``(N, 2, 1 + 2N)``: the one-locker view a memory stores — "independent" keeps the empty set's
+        """``(N, 2, 1 + 2N)``: the one-locker view (for displays) — "independent" keeps the empty set's
         mass, and each non-empty set's mass is shared equally by its lockers."""
         view = self.probs @ self.sets.member_shares()  # (N, 2, 2N)
         return np.concatenate([self.probs[:, :, :1], view], axis=2)
+
+    def locker_memberships(self) -> np.ndarray:
+        """``(N, 2, 1 + 2N)``: what a memory stores — "independent" keeps the empty set's mass, and pair ``(m, s')``
+        gets the mass of every set it is a member of, P(``(m, s')`` is *among* the lockers). Unlike the one-locker
+        view, it tells "held by both screws" (1 and 1) from "by one of them" (1/2 and 1/2)."""
+        view = self.probs @ self.sets.member_indicator()  # (N, 2, 2N)
+        return np.concatenate([self.probs[:, :, :1], np.clip(view, 0.0, 1.0)], axis=2)
+
+    def block_confidence(self) -> np.ndarray:
+        """``(N, 2)``: how resolved each block is over the sets a block can hold (those without its own component)."""
+        possible = self.sets.possible.sum(axis=1)  # (N,): the same for every component
+        return np.stack([block_confidence(self.probs[c], int(possible[c])) for c in range(self.num_components)])
 
 
 def _bits_of(index: np.ndarray, n: int) -> np.ndarray:

@@ -1,6 +1,7 @@
-"""A prior over sets of lockers built from a one-locker prior (the default one, or a memory's recall).
+"""A prior over sets of lockers, built from a one-locker prior (the default one: :func:`set_prior`) or from a
+memory's recalled memberships (:func:`membership_set_prior`).
 
-The one-locker prior gives each block ``Z[c, s]`` a categorical ``q``: ``q_0`` = "independent" and
+The one-locker prior (:func:`set_prior`) gives each block ``Z[c, s]`` a categorical ``q``: ``q_0`` = "independent" and
 ``q_p`` = "held by pair ``p = (m, s')`` alone". The set prior keeps ``q_0`` on the empty set and spreads
 the rest, ``1 - q_0``, over the non-empty sets of up to ``k`` lockers with weights
 
@@ -10,7 +11,7 @@ normalised over the non-empty sets. This is the distribution of independently pr
 odds ``q_p``) conditioned on "at least one, at most ``k``, at most one state per locker". So
 
 - at ``k = 1`` it is the one-locker prior itself (up to rounding);
-- what the memory recalls about each pair carries over: a pair the memory rules out (``q_p ~ 0``) is in
+- what the prior says about each pair carries over: a pair it rules out (``q_p ~ 0``) is in
   no likely set, a pair it is sure of (``q_p`` large) is in most of them;
 - a second locker costs a factor ``q_p`` (small: under the uninformed prior of 8 components a pair has
   ``q_p = 0.3 / 14 = 0.021``, so all two-locker sets together get 3.4 % of the mass): the belief turns to
@@ -47,4 +48,41 @@ def set_prior(single_probs: np.ndarray, sets: LockerSets) -> np.ndarray:
     # pair has weight)
     scale = np.divide(1.0 - independent, locked, out=np.zeros_like(locked), where=locked > 0.0)
     prior = np.concatenate([np.where(locked > 0.0, independent, 1.0), weights[:, :, 1:] * scale], axis=2)
+    return prior / prior.sum(axis=2, keepdims=True)
+
+
+def membership_set_prior(
+    memberships: np.ndarray, sets: LockerSets, floor: float = 0.01, holding: np.ndarray | None = None
+) -> np.ndarray:
+    """``(N, 2, H)`` prior over ``sets`` from recalled *memberships* ``(N, 2, 1 + 2N)`` (a memory's recall of
+    :meth:`learning.multi_belief.MultiBelief.locker_memberships`): ``[c, s, 0]`` = P(held by nothing),
+    ``[c, s, 1 + p]`` = ``m_p`` = P(pair ``p`` is among the lockers), rows *not* summing to one.
+
+    The empty set keeps the recalled independence; the non-empty sets share the rest with weights
+
+        w(L) = prod_{p in L} m_p / (1 - m_p),
+
+    the distribution of pairs present independently with probabilities ``m_p``, conditioned as
+    :func:`set_prior` conditions (at least one, at most ``k``). So a memory of "held by both screws" (``m``
+    near 1 for both) recalls the two-screw set, where the one-locker view (a half each) would recall either
+    screw alone. Every probability is first clipped to ``[floor, 1 - floor]`` (the one-locker recall's uniform
+    mass), so no set is ruled out and a wrong memory can still be unlearned — except the sets with a pair
+    outside ``holding`` (``(2N,)`` bool, :mod:`learning.holding_pairs`; None: every pair can hold).
+    """
+    view = np.asarray(memberships, dtype=np.float64)
+    n = sets.num_components
+    if view.shape != (n, 2, hypothesis_count(n)):
+        raise ConfigError(f"memberships for {n} components have shape {(n, 2, hypothesis_count(n))}, got {view.shape}")
+    if not 0.0 < floor < 0.5:
+        raise ConfigError(f"the membership floor must be in (0, 0.5), got {floor}")
+    clipped = np.clip(view, floor, 1.0 - floor)
+    odds = clipped[:, :, 1:] / (1.0 - clipped[:, :, 1:])
+    if holding is not None:
+        odds = np.where(np.asarray(holding, dtype=bool)[None, None, :], odds, 0.0)
+    pair_weight = np.concatenate([odds, np.ones((n, 2, 1))], axis=2)  # the padding pair weighs 1
+    weights = np.where(sets.possible[:, None, :], pair_weight[:, :, sets.members].prod(axis=3), 0.0)
+    locked = weights[:, :, 1:].sum(axis=2, keepdims=True)
+    independent = np.where(locked > 0.0, clipped[:, :, :1], 1.0)  # no set can hold: independent
+    scale = np.divide(1.0 - independent, locked, out=np.zeros_like(locked), where=locked > 0.0)
+    prior = np.concatenate([independent, weights[:, :, 1:] * scale], axis=2)
     return prior / prior.sum(axis=2, keepdims=True)

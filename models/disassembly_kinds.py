@@ -84,6 +84,13 @@ def may_lock(locker_kind: str, locked_kind: str) -> bool:
     return (locker_kind, locked_kind) in ALLOWED_LOCKS
 
 
+def holding_states(kind: str) -> tuple[int, ...]:
+    """The states in which a component of ``kind`` can hold another in place: both for the puzzle-box kinds
+    (an open door can block a slide as a closed one can), only 0 for the disassembly kinds — state 1 is
+    *removed*, and a part out of the case holds nothing. :class:`UnknownKindError` lists every known kind."""
+    return (0,) if kind_family(kind) == DISASSEMBLY_FAMILY else (0, 1)
+
+
 def kind_family(kind: str) -> str:
     """``"puzzle-box"`` or ``"disassembly"``; :class:`UnknownKindError` lists every known kind."""
     if kind in registered_kinds():

@@ -8,8 +8,9 @@
 ``DEEP`` is one of dqn, model-based, mt-dqn, mt-model-based.
 
 ``--max-lockers K`` (symbolic) trains the memory agent with a belief over sets of up to K lockers per component
-(default 1: the paper's one-locker belief); the memory stores each episode's graph in its one-locker form either
-way (``learning.multi_belief.MultiBelief.single_locker_probs``), so any agent can recall it.
+(default 1: the paper's one-locker belief); the memory stores each episode's graph in the one format either way,
+each pair's probability of being among the lockers (``learning.lock_belief.LockBelief.locker_memberships``: for
+one locker the belief itself), so any agent can recall it.
 
 Episode ``e`` runs on ``specs[e % len(specs)]`` with world seed ``S + e``. The memory is written to
 SQLite after every episode (one transaction each, the episode's training-log row with it), so an

@@ -9,10 +9,12 @@ import numpy as np
 
 from learning.belief import default_prior
 from learning.dual_controller import Decision, DualControllerConfig, decide, max_entropy_for, new_belief
+from learning.holding_pairs import holding_pairs, restrict_single_prior
 from learning.lock_belief import LockBelief
 from learning.memory.keys import se3_pose_keys
-from learning.memory.prior import MemoryConfig, episode_record, recall_prior
+from learning.memory.prior import MemoryConfig, episode_record, recall_memberships, recall_prior
 from learning.memory.store import MemoryStore
+from learning.multi_belief import MultiBelief
 from models import SceneObservation, TryResult
 
 
@@ -21,7 +23,7 @@ class DualAgent:
 
     The belief is over one locker per component and state (``config.max_lockers = 1``, the paper's) or over
     sets of up to ``max_lockers`` (:func:`learning.dual_controller.new_belief`); the prior is given in the
-    one-locker form either way (:meth:`initial_prior`).
+    one-locker form either way (:meth:`initial_prior`), with no mass on lockers that cannot hold (:meth:`holding`).
     """
 
     name = "dual"
@@ -38,8 +40,24 @@ class DualAgent:
         """The one-locker prior ``(N, 2, 1 + 2N)`` of a new task."""
         return default_prior(len(observation), self.config.belief.prior_independent)
 
+    def holding(self, observation: SceneObservation) -> np.ndarray | None:
+        """``(2N,)`` bool: the pairs that can hold in this scene by its kinds' family rule
+        (:mod:`learning.holding_pairs`), or None when every pair can (puzzle boxes, or the rule turned off by
+        ``BeliefConfig.family_holding_states``)."""
+        if not self.config.belief.family_holding_states:
+            return None
+        holding = holding_pairs(observation.kinds)
+        return None if holding.all() else holding
+
+    def initial_belief(self, observation: SceneObservation) -> LockBelief:
+        """The belief a new task starts from: :func:`learning.dual_controller.new_belief` of :meth:`initial_prior`
+        (no mass on the pairs that cannot hold, :meth:`holding`)."""
+        prior = self.initial_prior(observation)
+        holding = self.holding(observation)
+        return new_belief(prior if holding is None else restrict_single_prior(prior, holding), self.config)
+
     def begin_episode(self, observation: SceneObservation, rng: np.random.Generator) -> None:
-        self.belief = new_belief(self.initial_prior(observation), self.config)
+        self.belief = self.initial_belief(observation)
         self._h_max = max_entropy_for(len(observation), self.config)
         self._rng = rng
         self.decisions = []
@@ -111,12 +129,26 @@ class MemoryAgent(DualAgent):
             self.store, observation.kinds, observation.poses, self.memory_config, self.config.belief.prior_independent
         )
 
+    def initial_belief(self, observation: SceneObservation) -> LockBelief:
+        """With one locker, the recalled prior itself; over sets of lockers, the set prior of the recalled
+        memberships (:func:`learning.memory.prior.recall_memberships`), so a memory of "held by both screws"
+        starts the belief on the pair of screws."""
+        k = self.config.max_lockers
+        if k == 1:
+            return super().initial_belief(observation)
+        self._observation = observation
+        memberships = recall_memberships(
+            self.store, observation.kinds, observation.poses, self.memory_config, self.config.belief.prior_independent
+        )
+        floor, holding = self.memory_config.uniform_mass, self.holding(observation)
+        return MultiBelief.from_memberships(memberships, k, self.config.belief, floor, holding)
+
     def end_episode(self, solved: bool) -> None:
         if not self.learn or self.belief is None or self._observation is None:
             return
         observation = self._observation
-        # a belief over sets of lockers is stored as its one-locker view: the memory's format
-        pair_values, independence = episode_record(self.belief.single_locker_probs())
+        # a belief over sets of lockers is stored as each pair's probability of being among the lockers
+        pair_values, independence = episode_record(self.belief.locker_memberships(), self.belief.block_confidence())
         keys = se3_pose_keys(observation.poses, self.store.position_scale, self.store.rotation_weight)
         self.store.add_episode(
             observation.kinds,

@@ -7,6 +7,12 @@ with the uninformed prior as a pseudo-neighbour: see :class:`MemoryConfig`). The
 normalised, then ``uniform_mass`` is added to every possible hypothesis and the block renormalised, so
 a bad prior can still be unlearned. A bucket the memory has never filled falls back to the
 uninformed prior's value, or — with ``back_off`` — is recalled from all pairs at a similar pose.
+
+What a memory stores of a pair is the probability that it is *among* the lockers
+(:meth:`learning.lock_belief.LockBelief.locker_memberships`): for the paper's one-locker belief the locker's
+own probability; for a belief over sets of lockers, the mass of every set the pair is in, so "held by both
+screws" is remembered as such. A set belief's prior is built from the unnormalised recall
+(:func:`recall_memberships`, :func:`learning.set_prior.membership_set_prior`).
 """
 
 from __future__ import annotations
@@ -15,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from learning.belief import block_entropy, default_prior, hypothesis_count
+from learning.belief import block_confidence, default_prior, hypothesis_count
 from learning.memory.keys import se3_pose_keys
 from learning.memory.store import MemoryStore
 from models.disassembly_kinds import kind_family
@@ -48,7 +54,9 @@ class MemoryConfig:
     wheels): 100% / 5.93 actions on the unseen variants against 95.3% / 8.33 without; unchanged at
     9 episodes (5.07) and on the validation split (6.96)."""
     uniform_mass: float = 0.01
-    """Added to every hypothesis before renormalising (the authors' release: 0.01)."""
+    """Added to every hypothesis before renormalising (the authors' release: 0.01). For a belief over sets
+    of lockers, the floor (and one minus it the ceiling) of every recalled membership and independence
+    (:func:`learning.set_prior.membership_set_prior`)."""
     position_scale: float = 0.02
     """Length that weighs like one key unit [m] (used when creating a memory)."""
     rotation_weight: float = 1.0
@@ -69,12 +77,38 @@ def recall_prior(
     config: MemoryConfig,
     prior_independent: float = 0.7,
 ) -> np.ndarray:
-    """The ``(N, 2, 1 + 2N)`` prior for a task with these kinds and poses (any common frame)."""
+    """The one-locker ``(N, 2, 1 + 2N)`` prior for a task with these kinds and poses (any common frame):
+    :func:`recall_memberships` with every block normalised, then ``uniform_mass`` added to every possible
+    hypothesis."""
+    fallback = default_prior(len(kinds), prior_independent)
+    if not _recalls(store, kinds):
+        return fallback
+    weights = recall_memberships(store, kinds, poses, config, prior_independent)
+    possible = fallback > 0.0
+    totals = weights.sum(axis=-1, keepdims=True)
+    probs = np.where(totals > 0.0, weights / np.where(totals > 0.0, totals, 1.0), fallback)
+    probs = np.where(possible, probs + config.uniform_mass, 0.0)
+    return probs / probs.sum(axis=-1, keepdims=True)
+
+
+def recall_memberships(
+    store: MemoryStore,
+    kinds: tuple[str, ...],
+    poses: np.ndarray,
+    config: MemoryConfig,
+    prior_independent: float = 0.7,
+) -> np.ndarray:
+    """``(N, 2, 1 + 2N)``: what the memory recalls for each block, before any normalising (see the module
+    docstring): ``[j, s_j, 0]`` the mean stored independence of ``kind_j``, ``[j, s_j, 1 + 2i + s_i]`` the
+    kernel-weighted mean of the k nearest stored values of the pair — P(``(i, s_i)`` is among ``j``'s lockers
+    in ``s_j``), a memory's :meth:`learning.lock_belief.LockBelief.locker_memberships` (with one locker,
+    P(it *is* the locker)). Pairs and kinds the memory has never seen hold the uninformed prior's values.
+    A belief over sets of lockers is built from it by :func:`learning.set_prior.membership_set_prior`."""
     n = len(kinds)
     fallback = default_prior(n, prior_independent)
-    family = kind_family(kinds[0]) if n else ""
-    if n < 2 or not store.holds_family(family):  # a memory of puzzle boxes knows nothing of computers
+    if not _recalls(store, kinds):
         return fallback
+    family = kind_family(kinds[0])
     keys = se3_pose_keys(poses, store.position_scale, store.rotation_weight)
     weights = np.zeros((n, 2, hypothesis_count(n)))
     for j in range(n):
@@ -105,26 +139,34 @@ def recall_prior(
             total = neighbour_weights.sum(axis=0)[:, None] + prior_weight  # (s_j, 1)
             block = (np.einsum("kr,krs->rs", neighbour_weights, values) + prior_weight * uninformed) / total
             weights[j, :, 1 + 2 * i : 3 + 2 * i] = block
-    possible = fallback > 0.0
-    totals = weights.sum(axis=-1, keepdims=True)
-    probs = np.where(totals > 0.0, weights / np.where(totals > 0.0, totals, 1.0), fallback)
-    probs = np.where(possible, probs + config.uniform_mass, 0.0)
-    return probs / probs.sum(axis=-1, keepdims=True)
+    return weights
 
 
-def episode_record(probs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _recalls(store: MemoryStore, kinds: tuple[str, ...]) -> bool:
+    """Whether the memory has anything to say about a task of these kinds (a memory of puzzle boxes knows
+    nothing of computers)."""
+    return len(kinds) >= 2 and store.holds_family(kind_family(kinds[0]))
+
+
+def episode_record(view: np.ndarray, confidence: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """What an episode's learned belief contributes to memory.
 
+    Args:
+        view: ``(N, 2, 1 + 2N)``, the belief's :meth:`~learning.lock_belief.LockBelief.locker_memberships`
+            (with one locker, the belief itself).
+        confidence: ``(N, 2)``, how resolved each block is (:meth:`~learning.lock_belief.LockBelief.block_confidence`);
+            None: that of ``view`` read as one-locker categoricals, ``1 - entropy / log(2N - 1)``.
+
     Returns:
-        pair_values: ``(N, N, 6)``, ``[i, j]`` = ``P(Z[j, s_j] = (i, s_i))`` for ``(s_j, s_i)`` in
-            (0,0), (0,1), (1,0), (1,1), then the confidence of blocks ``Z[j, 0]`` and ``Z[j, 1]``
-            (1 - entropy / log of the number of hypotheses: 1 = resolved, 0 = uniform).
+        pair_values: ``(N, N, 6)``, ``[i, j]`` = ``P((i, s_i) among the lockers of j in s_j)`` for ``(s_j, s_i)``
+            in (0,0), (0,1), (1,0), (1,1), then the confidence of blocks ``Z[j, 0]`` and ``Z[j, 1]``
+            (1 = resolved, 0 = uniform).
         independence: ``(N, 2)``, ``P(Z[j, s] = independent)``.
     """
-    n = probs.shape[0]
-    lockers = probs[:, :, 1:].reshape(n, 2, n, 2)  # [j, s_j, i, s_i]
+    n = view.shape[0]
+    lockers = view[:, :, 1:].reshape(n, 2, n, 2)  # [j, s_j, i, s_i]
     pair_values = lockers.transpose(2, 0, 1, 3).reshape(n, n, 4)  # [i, j, (s_j, s_i)]
-    possible = max(2 * n - 1, 2)  # hypotheses per block: independent + 2(N-1) lockers
-    confidence = np.clip(1.0 - block_entropy(probs) / np.log(possible), 0.0, 1.0)  # (j, s_j)
-    confidence_ij = np.broadcast_to(confidence[None, :, :], (n, n, 2))
-    return np.concatenate([pair_values, confidence_ij], axis=-1), probs[:, :, 0].copy()
+    if confidence is None:
+        confidence = block_confidence(view, 2 * n - 1)  # (j, s_j): hypotheses per block, independent + 2(N-1)
+    confidence_ij = np.broadcast_to(np.asarray(confidence)[None, :, :], (n, n, 2))
+    return np.concatenate([pair_values, confidence_ij], axis=-1), view[:, :, 0].copy()

@@ -1,7 +1,10 @@
 """The memory of learned dependency graphs, persisted in SQLite.
 
 After an episode, every ordered pair (i, j) contributes its learned belief block — the probabilities
-that i, in each of its states, holds j in each of j's states — to the bucket of its kinds
+that i, in each of its states, is among the lockers of j in each of j's states
+(:meth:`learning.lock_belief.LockBelief.locker_memberships`; for the paper's one-locker belief, that it *is* the
+locker; memories trained over sets of lockers before memberships stored each set's mass shared among its
+lockers, which reads as a half of each of two lockers) — to the bucket of its kinds
 ``(kind_i, kind_j)``, keyed by j's pose in i's frame; every component contributes its probability of
 being independent (per state) to the bucket of its kind. Everything lives in memory for fast
 nearest-neighbour look-ups and, when a path is given, in an SQLite file: one transaction per
