@@ -9,7 +9,7 @@ the reality gap in the twin.
                                  [--agents memory,dqn,model-based]
     python scripts/experiment.py sysid --out DIR [--workers W] [--cells 0,1,2] [--quick]
     python scripts/experiment.py disassembly --agents memory,dual,dqn,model-based --out DIR [--quick] [--runs R]
-                                 [--seeds S] [--workers W | --ray ...]
+                                 [--seeds S] [--workers W | --ray ...] [--validation] [--no-holding-rule]
     python scripts/experiment.py kinds --out DIR [--quick] [--runs R] [--workers W]
 
 Writes ``DIR/<protocol>.json`` (every point, mean and std over training seeds and each seed's value,
@@ -44,6 +44,9 @@ jittered; ``--runs`` runs per test scene, default 5): success = the motherboard 
 against training episodes (memory: 1-20, with the paper's one-locker belief and with sets of two lockers,
 ``memory-k2``; the deep agents, with dense rewards: 0-200). It writes ``DIR/disassembly.{json,md,png}``; each
 (agent, training seed) is a task whose record is kept in ``DIR/records/``: the same command resumes.
+``--validation`` tests on 10 variants of ``lab-computer-a`` instead (seeds 5000-5009: where every setting was
+chosen); ``--no-holding-rule`` lets the belief agents believe that a removed part holds another (the paper's
+hypothesis space, an ablation).
 
 ``kinds`` (``scripts/_kinds_experiment.py``) runs boxes mixing every registered kind (door, slide, wheel,
 drawer, lever): every five-kind chain and 100 random boxes symbolically, and 3 held-out chains end to end in the
@@ -102,9 +105,19 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--cells", default=None, metavar="SEEDS", help="sysid: the cells' seeds, comma-separated (default 0,1,2)"
     )
+    parser.add_argument(
+        "--validation", action="store_true",
+        help="disassembly: test on variants of the training computer (the split settings are chosen on)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--no-holding-rule", action="store_true",
+        help="disassembly: the belief agents may believe a removed part holds another (the paper's hypotheses)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
     if args.cells is not None and args.protocol != SYSID:
         fail("--cells goes with the sysid protocol")
+    if (args.validation or args.no_holding_rule) and args.protocol != DISASSEMBLY:
+        fail("--validation and --no-holding-rule go with the disassembly protocol")
 
     if args.protocol == REALITY:
         return _reality(args)
@@ -286,6 +299,7 @@ def _disassembly(args: argparse.Namespace) -> int:
         if args.seeds < 1:
             fail(f"--seeds must be >= 1, got {args.seeds}")
         config = replace(config, training_seeds=args.seeds)
+    config = replace(config, validation=args.validation, holding_rule=not args.no_holding_rule)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         fail(f"--out {out} is a file, not a directory")

@@ -66,6 +66,13 @@ class DisassemblyConfig:
     variant_seed: int = 1000
     """Seed of variant 0 (variant v: ``variant_seed + v``)."""
     variant: VariantConfig = field(default_factory=VariantConfig)
+    validation: bool = False
+    """Test on ``variants`` variants of the *training* scene (seeds ``validation_seed + v``) instead of the test
+    scene and its variants: the split every setting here was chosen on, never the test computer."""
+    validation_seed: int = 5000
+    holding_rule: bool = True
+    """The belief agents know that a removed part holds nothing (``BeliefConfig.family_holding_states``); False:
+    the paper's hypothesis space, every pair may hold (an ablation)."""
     runs_per_test: int = 5
     """Seeded runs on each test scene, per point."""
     max_actions: int = 24
@@ -129,32 +136,37 @@ def scenes(config: DisassemblyConfig) -> tuple[PuzzleSpec, list[PuzzleSpec]]:
         raise ConfigError(f"the disassembly data is missing: {', '.join(missing)} (the measured computers ship in "
                           "../shared/data/disassembly beside the repository)")  # fmt: skip
     train, test = (load_spec(p) for p in paths)
+    if config.validation:
+        return train, [disassembly_variant(train, config.validation_seed + v, config.variant)
+                       for v in range(config.variants)]  # fmt: skip
     variants = [disassembly_variant(test, config.variant_seed + v, config.variant) for v in range(config.variants)]
     return train, [test, *variants]
 
 
-def _controller(max_lockers: int, entropy_scale: float = 4.0) -> DualControllerConfig | None:
-    """The controller of a curve (None: the agents' own default, the paper's, as everywhere else)."""
-    if max_lockers == 1 and entropy_scale == DualControllerConfig().entropy_scale:
+def _controller(max_lockers: int, entropy_scale: float = 4.0, holding_rule: bool = True) -> DualControllerConfig | None:
+    """The controller of a curve (None: the agents' own default, as everywhere else)."""
+    if max_lockers == 1 and entropy_scale == DualControllerConfig().entropy_scale and holding_rule:
         return None
-    return DualControllerConfig(belief=BeliefConfig(), max_lockers=max_lockers, entropy_scale=entropy_scale)
+    belief = BeliefConfig(family_holding_states=holding_rule)
+    return DualControllerConfig(belief=belief, max_lockers=max_lockers, entropy_scale=entropy_scale)
 
 
 def symbolic_task(settings: dict[str, Any]) -> dict[str, Any]:
     """One (memory or dual agent, training seed): its points (see the module docstring)."""
     train, tests = spec_from_dict(settings["train"]), [spec_from_dict(t) for t in settings["tests"]]
     seed, k, agent, runs, budget = (settings[name] for name in ("seed", "max_lockers", "agent", "runs", "max_actions"))
+    rule = settings.get("holding_rule", True)  # only set when off: a default task keeps its settings
     start = time.perf_counter()
     if agent == "dual":
-        point = evaluate_on_scenes(lambda: DualAgent(_controller(k)), tests, runs, budget)
+        point = evaluate_on_scenes(lambda: DualAgent(_controller(k, holding_rule=rule)), tests, runs, budget)
         return {"points": [{"episodes": e, **point} for e in settings["episodes"]],
                 "wall_time_s": time.perf_counter() - start}  # fmt: skip
     store, trained, points = MemoryStore(position_scale=settings["position_scale"]), [], []
-    tested = _controller(k, settings["entropy_scale"])  # the tests' controller; training explores more
+    tested = _controller(k, settings["entropy_scale"], rule)  # the tests' controller; training explores more
     for episodes in settings["episodes"]:
         while len(trained) < episodes:
             world_seed = 10_000 * seed + len(trained)
-            learner = MemoryAgent(store, config=_controller(k), learn=True)
+            learner = MemoryAgent(store, config=_controller(k, holding_rule=rule), learn=True)
             learner.episode_label = train.name
             result = run_episode(learner, SymbolicWorld(train, world_seed), train.name, world_seed,
                                  settings["train_max_actions"])  # fmt: skip
@@ -207,6 +219,8 @@ def tasks_for(
             for seed in range(seeds):
                 function = deep_task if agent in DEEP else symbolic_task
                 settings = {**(deep if agent in DEEP else symbolic), "agent": agent, "seed": seed, "max_lockers": k}
+                if agent not in DEEP and not config.holding_rule:
+                    settings["holding_rule"] = False
                 if agent == "memory":
                     settings["position_scale"] = config.position_scale(k)
                     settings["entropy_scale"] = config.entropy_scale(k)

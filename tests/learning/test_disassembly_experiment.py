@@ -62,3 +62,16 @@ def test_the_command_writes_results_plot_and_the_paper_table(tmp_path):
     table = (tmp_path / "disassembly.md").read_text()
     assert "| memory after 1 episode | 100 %, 20 actions |" in table
     assert json.loads((tmp_path / "disassembly.config.json").read_text())["disassembly"]["variants"] == 2
+
+
+def test_validation_tests_on_variants_of_the_training_computer_and_never_on_the_test_computer():
+    train, tests = scenes(replace(QUICK, validation=True))
+    assert [t.name for t in tests] == ["lab-computer-a-v5000", "lab-computer-a-v5001"]
+    assert all(t.name.startswith(train.name) for t in tests)
+
+
+def test_the_holding_rule_ablation_reaches_the_belief_agents_only_and_default_tasks_keep_their_settings():
+    ablation = replace(QUICK, holding_rule=False)
+    assert all("holding_rule" not in t.settings for t in tasks_for(["memory", "dual"], QUICK))
+    assert all(t.settings["holding_rule"] is False for t in tasks_for(["memory", "dual"], ablation))
+    assert all("holding_rule" not in t.settings for t in tasks_for(["dqn"], ablation))

@@ -188,6 +188,13 @@ def test_cells_go_with_the_sysid_protocol_only(tmp_path):
     assert result.returncode == 2 and "--cells goes with the sysid protocol" in result.stderr, result.stderr
 
 
+@pytest.mark.parametrize("flag", ["--validation", "--no-holding-rule"])
+def test_the_disassembly_flags_go_with_the_disassembly_protocol_only(tmp_path, flag):
+    result = experiment("variants", "--out", tmp_path / "out", flag)
+    assert result.returncode == 2 and "go with the disassembly protocol" in result.stderr, result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+
+
 def test_sysid_refuses_an_output_that_is_a_file(tmp_path):
     (tmp_path / "taken").write_text("")
     result = experiment("sysid", "--out", tmp_path / "taken", "--quick")
