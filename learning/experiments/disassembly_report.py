@@ -14,6 +14,19 @@ COLOURS = {"memory": "tab:blue", "memory-k2": "tab:cyan", "memory-k3": "tab:purp
            "dqn": "tab:red", "model-based": "tab:orange"}  # fmt: skip
 
 
+def split_label(summary: dict[str, Any]) -> str:
+    """What the tests were: the test computer and its variants, or (``validation``) variants of the training
+    computer; and the hypothesis space when it is not the default."""
+    config, tests = summary["config"], len(summary["tests"])
+    if config.get("validation"):
+        label = f"validation on {tests} variants of {config['train_scene']}"
+    else:
+        label = f"tested on {config['test_scene']} and {tests - 1} variants"
+    if not config.get("holding_rule", True):
+        label += ", removed parts may hold (the paper's hypotheses)"
+    return label
+
+
 def plot(summary: dict[str, Any], path: Path) -> Path:
     """Success rate and mean actions against training episodes on ``lab-computer-a``, one line per agent
     (shaded: +- one standard deviation over training seeds), with the optimum and the paper's memory agent."""
@@ -38,13 +51,12 @@ def plot(summary: dict[str, Any], path: Path) -> Path:
         ticks = [0.5, 1, 2, 5, 10, 20, 50, 100, 200]
         ax.set_xticks(ticks, ["0", "1", "2", "5", "10", "20", "50", "100", "200"])
         ax.minorticks_off()
-        ax.set_xlabel("training episodes on lab-computer-a")
+        ax.set_xlabel(f"training episodes on {summary['config']['train_scene']}")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
     ax_success.set_ylim(-3, 103)
     ax_actions.legend(fontsize=7, loc="upper right")
-    tests = len(summary["tests"])
-    fig.suptitle(f"Disassembly: tested on lab-computer-b and {tests - 1} variants (motherboard out within {budget})")
+    fig.suptitle(f"Disassembly: {split_label(summary)} (motherboard out within {budget})")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -53,7 +65,8 @@ def plot(summary: dict[str, Any], path: Path) -> Path:
 
 def table(summary: dict[str, Any]) -> str:
     """Markdown: every curve's points, then ours beside the paper."""
-    lines = ["| agent | training episodes | success | mean actions | seeds |", "|---|---|---|---|---|"]
+    lines = [f"{split_label(summary).capitalize()}.", "",
+             "| agent | training episodes | success | mean actions | seeds |", "|---|---|---|---|---|"]  # fmt: skip
     for curve, rows in summary["curves"].items():
         for r in rows:
             lines.append(
