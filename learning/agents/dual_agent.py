@@ -132,7 +132,8 @@ class MemoryAgent(DualAgent):
     def initial_belief(self, observation: SceneObservation) -> LockBelief:
         """With one locker, the recalled prior itself; over sets of lockers, the set prior of the recalled
         memberships (:func:`learning.memory.prior.recall_memberships`), so a memory of "held by both screws"
-        starts the belief on the pair of screws."""
+        starts the belief on the pair of screws (a memory with nothing to recall gives the uninformed prior, read
+        as memberships). Both without mass on the lockers that cannot hold (:meth:`holding`)."""
         k = self.config.max_lockers
         if k == 1:
             return super().initial_belief(observation)
