@@ -19,38 +19,28 @@ from learning.trial import run_episode
 from models import spec_from_dict
 from models.errors import UnknownKindError
 
-# screws hold the panel (both); the panel holds everything inside; the CPU, RAM and GPU hold the board (four
-# lockers with the panel: more than any set belief here allows)
-MINI_COMPUTER = {
-    "format": "puzzlebox-spec/1",
-    "name": "mini-computer",
-    "components": [
-        {"name": "screw-1", "kind": "screw", "pose": [0.0, 0.0, 0.0, 0, 0, 0]},
-        {"name": "screw-2", "kind": "screw", "pose": [0.0, 0.0, -0.37, 0, 0, 0]},
-        {"name": "side-panel", "kind": "panel", "pose": [-0.24, 0.0, -0.185, 0, 0, 1.5707963267948966]},
-        {"name": "cpu", "kind": "cpu", "pose": [-0.14, -0.17, -0.08, 0, 0, 1.5707963267948966]},
-        {"name": "ram-1", "kind": "ram", "pose": [-0.2, -0.16, -0.08, 0, 0, 1.5707963267948966]},
-        {"name": "gpu", "kind": "gpu", "pose": [-0.17, -0.04, -0.22, 0, 0, 1.5707963267948966]},
-        {"name": "motherboard", "kind": "motherboard", "pose": [-0.14, -0.18, -0.08, 0, 0, 1.5707963267948966]},
-    ],
-    "locks": [
-        {"locker": "screw-1", "locker_state": 0, "locked": "side-panel", "locked_state": 0},
-        {"locker": "screw-2", "locker_state": 0, "locked": "side-panel", "locked_state": 0},
-        {"locker": "side-panel", "locker_state": 0, "locked": "ram-1", "locked_state": 0},
-        {"locker": "side-panel", "locker_state": 0, "locked": "motherboard", "locked_state": 0},
-        {"locker": "ram-1", "locker_state": 0, "locked": "motherboard", "locked_state": 0},
-        {"locker": "side-panel", "locker_state": 0, "locked": "cpu", "locked_state": 0},
-        {"locker": "side-panel", "locker_state": 0, "locked": "gpu", "locked_state": 0},
-        {"locker": "cpu", "locker_state": 0, "locked": "motherboard", "locked_state": 0},
-        {"locker": "gpu", "locker_state": 0, "locked": "motherboard", "locked_state": 0},
-    ],
-    "goal": {"component": "motherboard", "state": 1},
-}
-
 
 @pytest.fixture
-def computer():
-    return spec_from_dict(MINI_COMPUTER)
+def computer(scene_dict):
+    """The shared small computer (two screws hold the panel, the panel the RAM, the RAM the board) with a CPU and a
+    GPU added under the panel, and the panel, CPU and GPU holding the board too: four lockers of the board, more
+    than any set belief here allows."""
+    turned = [0, 0, 1.5708]
+    scene_dict["components"] += [
+        {"name": "cpu", "kind": "cpu", "pose": [-0.11, -0.14, -0.07, *turned]},
+        {"name": "gpu", "kind": "gpu", "pose": [-0.1, -0.05, -0.185, *turned]},
+    ]
+    scene_dict["locks"] += [
+        {"locker": locker, "locker_state": 0, "locked": locked, "locked_state": 0}
+        for locker, locked in (
+            ("panel", "cpu"),
+            ("panel", "gpu"),
+            ("panel", "board"),
+            ("cpu", "board"),
+            ("gpu", "board"),
+        )
+    ]
+    return spec_from_dict(scene_dict)
 
 
 def controller(k: int, rule: bool = True) -> DualControllerConfig:
