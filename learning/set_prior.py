@@ -38,17 +38,7 @@ def set_prior(single_probs: np.ndarray, sets: LockerSets) -> np.ndarray:
         raise ConfigError(
             f"a one-locker prior for {n} components has shape {(n, 2, hypothesis_count(n))}, got {single.shape}"
         )
-    # a pair's weight, with the padding pair 2N weighing 1 so that a gather + product reads every set
-    pair_weight = np.concatenate([single[:, :, 1:], np.ones((n, 2, 1))], axis=2)
-    weights = pair_weight[:, :, sets.members].prod(axis=3)  # (N, 2, H)
-    weights = np.where(sets.possible[:, None, :], weights, 0.0)
-    locked = weights[:, :, 1:].sum(axis=2, keepdims=True)
-    independent = single[:, :, :1]
-    # the non-empty sets share the one-locker prior's locker mass 1 - q_0 (all on "independent" if no
-    # pair has weight)
-    scale = np.divide(1.0 - independent, locked, out=np.zeros_like(locked), where=locked > 0.0)
-    prior = np.concatenate([np.where(locked > 0.0, independent, 1.0), weights[:, :, 1:] * scale], axis=2)
-    return prior / prior.sum(axis=2, keepdims=True)
+    return _weighted_sets(single[:, :, 1:], single[:, :, :1], sets)
 
 
 def membership_set_prior(
@@ -79,10 +69,19 @@ def membership_set_prior(
     odds = clipped[:, :, 1:] / (1.0 - clipped[:, :, 1:])
     if holding is not None:
         odds = np.where(np.asarray(holding, dtype=bool)[None, None, :], odds, 0.0)
-    pair_weight = np.concatenate([odds, np.ones((n, 2, 1))], axis=2)  # the padding pair weighs 1
-    weights = np.where(sets.possible[:, None, :], pair_weight[:, :, sets.members].prod(axis=3), 0.0)
+    return _weighted_sets(odds, clipped[:, :, :1], sets)
+
+
+def _weighted_sets(pair_weights: np.ndarray, independent: np.ndarray, sets: LockerSets) -> np.ndarray:
+    """``(N, 2, H)``: the empty set gets ``independent`` ``(N, 2, 1)``; the non-empty sets share the rest in
+    proportion to the product of their pairs' ``pair_weights`` ``(N, 2, 2N)`` (all on the empty set if no set
+    has weight)."""
+    n = sets.num_components
+    # the padding pair 2N weighs 1, so that a gather + product reads every set
+    pair_weight = np.concatenate([pair_weights, np.ones((n, 2, 1))], axis=2)
+    weights = pair_weight[:, :, sets.members].prod(axis=3)  # (N, 2, H)
+    weights = np.where(sets.possible[:, None, :], weights, 0.0)
     locked = weights[:, :, 1:].sum(axis=2, keepdims=True)
-    independent = np.where(locked > 0.0, clipped[:, :, :1], 1.0)  # no set can hold: independent
     scale = np.divide(1.0 - independent, locked, out=np.zeros_like(locked), where=locked > 0.0)
-    prior = np.concatenate([independent, weights[:, :, 1:] * scale], axis=2)
+    prior = np.concatenate([np.where(locked > 0.0, independent, 1.0), weights[:, :, 1:] * scale], axis=2)
     return prior / prior.sum(axis=2, keepdims=True)
