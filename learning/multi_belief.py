@@ -213,8 +213,8 @@ class MultiBelief:
 
     def block_confidence(self) -> np.ndarray:
         """``(N, 2)``: how resolved each block is over the sets a block can hold (those without its own component)."""
-        possible = self.sets.possible.sum(axis=1)  # (N,): the same for every component
-        return np.stack([block_confidence(self.probs[c], int(possible[c])) for c in range(self.num_components)])
+        possible = int(self.sets.possible[0].sum())  # the same for every component: the sets without it
+        return block_confidence(self.probs, possible)
 
 
 def _bits_of(index: np.ndarray, n: int) -> np.ndarray:

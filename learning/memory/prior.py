@@ -83,7 +83,7 @@ def recall_prior(
     fallback = default_prior(len(kinds), prior_independent)
     if not _recalls(store, kinds):
         return fallback
-    weights = recall_memberships(store, kinds, poses, config, prior_independent)
+    weights = _recalled_weights(store, kinds, poses, config, fallback)
     possible = fallback > 0.0
     totals = weights.sum(axis=-1, keepdims=True)
     probs = np.where(totals > 0.0, weights / np.where(totals > 0.0, totals, 1.0), fallback)
@@ -104,10 +104,16 @@ def recall_memberships(
     in ``s_j``), a memory's :meth:`learning.lock_belief.LockBelief.locker_memberships` (with one locker,
     P(it *is* the locker)). Pairs and kinds the memory has never seen hold the uninformed prior's values.
     A belief over sets of lockers is built from it by :func:`learning.set_prior.membership_set_prior`."""
+    fallback = default_prior(len(kinds), prior_independent)
+    return _recalled_weights(store, kinds, poses, config, fallback) if _recalls(store, kinds) else fallback
+
+
+def _recalled_weights(
+    store: MemoryStore, kinds: tuple[str, ...], poses: np.ndarray, config: MemoryConfig, fallback: np.ndarray
+) -> np.ndarray:
+    """:func:`recall_memberships` for a task the memory can recall (:func:`_recalls`); ``fallback`` is the
+    uninformed prior of the task."""
     n = len(kinds)
-    fallback = default_prior(n, prior_independent)
-    if not _recalls(store, kinds):
-        return fallback
     family = kind_family(kinds[0])
     keys = se3_pose_keys(poses, store.position_scale, store.rotation_weight)
     weights = np.zeros((n, 2, hypothesis_count(n)))
