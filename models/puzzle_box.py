@@ -32,6 +32,7 @@ from models.kinds.parts import PLATE_THICKNESS
 from models.kinds.registry import registered_kind
 from models.kinds.template import HANDLE_HEIGHT
 from models.markers import add_marker_geom
+from models.mechanism_mjcf import LOCK_MODES, LockMode, add_mechanisms
 from models.spec import PuzzleSpec
 
 MARKER_Z = PLATE_THICKNESS + 0.0005
@@ -42,6 +43,8 @@ LATCH_SOLIMP = (0.95, 0.99, 0.001)
 
 __all__ = [  # PLATE_THICKNESS lives with the kinds' parts (models.kinds.parts); importers find it here too
     "LATCH_SOLIMP",
+    "LOCK_MODES",
+    "LockMode",
     "LATCH_SOLREF",
     "MARKER_Z",
     "PLATE_THICKNESS",
@@ -67,8 +70,15 @@ def component_prefixes(spec: PuzzleSpec) -> dict[str, str]:
     return out
 
 
-def build_puzzle_box(spec: PuzzleSpec, with_markers: bool = True, lock_features: bool = False) -> mjcf.RootElement:
+def build_puzzle_box(
+    spec: PuzzleSpec, with_markers: bool = True, lock_features: bool = False, locks: LockMode = "contact"
+) -> mjcf.RootElement:
     """The box model of a puzzle-box spec (see the module docstring). Attach it at the lid frame.
+
+    With ``locks="contact"`` (the default) the spec's lock rules are mechanisms that block by contact
+    (:mod:`models.lock_mechanisms`, :func:`add_mechanisms`): the model alone behaves as the spec says, in plain
+    MuJoCo; rules no mechanism realizes are left to the latches (inactive in the model; the twin engages them).
+    With ``locks="latch"`` the model has no mechanism: exactly the model built before mechanisms existed.
 
     With ``lock_features``, every visible lock feature of :func:`models.lock_features.lock_features` is added
     to its locker's body (so it moves with the locker's joint) as a visual-only mesh geom
@@ -118,6 +128,10 @@ def build_puzzle_box(spec: PuzzleSpec, with_markers: bool = True, lock_features:
         bodies[component.name] = moving
     if lock_features:
         _add_lock_features(root, spec, bodies, prefixes)
+    if locks == "contact":
+        add_mechanisms(root, spec, bodies, prefixes)
+    elif locks != "latch":
+        raise ValueError(f"locks must be one of {LOCK_MODES}, got {locks!r}")
     return root
 
 

@@ -1,0 +1,157 @@
+"""The mechanism check: does a compiled model alone behave as its spec says?
+
+From every state reachable from all-zero (the spec's semantics, :class:`~models.lock_table.LockTable`), each part
+is pushed toward its other state with a bounded generalized force — :data:`SLIDE_FORCE` along a prismatic joint,
+:data:`HINGE_TORQUE` about a hinge, what the robot's pinch gives below its force limit — for
+:data:`PUSH_TIME`, every other joint held where it stands (its position reset after every step: a held part
+cannot be pushed out of the way). A free part must reach :data:`FREE_FRACTION` of its travel toward the other
+state (the twin's state threshold); a held part must move less than :data:`HELD_FRACTION`. Only ``mujoco`` runs:
+the model is stepped as it is, no latch engaged, no project code in the loop, so what holds a part is its
+geometry.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from models.lock_table import LockTable
+from models.spec import PuzzleSpec
+
+__all__ = [
+    "FREE_FRACTION",
+    "HELD_FRACTION",
+    "HINGE_TORQUE",
+    "PUSH_TIME",
+    "SLIDE_FORCE",
+    "LockCheck",
+    "Transition",
+    "check_locks",
+    "reachable_states",
+]
+
+SLIDE_FORCE = 25.0
+"""Push along a prismatic joint [N]."""
+HINGE_TORQUE = 1.5
+"""Push about a hinge [N·m]."""
+PUSH_TIME = 1.0
+"""How long each push lasts [s]."""
+FREE_FRACTION = 0.75
+"""A free part reaches at least this fraction of its travel toward its other state."""
+HELD_FRACTION = 0.5
+"""A held part moves less than this fraction of its travel."""
+MAX_STATES = 4096
+"""Most reachable states checked (all of them up to 12 parts)."""
+
+
+@dataclass(frozen=True)
+class Transition:
+    """One push: ``component`` from ``state`` (bitmask over spec order) toward its other state."""
+
+    state: int
+    component: str
+    expected_free: bool
+    moved: float
+    """Largest fraction of the travel the part reached toward its other state."""
+
+    @property
+    def agrees(self) -> bool:
+        """Whether the part did what the spec says: reached :data:`FREE_FRACTION` if free, stayed below
+        :data:`HELD_FRACTION` if held."""
+        return self.moved >= FREE_FRACTION if self.expected_free else self.moved < HELD_FRACTION
+
+
+@dataclass(frozen=True)
+class LockCheck:
+    """Every transition of one model, and how many agree with the spec."""
+
+    spec_name: str
+    transitions: tuple[Transition, ...]
+
+    @property
+    def agreeing(self) -> int:
+        return sum(t.agrees for t in self.transitions)
+
+    @property
+    def fraction(self) -> float:
+        return self.agreeing / len(self.transitions) if self.transitions else 1.0
+
+    def held_moves(self) -> list[float]:
+        """How far each held part moved [fraction of its travel]."""
+        return [t.moved for t in self.transitions if not t.expected_free]
+
+    def disagreements(self) -> list[Transition]:
+        return [t for t in self.transitions if not t.agrees]
+
+
+def reachable_states(spec: PuzzleSpec, limit: int = MAX_STATES) -> list[int]:
+    """States (bitmasks over spec order) reachable from all-zero by allowed toggles, breadth first."""
+    table = LockTable.from_spec(spec)
+    seen = {0}
+    order = [0]
+    k = 0
+    while k < len(order) and len(order) < limit:
+        state = order[k]
+        k += 1
+        for c in range(len(spec.components)):
+            if table.can_move(state, c):
+                nxt = state ^ (1 << c)
+                if nxt not in seen:
+                    seen.add(nxt)
+                    order.append(nxt)
+    return order[:limit]
+
+
+def check_locks(
+    spec: PuzzleSpec, model: mujoco.MjModel, joint_names: dict[str, str], limit: int = MAX_STATES
+) -> LockCheck:
+    """Push every part from every reachable state (module docstring) in ``model``, whose joint of each
+    component is ``joint_names[component name]``. Other joints of the model (a robot's, a pawl's) are held
+    where they stand at reset, but for joints that belong to no component and carry a spring (a mechanism's own
+    sprung parts), which move freely."""
+    table = LockTable.from_spec(spec)
+    joints = [model.joint(joint_names[c.name]) for c in spec.components]
+    qadr = np.array([int(j.qposadr[0]) for j in joints])
+    dadr = np.array([int(j.dofadr[0]) for j in joints])
+    travel = np.array([float(model.jnt_range[j.id][1]) for j in joints])
+    hinge = np.array([model.jnt_type[j.id] == mujoco.mjtJoint.mjJNT_HINGE for j in joints])
+    own = {j.id for j in joints}
+    held_other = [
+        j for j in range(model.njnt) if j not in own and not model.jnt_stiffness[j] > 0
+    ]  # robot joints and anything rigid
+    other_q = [int(model.jnt_qposadr[j]) for j in held_other]
+    other_d = [int(model.jnt_dofadr[j]) for j in held_other]
+    data = mujoco.MjData(model)
+    steps = int(round(PUSH_TIME / model.opt.timestep))
+    transitions: list[Transition] = []
+    for state in reachable_states(spec, limit):
+        bits = np.array([(state >> c) & 1 for c in range(len(joints))])
+        for c in range(len(joints)):
+            mujoco.mj_resetData(model, data)
+            q0 = np.where(bits == 1, travel, 0.0)
+            data.qpos[qadr] = q0
+            mujoco.mj_forward(model, data)
+            hold_q = data.qpos.copy()
+            sign = 1.0 if bits[c] == 0 else -1.0
+            effort = HINGE_TORQUE if hinge[c] else SLIDE_FORCE
+            others = np.array([k for k in range(len(joints)) if k != c], dtype=int)
+            best = 0.0
+            for _ in range(steps):
+                data.qfrc_applied[:] = 0.0
+                data.qfrc_applied[dadr[c]] = sign * effort
+                mujoco.mj_step(model, data)
+                if len(others):
+                    data.qpos[qadr[others]] = hold_q[qadr[others]]
+                    data.qvel[dadr[others]] = 0.0
+                if other_q:
+                    data.qpos[other_q] = hold_q[other_q]
+                    data.qvel[other_d] = 0.0
+                moved = sign * (data.qpos[qadr[c]] - q0[c]) / travel[c]
+                best = max(best, float(moved))
+                if best >= 0.98:
+                    break
+            free = bool(table.can_move(state, c))
+            transitions.append(Transition(state, spec.components[c].name, free, best))
+    return LockCheck(spec.name, tuple(transitions))

@@ -1,0 +1,327 @@
+"""Locks made of matter: the lock rules of a puzzle-box spec as mechanisms that block by contact.
+
+SPEC.md: while ``locker`` (A) is in ``locker_state`` a, ``locked`` (B) cannot *leave* ``locked_state`` b.
+Two rules "A in a keeps B in b" and "B in 1-b keeps A in 1-a" form a **pair**: together they forbid the one
+configuration (A at a, B at 1-b) and both ways into it. A pair becomes a rigid **interlock** of two tubes under
+the lid that cross at a point X (lid frame):
+
+- on A, a *wall*: the path X takes through A's moving part while A goes from a to a fraction ``theta`` of its
+  travel toward 1-a, so that X lies inside the wall exactly while A is within that fraction of a;
+- on B, a *rod*: the path of X through B while B is between a fraction ``delta`` of its travel and 1-b, so
+  that X lies inside the rod exactly while B has left b by more than ``delta``.
+
+Both contain X only in the forbidden corner: with A at a, B's rod meets A's wall after B moved ``delta``; with B
+at 1-b, A's wall meets B's rod after A moved ``1 - theta``; with A at 1-a or B at b they pass each other with a
+clearance. At X the wall runs along A's motion and the rod along B's, so a contact's normal there (across the
+tube it touches) does no work on the part it does not block: the locker is not pushed open by a blocked try.
+X is searched for (:func:`design_mechanisms`): where the two motions cross at a good angle, the blocking
+fractions are small, the tubes stay inside the box and, as far as they can, under the lid.
+
+An **unpaired** rule (random and multi-locker boxes) forbids leaving b but not entering it: a one-way latch,
+not built yet — it is named as unrealized and the twin enforces it with a rule-driven latch
+(:mod:`twin.latches`), as it does for any rule whose pair no crossing point serves.
+
+Collisions: every mechanism geom has its own contact bit (``contype = conaffinity = 2**k``, ``k`` in 1..31), so
+a wall touches only the rod of its own interlock, never the robot, the table or another interlock; the tubes
+are capsules (the contact MuJoCo and every engine that reads MJCF handle best). Frames: lid frame (origin at
+the lid centre on its top face, x along the length, z up) [m].
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from models.errors import UnknownKindError
+from models.joint_motion import JointMotion
+from models.kinds.registry import get_kind
+from models.spec import LockRule, PuzzleSpec
+
+__all__ = [
+    "GAP",
+    "TUBE_RADIUS",
+    "Interlock",
+    "MechanismLayout",
+    "UnrealizedRule",
+    "design_mechanisms",
+    "paired_rules",
+]
+
+TUBE_RADIUS = 0.0025
+"""Radius of a wall's and a rod's capsules [m]."""
+GAP = 0.0015
+"""Clearance between a wall and a rod wherever they must pass each other [m]."""
+MIN_CROSSING_SINE = 0.5
+"""Smallest sine of the angle between the two motions at X (30 deg): below it a blocked push would need twice its
+own force at the contact, and the tubes would have to be long to clear each other."""
+MAX_BLOCKING = 0.35
+"""Largest fraction of its travel a held part may move before its tube meets the other's."""
+SAMPLES = 241
+"""Points along each motion's path over [-1.2, 1.2] of its travel (every 1 % of the travel)."""
+STEP = 0.01
+"""Resolution of the search for ``delta`` and ``1 - theta`` [fraction of the travel]."""
+GRID_STEP = 0.005
+"""Spacing of the candidate crossing points in plan [m]."""
+DEPTHS = (-0.006, -0.012, -0.02, -0.03)
+"""Candidate heights of the crossing point below the lid's top face [m]."""
+BOX_MARGIN = 0.004
+"""How far inside the box's side walls and above its floor every tube stays [m]."""
+MAX_TRIED = 60
+"""Candidate crossing points whose blocking fractions are computed, best first guesses first."""
+SEGMENT_ANGLE = np.radians(8.0)
+"""Largest turn of a hinge's tube per capsule [rad] (chord error < 0.25 % of its radius)."""
+
+
+@dataclass(frozen=True)
+class UnrealizedRule:
+    """A lock rule no mechanism realizes, and why; the twin enforces it with a latch."""
+
+    rule: LockRule
+    reason: str
+
+
+@dataclass(frozen=True)
+class Interlock:
+    """A rigid two-way interlock realizing a pair of rules (module docstring).
+
+    Attributes:
+        name: ``"<A>-interlocks-<B>"`` (spec names).
+        locker: A, the part whose state a holds B (the first rule's locker).
+        locked: B.
+        locker_state: a.
+        locked_state: b.
+        rules: the two rules, ``(A in a keeps B in b, B in 1-b keeps A in 1-a)``.
+        crossing: X, lid frame [m].
+        theta: A's wall covers X while A is within this fraction of its travel from a.
+        delta: B's rod covers X once B has left b by this fraction of its travel.
+        wall: ``(n, 3)`` polyline of the wall's axis in the lid frame with every part in state 0 [m].
+        rod: ``(m, 3)`` polyline of the rod's axis, likewise [m].
+        crossing_sine: sine of the angle between the two motions at X.
+        exposed: how far the tubes rise above the lid's top face in any of the four corner states [m] (<= 0: the
+            mechanism is hidden under the lid).
+    """
+
+    name: str
+    locker: str
+    locked: str
+    locker_state: int
+    locked_state: int
+    rules: tuple[LockRule, LockRule]
+    crossing: np.ndarray = field(repr=False, compare=False)
+    theta: float
+    delta: float
+    wall: np.ndarray = field(repr=False, compare=False)
+    rod: np.ndarray = field(repr=False, compare=False)
+    crossing_sine: float
+    exposed: float
+    radius: float = TUBE_RADIUS
+
+
+@dataclass(frozen=True)
+class MechanismLayout:
+    """A spec's mechanisms: every rule is in exactly one interlock or in ``unrealized``."""
+
+    interlocks: tuple[Interlock, ...]
+    unrealized: tuple[UnrealizedRule, ...]
+
+    @property
+    def complete(self) -> bool:
+        """Whether every rule is realized by a mechanism (the model alone behaves as the spec says)."""
+        return not self.unrealized
+
+
+def paired_rules(spec: PuzzleSpec) -> tuple[list[tuple[LockRule, LockRule]], list[LockRule]]:
+    """The spec's rules as pairs ``(A in a keeps B in b, B in 1-b keeps A in 1-a)``, in order of the first rule
+    of each pair, and the rules left unpaired, in spec order."""
+    remaining = list(spec.locks)
+    pairs: list[tuple[LockRule, LockRule]] = []
+    unpaired: list[LockRule] = []
+    while remaining:
+        rule = remaining.pop(0)
+        partner = LockRule(rule.locked, 1 - rule.locked_state, rule.locker, 1 - rule.locker_state)
+        if partner in remaining:
+            remaining.remove(partner)
+            pairs.append((rule, partner))
+        else:
+            unpaired.append(rule)
+    return pairs, unpaired
+
+
+def design_mechanisms(spec: PuzzleSpec) -> MechanismLayout:
+    """The mechanisms of a puzzle-box spec (module docstring): an interlock per pair of rules that a crossing
+    point serves; every other rule unrealized, with its reason. Deterministic: a pure function of the spec."""
+    if spec.box is None:
+        raise ValueError(f"spec {spec.name!r} has no box: not a puzzle box")
+    by_name = {c.name: c for c in spec.components}
+    pairs, unpaired = paired_rules(spec)
+    interlocks: list[Interlock] = []
+    unrealized: list[UnrealizedRule] = []
+    for first, second in pairs:
+        try:
+            a, b = (_motion(by_name[first.locker]), _motion(by_name[first.locked]))
+        except UnknownKindError as error:
+            unrealized += [UnrealizedRule(r, f"unknown kind: {error}") for r in (first, second)]
+            continue
+        designed = _design_interlock(spec, first, second, a, b, by_name)
+        if isinstance(designed, str):
+            unrealized += [UnrealizedRule(r, designed) for r in (first, second)]
+        else:
+            interlocks.append(designed)
+    for rule in unpaired:
+        unrealized.append(UnrealizedRule(rule, "an unpaired rule needs a one-way latch, which no mechanism builds yet"))
+    order = {rule: k for k, rule in enumerate(spec.locks)}
+    unrealized.sort(key=lambda u: order[u.rule])
+    return MechanismLayout(tuple(interlocks), tuple(unrealized))
+
+
+def _motion(component) -> JointMotion:
+    return JointMotion.of(get_kind(component.kind), tuple(component.pose))
+
+
+@dataclass(frozen=True)
+class _Paths:
+    """Both motions' paths of one candidate X: ``C_A(t)``, ``C_B(t)`` for ``t`` in ``ts`` and their distances."""
+
+    ts: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    distance: np.ndarray
+
+
+def _paths(x: np.ndarray, a: JointMotion, b: JointMotion, dir_a: float, dir_b: float) -> _Paths:
+    ts = np.linspace(-1.2, 1.2, SAMPLES)
+    pa = a.move(x, dir_a * a.travel * ts)
+    pb = b.move(x, dir_b * b.travel * ts)
+    distance = np.linalg.norm(pa[:, None, :] - pb[None, :, :], axis=-1)
+    return _Paths(ts, pa, pb, distance)
+
+
+def _index(ts: np.ndarray, t: float) -> int:
+    return int(round((t - ts[0]) / (ts[1] - ts[0])))
+
+
+def _fractions(paths: _Paths) -> tuple[float, float] | None:
+    """``(theta, delta)``: the largest theta and smallest delta on the :data:`STEP` grid for which the free edges
+    of the configuration square are clear (module docstring), or None within :data:`MAX_BLOCKING`.
+
+    Free edges, with t the displacement (fraction of travel) that carries X through a part: B at b and A anywhere
+    (wall ``t`` in [-theta, 1], rod in [-1, -delta]) and A at 1-a and B anywhere (wall in [1-theta, 1], rod in
+    [-1, 1-delta])."""
+    need = 2 * TUBE_RADIUS + GAP
+    ts, d = paths.ts, paths.distance
+    i_m1, i_p1 = _index(ts, -1.0), _index(ts, 1.0)
+    blockings = np.arange(STEP, MAX_BLOCKING + 1e-9, STEP)
+    for delta in blockings:
+        # per wall sample, its nearest rod sample: B at b (rod [-1, -delta]) and B anywhere (rod [-1, 1-delta])
+        at_b = d[: i_p1 + 1, i_m1 : _index(ts, -delta) + 1].min(axis=1)
+        anywhere = d[: i_p1 + 1, i_m1 : _index(ts, 1.0 - delta) + 1].min(axis=1)
+        clear_at_b = np.minimum.accumulate(at_b[::-1])[::-1]  # min over wall samples i..t=1
+        clear_anywhere = np.minimum.accumulate(anywhere[::-1])[::-1]
+        for blocking_a in blockings:
+            theta = 1.0 - blocking_a
+            if clear_at_b[_index(ts, -theta)] >= need and clear_anywhere[_index(ts, 1.0 - theta)] >= need:
+                return float(theta), float(delta)
+    return None
+
+
+def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b: JointMotion, by_name):
+    """The best interlock for a pair of rules, or why there is none."""
+    dir_a = 1.0 if first.locker_state == 0 else -1.0  # A goes from a toward 1-a
+    dir_b = 1.0 if first.locked_state == 0 else -1.0  # B goes from b toward 1-b
+    length, width, height = spec.box.size
+    lo = np.array([-length / 2 + BOX_MARGIN, -width / 2 + BOX_MARGIN, -height + BOX_MARGIN])
+    hi = np.array([length / 2 - BOX_MARGIN, width / 2 - BOX_MARGIN, np.inf])
+    ca, cb = by_name[first.locker], by_name[first.locked]
+    fa = get_kind(ca.kind).footprint_in_lid(tuple(ca.pose))
+    fb = get_kind(cb.kind).footprint_in_lid(tuple(cb.pose))
+    both = np.vstack([fa, fb])
+    xmin, ymin = np.maximum(both.min(axis=0) - 0.02, lo[:2])
+    xmax, ymax = np.minimum(both.max(axis=0) + 0.02, hi[:2])
+    xs = np.arange(xmin, xmax + 1e-9, GRID_STEP)
+    ys = np.arange(ymin, ymax + 1e-9, GRID_STEP)
+    grid = np.stack(np.meshgrid(xs, ys, np.array(DEPTHS), indexing="ij"), axis=-1).reshape(-1, 3)
+    va = _velocities(a, grid) * (dir_a * a.travel)  # per unit fraction of travel
+    vb = _velocities(b, grid) * (dir_b * b.travel)
+    na, nb = np.linalg.norm(va, axis=1), np.linalg.norm(vb, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sine = np.linalg.norm(np.cross(va, vb), axis=1) / (na * nb)
+    keep = (na > 1e-6) & (nb > 1e-6) & (sine >= MIN_CROSSING_SINE)
+    # every tube lies on X's paths through A and B over a whole travel each way: inside the box?
+    top = np.full(len(grid), -np.inf)
+    for t in np.linspace(-1.0, 1.0, 21):
+        for motion in (a, b):
+            moved = motion.move(grid, motion.travel * t)
+            keep &= np.all((moved >= lo + TUBE_RADIUS) & (moved <= hi - TUBE_RADIUS), axis=1)
+            top = np.maximum(top, moved[:, 2])
+    if not np.any(keep):
+        return "no point inside the box where the two parts' motions cross at 30 degrees or more"
+    # first guess of the blocking fractions from the local geometry (clearance across the motion)
+    guess = (2 * TUBE_RADIUS + GAP) / sine * (1 / na + 1 / nb)
+    exposure = np.where(top + TUBE_RADIUS > 0, 0.5 + 200.0 * (top + TUBE_RADIUS), 0.0)
+    candidates = [(float(g), -float(si), *map(float, p[[2, 0, 1]])) for g, si, p in
+                  zip((guess + exposure)[keep], sine[keep], grid[keep], strict=True)]  # fmt: skip
+    candidates.sort()
+    best = None
+    reasons: dict[str, int] = {}
+    for k, (_, neg_sine, z, x, y) in enumerate(candidates):
+        if k >= MAX_TRIED and (best is not None or k >= 5 * MAX_TRIED):
+            break
+        point = np.array([x, y, z])
+        paths = _paths(point, a, b, dir_a, dir_b)
+        fractions = _fractions(paths)
+        if fractions is None:
+            reasons["the tubes cannot clear each other"] = reasons.get("the tubes cannot clear each other", 0) + 1
+            continue
+        theta, delta = fractions
+        wall_ts, rod_ts = _tube_ts(-theta, 0.0, a, dir_a), _tube_ts(-1.0, -delta, b, dir_b)
+        # the wall and rod with every part closed: X carried back to where the parts stand at state 0
+        q0a, q0b = a.q(first.locker_state), b.q(first.locked_state)
+        wall0 = a.move(a.move(point, dir_a * a.travel * wall_ts), -q0a)
+        rod0 = b.move(b.move(point, dir_b * b.travel * rod_ts), -q0b)
+        corners = [np.vstack([a.move(wall0, a.q(sa)), b.move(rod0, b.q(sb))]) for sa in (0, 1) for sb in (0, 1)]
+        exposed = float(np.vstack(corners)[:, 2].max() + TUBE_RADIUS)
+        score = (1 - theta) + delta + _exposure_cost(exposed)
+        if best is None or score < best[0]:
+            best = (score, point, theta, delta, wall0, rod0, -neg_sine, exposed)
+    if best is None:
+        common = max(reasons, key=reasons.__getitem__) if reasons else "no candidate"
+        return f"no crossing point serves the pair (mostly: {common})"
+    _, point, theta, delta, wall0, rod0, sine, exposed = best
+    return Interlock(
+        name=f"{first.locker}-interlocks-{first.locked}",
+        locker=first.locker,
+        locked=first.locked,
+        locker_state=first.locker_state,
+        locked_state=first.locked_state,
+        rules=(first, second),
+        crossing=point,
+        theta=theta,
+        delta=delta,
+        wall=wall0,
+        rod=rod0,
+        crossing_sine=sine,
+        exposed=exposed,
+    )
+
+
+def _velocities(motion: JointMotion, points: np.ndarray) -> np.ndarray:
+    """Velocities ``(n, 3)`` of the material points at ``points`` ``(n, 3)`` per unit joint velocity."""
+    if motion.joint == "slide":
+        return np.broadcast_to(motion.axis, points.shape).copy()
+    return np.cross(motion.axis, points - motion.origin)
+
+
+def _exposure_cost(exposed: float) -> float:
+    """What showing a tube above the lid costs, in fractions of travel: 0.5 for showing at all, plus 0.2 per mm."""
+    return 0.0 if exposed <= 0 else 0.5 + 200.0 * exposed
+
+
+def _tube_ts(t0: float, t1: float, motion: JointMotion, direction: float) -> np.ndarray:
+    """Displacements (fraction of travel) sampling a tube from ``t0`` to ``t1``: two for a slide (a straight
+    capsule), one per :data:`SEGMENT_ANGLE` of turn for a hinge."""
+    if motion.joint == "slide":
+        return np.array([t0, t1])
+    turn = abs(t1 - t0) * motion.travel
+    n = max(1, int(np.ceil(turn / SEGMENT_ANGLE)))
+    return np.linspace(t0, t1, n + 1)
