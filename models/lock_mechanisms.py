@@ -48,14 +48,14 @@ __all__ = [
     "paired_rules",
 ]
 
-TUBE_RADIUS = 0.0025
+TUBE_RADIUS = 0.00125
 """Radius of a wall's and a rod's capsules [m]."""
-GAP = 0.0015
+GAP = 0.001
 """Clearance between a wall and a rod wherever they must pass each other [m]."""
 MIN_CROSSING_SINE = 0.5
 """Smallest sine of the angle between the two motions at X (30 deg): below it a blocked push would need twice its
 own force at the contact, and the tubes would have to be long to clear each other."""
-MAX_BLOCKING = 0.35
+MAX_BLOCKING = 0.08
 """Largest fraction of its travel a held part may move before its tube meets the other's."""
 SAMPLES = 241
 """Points along each motion's path over [-1.2, 1.2] of its travel (every 1 % of the travel)."""
@@ -265,7 +265,7 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
     best = None
     reasons: dict[str, int] = {}
     for k, (_, neg_sine, z, x, y) in enumerate(candidates):
-        if k >= MAX_TRIED and (best is not None or k >= 5 * MAX_TRIED):
+        if k >= MAX_TRIED and (best is not None or k >= 50 * MAX_TRIED):
             break
         point = np.array([x, y, z])
         paths = _paths(point, a, b, dir_a, dir_b)
