@@ -10,6 +10,7 @@ pass them. They sit in geom group 3, which MuJoCo does not draw by default: the 
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from typing import TYPE_CHECKING, Literal
 
@@ -44,9 +45,15 @@ CONTACT_BITS = 30
 """Contact bits 1..30 available to interlocks (bit 0 is every other geom's)."""
 
 
-@functools.lru_cache(maxsize=64)
 def mechanism_layout(spec: PuzzleSpec) -> MechanismLayout:
-    """:func:`models.lock_mechanisms.design_mechanisms`, cached per spec (the design takes about a second)."""
+    """:func:`models.lock_mechanisms.design_mechanisms`, cached per spec wherever its box stands (the design is
+    in the lid frame and takes about a second; a trial under a profile that places boxes places each anew)."""
+    unplaced = spec if spec.box is None else dataclasses.replace(spec, box=dataclasses.replace(spec.box, pose=None))
+    return _layout(unplaced)
+
+
+@functools.lru_cache(maxsize=64)
+def _layout(spec: PuzzleSpec) -> MechanismLayout:
     return design_mechanisms(spec)
 
 

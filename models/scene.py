@@ -19,7 +19,7 @@ from dm_control import mjcf
 from models import reach
 from models.errors import ModelsError
 from models.kinds import get_kind
-from models.puzzle_box import build_puzzle_box, component_prefixes, lid_to_world, yaw_quat
+from models.puzzle_box import LockMode, build_puzzle_box, component_prefixes, lid_to_world, yaw_quat
 from models.spec import PuzzleSpec
 from models.xarm7 import ARM_JOINTS, XArm7Config, build_xarm7, compensate_gravity
 
@@ -59,6 +59,10 @@ class SceneConfig:
     """Add the box's visible lock features as visual-only meshes (geom group 2, no contacts, no mass:
     :func:`models.puzzle_box.build_puzzle_box`). Off by default: the scene is then exactly the one built before
     lock features existed."""
+    locks: LockMode = "contact"
+    """How the box holds its lock rules: ``contact``, mechanisms that block by contact (rules they do not realize
+    left to the latches, which the twin engages), or ``latch``, the rule-driven latches alone (the model built
+    before mechanisms existed: an ablation). :func:`models.puzzle_box.build_puzzle_box`."""
     calibration_board: bool = False
     """Add the ChArUco calibration board as a mocap body, hidden in the table until a rig places it
     (``models.charuco.add_board_body``, ``twin.calibration_rig``)."""
@@ -182,7 +186,9 @@ def build_scene(spec: PuzzleSpec, config: SceneConfig | None = None) -> Scene:
 
     robot = build_xarm7(config.robot)
     world.add("site", name="robot_mount", pos=[0, 0, 0], size=[0.001], group=4).attach(robot)
-    box_model = build_puzzle_box(spec, with_markers=config.with_markers, lock_features=config.lock_features)
+    box_model = build_puzzle_box(
+        spec, with_markers=config.with_markers, lock_features=config.lock_features, locks=config.locks
+    )
     x, y, yaw = box_pose
     world.add("site", name="box_mount", pos=[x, y, height], quat=yaw_quat(yaw), size=[0.001], group=4).attach(box_model)
     if config.calibration_board:

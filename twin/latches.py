@@ -1,4 +1,9 @@
-"""Latches: the spec's lock rules acting physically on the box's joints.
+"""Latches: lock rules acting on the box's joints by rule, where no mechanism enforces them.
+
+With contact locks (the default, :data:`models.scene.SceneConfig.locks`) the box's mechanisms enforce the rules
+they realize by contact (:mod:`models.lock_mechanisms`); the latches hold only the rules no mechanism realizes
+(:func:`latched_rules`, each named in one warning) and jammed parts (:mod:`twin.jams`: a fault, not a rule). With
+``locks="latch"`` (the ablation) they hold every rule, as before mechanisms existed.
 
 Each component has one joint equality constraint (built inactive, see ``models.puzzle_box``). While a
 rule "``locker`` in ``locker_state`` keeps ``locked`` in ``locked_state``" is active — the locker is
@@ -11,10 +16,37 @@ and 0.04 deg under a 50 N push, and that narrowing joint ranges instead is 30-60
 
 from __future__ import annotations
 
+import dataclasses
+import warnings
+
 import mujoco
 import numpy as np
 
 from models import LockTable, PuzzleSpec
+from models.mechanism_mjcf import LockMode, mechanism_layout
+
+
+class UnrealizedLockWarning(UserWarning):
+    """A spec's lock rule that no mechanism realizes is enforced by a rule-driven latch."""
+
+
+def latched_rules(spec: PuzzleSpec, locks: LockMode) -> PuzzleSpec:
+    """``spec`` with only the lock rules the latches must enforce: all of them with ``locks="latch"``; with
+    ``"contact"``, those no mechanism realizes, named in one :class:`UnrealizedLockWarning`."""
+    if locks == "latch" or not spec.locks:
+        return spec
+    unrealized = mechanism_layout(spec).unrealized
+    if unrealized:
+        named = "; ".join(
+            f"{u.rule.locker} in {u.rule.locker_state} keeps {u.rule.locked} in {u.rule.locked_state} ({u.reason})"
+            for u in unrealized
+        )
+        warnings.warn(
+            f"spec {spec.name!r}: {len(unrealized)} lock rule(s) enforced by latches, not mechanisms: {named}",
+            UnrealizedLockWarning,
+            stacklevel=3,
+        )
+    return dataclasses.replace(spec, locks=tuple(u.rule for u in unrealized))
 
 
 class Latches:

@@ -39,7 +39,7 @@ from twin.cell import apply_cell, draw_cell
 from twin.component_states import ComponentStates, HysteresisConfig
 from twin.errors import SimulationDiverged
 from twin.jams import Jams
-from twin.latches import Latches
+from twin.latches import Latches, latched_rules
 from twin.nominal_calibration import camera_calibration
 from twin.physics_draws import apply_physics, draw_physics, subtree_bodies
 from twin.reality import RealityProfile, load_profile
@@ -130,7 +130,8 @@ class TwinSession:
         self.component_qpos = np.array([m.joint(c.joint).qposadr[0] for c in component_names])
         self.travel = np.array([get_kind(c.kind).travel for c in spec.components])
         self.states = ComponentStates(self.travel, self.config.hysteresis)
-        self.latches = Latches(m, spec, [c.latch for c in component_names], self.component_qpos)
+        self.latches = Latches(m, latched_rules(spec, self.config.scene.locks), [c.latch for c in component_names],
+                               self.component_qpos)  # fmt: skip
         camera_names = (names.overview_camera, names.wrist_camera)
         # the next children of the same root: spawn keys follow on from the streams above
         self._camera_streams = dict(zip(camera_names, root.spawn(len(camera_names)), strict=True))
