@@ -17,9 +17,15 @@ tube it touches) does no work on the part it does not block: the locker is not p
 X is searched for (:func:`design_mechanisms`): where the two motions cross at a good angle, the blocking
 fractions are small, the tubes stay inside the box and, as far as they can, under the lid.
 
-An **unpaired** rule (random and multi-locker boxes) forbids leaving b but not entering it: a one-way latch,
-not built yet — it is named as unrealized and the twin enforces it with a rule-driven latch
-(:mod:`twin.latches`), as it does for any rule whose pair no crossing point serves.
+An **unpaired** rule (random and multi-locker boxes) forbids leaving b but not entering it: a **one-way latch**,
+as on a door: on A a sprung pawl whose tooth, while A is at a, stands in the path of a lug on B. In the frame
+``(e1, e2, e3)`` at X — e1 along B's motion from b toward 1-b, e2 across it toward A's motion, e3 = e1 x e2 — the
+lug (at b) lies just behind X along e1 and the tooth just ahead; the tooth's face toward the lug is flat (B leaving
+b meets it square: blocked) and its other face is bevelled (B coming back to b presses it down along -e3, against
+its spring, and passes). A leaving a carries the tooth away across B's path (e2). X is chosen where A's motion is
+across B's (so B's blocked push does no work on A) and where neither part's lug or tooth meets the other's on any
+free move. Rules that no mechanism serves are named as unrealized; the twin enforces them with rule-driven latches
+(:mod:`twin.latches`).
 
 Collisions: every mechanism geom has its own contact bit (``contype = conaffinity = 2**k``, ``k`` in 1..31), so
 a wall touches only the rod of its own interlock, never the robot, the table or another interlock; the tubes
@@ -42,6 +48,7 @@ __all__ = [
     "GAP",
     "TUBE_RADIUS",
     "Interlock",
+    "OneWayLatch",
     "MechanismLayout",
     "UnrealizedRule",
     "design_mechanisms",
@@ -57,13 +64,13 @@ MIN_CROSSING_SINE = 0.5
 own force at the contact, and the tubes would have to be long to clear each other."""
 MAX_BLOCKING = 0.08
 """Largest fraction of its travel a held part may move before its tube meets the other's."""
-SAMPLES = 241
-"""Points along each motion's path over [-1.2, 1.2] of its travel (every 1 % of the travel)."""
-STEP = 0.01
+SAMPLES = 121
+"""Points along each motion's path over [-1.2, 1.2] of its travel (every 2 % of the travel)."""
+STEP = 0.02
 """Resolution of the search for ``delta`` and ``1 - theta`` [fraction of the travel]."""
 GRID_STEP = 0.005
 """Spacing of the candidate crossing points in plan [m]."""
-DEPTHS = (-0.006, -0.012, -0.02, -0.03)
+DEPTHS = (-0.006, -0.012, -0.02, -0.03, -0.045, -0.06)
 """Candidate heights of the crossing point below the lid's top face [m]."""
 BOX_MARGIN = 0.004
 """How far inside the box's side walls and above its floor every tube stays [m]."""
@@ -118,12 +125,71 @@ class Interlock:
     radius: float = TUBE_RADIUS
 
 
+TOOTH_LENGTH = 0.004
+"""Length of a one-way latch's tooth along B's motion (e1) [m]."""
+TOOTH_HALF_WIDTH = 0.002
+"""Half the width of the tooth across B's motion (e2) [m]."""
+TOOTH_DEPTH = 0.002
+"""How far the tooth reaches below the lug's underside (-e3) [m] (its body, on the pawl's guide)."""
+TOOTH_RISE = 0.003
+"""How far the tooth stands into the lug's path (+e3) [m]: the pawl retracts this much (plus play) to let it by."""
+LUG_LENGTH = 0.004
+"""Length of the lug along B's motion (e1) [m]."""
+LUG_HALF_WIDTH = 0.0025
+"""Half the width of the lug across B's motion (e2) [m]."""
+LUG_HEIGHT = 0.004
+"""Height of the lug above its underside (e3) [m]."""
+LATCH_GAP = 0.001
+"""Gap between the lug and the tooth's flat face with A at a and B at b [m]."""
+LATCH_CLEARANCE = 0.0007
+"""Smallest gap between tooth and lug on every free move [m]."""
+MAX_WORK_COSINE = 0.15
+"""Largest cosine of A's motion with B's at X for a one-way latch: a blocked push of B (along e1) does work on A
+in proportion, and A, resting at a by its friction alone, must not be pushed off."""
+
+
+@dataclass(frozen=True)
+class OneWayLatch:
+    """A one-way latch realizing an unpaired rule "A in a keeps B in b" (module docstring).
+
+    Attributes:
+        name: ``"<A>-latches-<B>"``.
+        locker, locked, locker_state, locked_state: A, B, a, b.
+        rule: the rule.
+        crossing: X, lid frame [m], with A at a and B at b.
+        frame: ``(3, 3)`` columns e1, e2, e3 in the lid frame, with A at a and B at b.
+        crossing_cosine: cosine of the angle between A's and B's motions at X.
+    """
+
+    name: str
+    locker: str
+    locked: str
+    locker_state: int
+    locked_state: int
+    rule: LockRule
+    crossing: np.ndarray = field(repr=False, compare=False)
+    frame: np.ndarray = field(repr=False, compare=False)
+    crossing_cosine: float
+
+    def tooth_profile(self) -> np.ndarray:
+        """``(5, 2)`` the tooth's outline in the (e1, e3) plane [m], counter-clockwise: flat face at e1 = 0 toward
+        the lug, bevel at 45 degrees down to the far end, extruded ±:data:`TOOTH_HALF_WIDTH` along e2."""
+        lt, rise, depth = TOOTH_LENGTH, TOOTH_RISE, TOOTH_DEPTH
+        return np.array([(0.0, -depth), (lt, -depth), (lt, 0.0), (lt - rise, rise), (0.0, rise)])
+
+    def lug_box(self) -> tuple[np.ndarray, np.ndarray]:
+        """The lug with B at b: centre in the (e1, e2, e3) frame at X and half sizes [m]."""
+        centre = np.array([-LATCH_GAP - LUG_LENGTH / 2, 0.0, LUG_HEIGHT / 2])
+        return centre, np.array([LUG_LENGTH / 2, LUG_HALF_WIDTH, LUG_HEIGHT / 2])
+
+
 @dataclass(frozen=True)
 class MechanismLayout:
-    """A spec's mechanisms: every rule is in exactly one interlock or in ``unrealized``."""
+    """A spec's mechanisms: every rule is in exactly one interlock or latch, or in ``unrealized``."""
 
     interlocks: tuple[Interlock, ...]
     unrealized: tuple[UnrealizedRule, ...]
+    latches: tuple[OneWayLatch, ...] = ()
 
     @property
     def complete(self) -> bool:
@@ -168,11 +234,137 @@ def design_mechanisms(spec: PuzzleSpec) -> MechanismLayout:
             unrealized += [UnrealizedRule(r, designed) for r in (first, second)]
         else:
             interlocks.append(designed)
+    latches: list[OneWayLatch] = []
     for rule in unpaired:
-        unrealized.append(UnrealizedRule(rule, "an unpaired rule needs a one-way latch, which no mechanism builds yet"))
+        try:
+            a, b = (_motion(by_name[rule.locker]), _motion(by_name[rule.locked]))
+        except UnknownKindError as error:
+            unrealized.append(UnrealizedRule(rule, f"unknown kind: {error}"))
+            continue
+        latch = _design_latch(spec, rule, a, b, by_name)
+        if isinstance(latch, str):
+            unrealized.append(UnrealizedRule(rule, latch))
+        else:
+            latches.append(latch)
     order = {rule: k for k, rule in enumerate(spec.locks)}
     unrealized.sort(key=lambda u: order[u.rule])
-    return MechanismLayout(tuple(interlocks), tuple(unrealized))
+    return MechanismLayout(tuple(interlocks), tuple(unrealized), tuple(latches))
+
+
+def _design_latch(spec, rule: LockRule, a: JointMotion, b: JointMotion, by_name) -> OneWayLatch | str:
+    """The best one-way latch for an unpaired rule, or why there is none."""
+    dir_a = 1.0 if rule.locker_state == 0 else -1.0
+    dir_b = 1.0 if rule.locked_state == 0 else -1.0
+    lo, hi, grid = _candidate_grid(spec, by_name[rule.locker], by_name[rule.locked])
+    # the parts at a and b: X in the lid frame with every part closed is where the design state puts it
+    va = _velocities(a, grid) * (dir_a * a.travel)
+    vb = _velocities(b, grid) * (dir_b * b.travel)
+    na, nb = np.linalg.norm(va, axis=1), np.linalg.norm(vb, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cosine = np.einsum("ij,ij->i", va, vb) / (na * nb)
+    keep = (na > 1e-6) & (nb > 1e-6) & (np.abs(cosine) <= MAX_WORK_COSINE)
+    if not np.any(keep):
+        return "no point under the lid where the locker's motion is across the locked part's"
+    margin = LUG_HEIGHT + LUG_LENGTH  # the tooth and the lug lie within this of X
+    for t in np.linspace(0.0, 1.0, 11):
+        for motion, direction in ((a, dir_a), (b, dir_b)):
+            moved = motion.move(grid, direction * motion.travel * t)
+            keep &= np.all((moved >= lo + margin) & (moved <= hi - margin), axis=1) & (moved[:, 2] < -margin)
+    if not np.any(keep):
+        return "no point where the locker's motion is across the locked part's keeps a latch under the lid"
+    # prefer long paths (a small blocking fraction for B, a tooth that leaves fast), then nearness
+    score = LATCH_GAP / nb + 0.01 / na + _distance_cost(grid, by_name, rule)
+    order = np.argsort(np.where(keep, score, np.inf))[: int(keep.sum())]
+    reasons: dict[str, int] = {}
+    q_a, q_b = a.q(rule.locker_state), b.q(rule.locked_state)
+    for k in order[: MAX_TRIED * 5]:
+        x0 = grid[k]  # with every part closed; move it to the design state (A at a, B at b): X is fixed in space,
+        # and the grid is a grid of space points, so X = x0 whatever the parts' states
+        e1 = vb[k] / nb[k]
+        e2 = va[k] - (va[k] @ e1) * e1
+        e2 /= np.linalg.norm(e2)
+        frame = np.column_stack([e1, e2, np.cross(e1, e2)])
+        why = _latch_clear(x0, frame, a, b, dir_a, dir_b, lo, hi)
+        if why is not None:
+            reasons[why] = reasons.get(why, 0) + 1
+            continue
+        return OneWayLatch(
+            name=f"{rule.locker}-latches-{rule.locked}",
+            locker=rule.locker,
+            locked=rule.locked,
+            locker_state=rule.locker_state,
+            locked_state=rule.locked_state,
+            rule=rule,
+            crossing=x0,
+            frame=frame,
+            crossing_cosine=float(cosine[k]),
+        )
+    del q_a, q_b
+    common = max(reasons, key=reasons.__getitem__) if reasons else "no candidate"
+    return f"no point serves a one-way latch (mostly: {common})"
+
+
+def _latch_clear(x, frame, a, b, dir_a, dir_b, lo, hi) -> str | None:
+    """Why a one-way latch at ``x`` with ``frame`` would meet itself on a free move or leave the box, or None.
+
+    The tooth and the lug are boxes in the (e1, e2, e3) frame, carried by their parts' motions; a rotation of a
+    part is allowed for by widening its box by the turn times its largest half size."""
+    tooth_centre = np.array([TOOTH_LENGTH / 2, 0.0, (TOOTH_RISE - TOOTH_DEPTH) / 2])
+    tooth_half = np.array([TOOTH_LENGTH / 2, TOOTH_HALF_WIDTH, (TOOTH_RISE + TOOTH_DEPTH) / 2])
+    lug_centre = np.array([-LATCH_GAP - LUG_LENGTH / 2, 0.0, LUG_HEIGHT / 2])
+    lug_half = np.array([LUG_LENGTH / 2, LUG_HALF_WIDTH, LUG_HEIGHT / 2])
+    tooth_world = x + frame @ tooth_centre
+    lug_world = x + frame @ lug_centre
+    ts = np.linspace(0.0, 1.0, 51)
+    tooth_path = a.move(tooth_world, dir_a * a.travel * ts)  # A from a to 1-a
+    lug_path = b.move(lug_world, dir_b * b.travel * ts)  # B from b to 1-b
+    turn_a = ts * a.travel if a.joint == "hinge" else 0 * ts
+    turn_b = ts * b.travel if b.joint == "hinge" else 0 * ts
+    every = np.vstack([tooth_path, lug_path])
+    reach = max(np.linalg.norm(tooth_half), np.linalg.norm(lug_half))
+    if np.any(every < lo + reach) or np.any(every > hi - reach) or np.any(every[:, 2] > -reach):
+        return "it leaves the box or rises through the lid"
+
+    def overlap(tooth_i, lug_i) -> bool:
+        d = (lug_path[lug_i] - tooth_path[tooth_i]) @ frame
+        grow = turn_a[tooth_i] * tooth_half.max() + turn_b[lug_i] * lug_half.max()
+        return bool(np.all(np.abs(d) < tooth_half + lug_half + grow + LATCH_CLEARANCE))
+
+    if any(overlap(i, 0) for i in range(1, len(ts))):
+        return "the tooth meets the lug as the locker leaves"
+    if any(overlap(len(ts) - 1, j) for j in range(len(ts))):
+        return "the lug meets the tooth with the locker away"
+    if any(overlap(i, len(ts) - 1) for i in range(len(ts))):
+        return "the tooth meets the lug with the locked part away"
+    return None
+
+
+def _near(grid: np.ndarray, by_name, rule: LockRule, reach: float = 0.02) -> np.ndarray:
+    """Which points of ``grid`` lie, in plan, within ``reach`` [m] of the bounding box of both parts' footprints."""
+    feet = [get_kind(by_name[n].kind).footprint_in_lid(tuple(by_name[n].pose)) for n in (rule.locker, rule.locked)]
+    both = np.vstack(feet)
+    lo, hi = both.min(axis=0) - reach, both.max(axis=0) + reach
+    return np.all((grid[:, :2] >= lo) & (grid[:, :2] <= hi), axis=1)
+
+
+def _distance_cost(grid: np.ndarray, by_name, rule: LockRule) -> np.ndarray:
+    """What a crossing point's distance from the two parts costs, in fractions of travel: 1 per 10 cm from the
+    midpoint of their frames (short tubes, and mechanisms that stay out of other pairs' way)."""
+    mid = (np.asarray(by_name[rule.locker].pose[:2]) + np.asarray(by_name[rule.locked].pose[:2])) / 2
+    return np.linalg.norm(grid[:, :2] - mid, axis=1) / 0.1
+
+
+def _candidate_grid(spec, ca, cb) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The box's inner bounds ``lo``, ``hi`` and candidate crossing points ``(n, 3)`` under the whole lid (the
+    components ``ca``, ``cb`` only for the signature's sake: where their parts move decides, not where they lie)."""
+    length, width, height = spec.box.size
+    lo = np.array([-length / 2 + BOX_MARGIN, -width / 2 + BOX_MARGIN, -height + BOX_MARGIN])
+    hi = np.array([length / 2 - BOX_MARGIN, width / 2 - BOX_MARGIN, np.inf])
+    # anywhere under the lid: a lever's pivot stands 33 mm above it, and its motion crosses a slide's only far out
+    xs = np.arange(lo[0], hi[0] + 1e-9, GRID_STEP)
+    ys = np.arange(lo[1], hi[1] + 1e-9, GRID_STEP)
+    grid = np.stack(np.meshgrid(xs, ys, np.array(DEPTHS), indexing="ij"), axis=-1).reshape(-1, 3)
+    return lo, hi, grid
 
 
 def _motion(component) -> JointMotion:
@@ -229,24 +421,16 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
     """The best interlock for a pair of rules, or why there is none."""
     dir_a = 1.0 if first.locker_state == 0 else -1.0  # A goes from a toward 1-a
     dir_b = 1.0 if first.locked_state == 0 else -1.0  # B goes from b toward 1-b
-    length, width, height = spec.box.size
-    lo = np.array([-length / 2 + BOX_MARGIN, -width / 2 + BOX_MARGIN, -height + BOX_MARGIN])
-    hi = np.array([length / 2 - BOX_MARGIN, width / 2 - BOX_MARGIN, np.inf])
-    ca, cb = by_name[first.locker], by_name[first.locked]
-    fa = get_kind(ca.kind).footprint_in_lid(tuple(ca.pose))
-    fb = get_kind(cb.kind).footprint_in_lid(tuple(cb.pose))
-    both = np.vstack([fa, fb])
-    xmin, ymin = np.maximum(both.min(axis=0) - 0.02, lo[:2])
-    xmax, ymax = np.minimum(both.max(axis=0) + 0.02, hi[:2])
-    xs = np.arange(xmin, xmax + 1e-9, GRID_STEP)
-    ys = np.arange(ymin, ymax + 1e-9, GRID_STEP)
-    grid = np.stack(np.meshgrid(xs, ys, np.array(DEPTHS), indexing="ij"), axis=-1).reshape(-1, 3)
+    lo, hi, grid = _candidate_grid(spec, by_name[first.locker], by_name[first.locked])
     va = _velocities(a, grid) * (dir_a * a.travel)  # per unit fraction of travel
     vb = _velocities(b, grid) * (dir_b * b.travel)
     na, nb = np.linalg.norm(va, axis=1), np.linalg.norm(vb, axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
         sine = np.linalg.norm(np.cross(va, vb), axis=1) / (na * nb)
     keep = (na > 1e-6) & (nb > 1e-6) & (sine >= MIN_CROSSING_SINE)
+    # the clearance across the motions alone asks at least this much of each part's travel: hopeless beyond
+    with np.errstate(divide="ignore", invalid="ignore"):
+        keep &= (2 * TUBE_RADIUS + GAP) / (sine * np.minimum(na, nb)) <= MAX_BLOCKING * 1.25
     # every tube lies on X's paths through A and B over a whole travel each way: inside the box?
     top = np.full(len(grid), -np.inf)
     for t in np.linspace(-1.0, 1.0, 21):
@@ -258,6 +442,8 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
         return "no point inside the box where the two parts' motions cross at 30 degrees or more"
     # first guess of the blocking fractions from the local geometry (clearance across the motion)
     guess = (2 * TUBE_RADIUS + GAP) / sine * (1 / na + 1 / nb)
+    # near the two parts first (within 2 cm of their footprints), ordered by the guess; then the rest of the lid
+    guess = guess + np.where(_near(grid, by_name, first), 0.0, 100.0)
     exposure = np.where(top + TUBE_RADIUS > 0, 0.5 + 200.0 * (top + TUBE_RADIUS), 0.0)
     candidates = [(float(g), -float(si), *map(float, p[[2, 0, 1]])) for g, si, p in
                   zip((guess + exposure)[keep], sine[keep], grid[keep], strict=True)]  # fmt: skip
@@ -265,7 +451,7 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
     best = None
     reasons: dict[str, int] = {}
     for k, (_, neg_sine, z, x, y) in enumerate(candidates):
-        if k >= MAX_TRIED and (best is not None or k >= 50 * MAX_TRIED):
+        if k >= MAX_TRIED and (best is not None or k >= 40 * MAX_TRIED):
             break
         point = np.array([x, y, z])
         paths = _paths(point, a, b, dir_a, dir_b)

@@ -1,5 +1,7 @@
 """The lock mechanisms of a spec (:mod:`models.lock_mechanisms`) as MJCF geoms on the components' moving bodies.
 
+Each one-way latch is a sprung pawl body ``<A>:latch:<B>:pawl`` (slide joint ``...:spring`` along its e3, a convex
+mesh tooth ``...:tooth``) on the locker's moving body and a box lug ``<A>:latch:<B>:lug`` on the locked part's.
 Each interlock's wall is a chain of capsules in the locker's moving body, its rod a chain in the locked part's,
 named ``<A>:interlock:<B>:wall:<k>`` and ``<A>:interlock:<B>:rod:<k>`` (MJCF component names). They collide
 with each other only: both have the contact bit of their interlock alone (``contype = conaffinity = 2**k``,
@@ -14,12 +16,20 @@ import dataclasses
 import functools
 from typing import TYPE_CHECKING, Literal
 
+import mujoco
 import numpy as np
 
 from models.joint_motion import JointMotion
 from models.kinds.parts import PART_DENSITY
 from models.kinds.registry import get_kind
-from models.lock_mechanisms import Interlock, MechanismLayout, design_mechanisms
+from models.lock_mechanisms import (
+    TOOTH_HALF_WIDTH,
+    TOOTH_RISE,
+    Interlock,
+    MechanismLayout,
+    OneWayLatch,
+    design_mechanisms,
+)
 from models.spec import PuzzleSpec
 
 if TYPE_CHECKING:
@@ -41,6 +51,20 @@ MECHANISM_SOLREF = (0.004, 1.0)
 """Time constant [s] (twice the 2 ms timestep, MuJoCo's stiffest stable value) and damping ratio."""
 MECHANISM_FRICTION = (0.1, 0.005, 0.0001)
 """Greased steel on steel: little sliding friction, so a blocked push does not drag the part it meets."""
+PAWL_STIFFNESS = 100.0
+"""Spring of a one-way latch's pawl [N/m]."""
+PAWL_PRELOAD = 0.01
+"""Where the pawl's spring would rest, past its stop [m]: it presses the pawl on its stop with 1 N, and a lug
+pressing its bevel down meets at most 1.3 N (nothing beside the 25 N a robot's push gives)."""
+PAWL_PLAY = 0.0005
+"""How far the pawl may retract past the tooth's rise [m]."""
+PAWL_DAMPING = 0.05
+"""Damping of the pawl's slide [N·s/m]: it springs back in a few milliseconds, without ringing."""
+PAWL_ARMATURE = 0.02
+"""Reflected mass of the pawl's slide [kg] (its spring's and guide's): a bare 0.6 g tooth pressed by 1 N sank 8 mm
+into its stop's soft limit; with it, < 0.5 mm."""
+STEEL_DENSITY = 7800
+"""Density of the pawl's tooth [kg/m³]."""
 CONTACT_BITS = 30
 """Contact bits 1..30 available to interlocks (bit 0 is every other geom's)."""
 
@@ -74,7 +98,53 @@ def add_mechanisms(
             component = by_name[owner]
             motion = JointMotion.of(get_kind(component.kind), tuple(component.pose))
             _add_chain(bodies[owner], f"{base}:{role}", motion.to_body(polyline, 0.0), interlock, bit)
+    for k, latch in enumerate(layout.latches, start=len(layout.interlocks)):
+        bit = 1 << (1 + k % CONTACT_BITS)
+        _add_latch(root, latch, bodies, prefixes, by_name, bit)
     return layout
+
+
+def _quat(rotation: np.ndarray) -> list[float]:
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(rotation).ravel())
+    return quat.tolist()
+
+
+def _add_latch(root, latch: OneWayLatch, bodies, prefixes, by_name, bit: int) -> None:
+    """A one-way latch: the sprung pawl (a body on the locker's moving body, sliding along e3 with its tooth) and
+    the lug (a box on the locked part's moving body), both posed from the design state (A at a, B at b)."""
+    base = f"{prefixes[latch.locker]}:latch:{prefixes[latch.locked]}"
+    locker, locked = by_name[latch.locker], by_name[latch.locked]
+    a = JointMotion.of(get_kind(locker.kind), tuple(locker.pose))
+    b = JointMotion.of(get_kind(locked.kind), tuple(locked.pose))
+    q_a, q_b = a.q(latch.locker_state), b.q(latch.locked_state)
+    contact = {
+        "contype": bit, "conaffinity": bit, "group": MECHANISM_GROUP, "rgba": list(MECHANISM_RGBA),
+        "friction": list(MECHANISM_FRICTION), "solref": list(MECHANISM_SOLREF), "solimp": list(MECHANISM_SOLIMP),
+    }  # fmt: skip
+    # the pawl: its frame is (e1, e2, e3) at X, written in the locker's moving body frame
+    rotation_a = np.column_stack([a.direction_to_body(latch.frame[:, i], q_a) for i in range(3)])
+    pawl = bodies[latch.locker].add(
+        "body", name=f"{base}:pawl", pos=a.to_body(latch.crossing[None], q_a)[0].tolist(), quat=_quat(rotation_a)
+    )
+    pawl.add(
+        "joint", name=f"{base}:spring", type="slide", axis=[0, 0, 1], range=[-(TOOTH_RISE + PAWL_PLAY), 0.0],
+        limited=True, stiffness=PAWL_STIFFNESS, springref=PAWL_PRELOAD, damping=PAWL_DAMPING, armature=PAWL_ARMATURE,
+        solreflimit=list(MECHANISM_SOLREF), solimplimit=list(MECHANISM_SOLIMP),
+    )  # fmt: skip
+    profile = latch.tooth_profile()
+    w = TOOTH_HALF_WIDTH
+    vertices = [(u, side * w, v) for side in (-1.0, 1.0) for u, v in profile]
+    mesh = root.asset.add("mesh", name=f"{base}:tooth", vertex=np.asarray(vertices).ravel().tolist())
+    pawl.add("geom", name=f"{base}:tooth", type="mesh", mesh=mesh, density=STEEL_DENSITY, **contact)
+    # the lug, on the locked part
+    centre, half = latch.lug_box()
+    rotation_b = np.column_stack([b.direction_to_body(latch.frame[:, i], q_b) for i in range(3)])
+    lug_world = latch.crossing + latch.frame @ centre
+    bodies[latch.locked].add(
+        "geom", name=f"{base}:lug", type="box", size=half.tolist(), pos=b.to_body(lug_world[None], q_b)[0].tolist(),
+        quat=_quat(rotation_b), density=PART_DENSITY, **contact,
+    )  # fmt: skip
 
 
 def _add_chain(body: mjcf.Element, name: str, points: np.ndarray, interlock: Interlock, bit: int) -> None:

@@ -49,10 +49,12 @@ def trial_task(
     misreport_kind: bool = False,
     max_lockers: int = 1,
     record: str | None = None,
+    locks: str = "contact",
 ) -> Task:
     """The task of one run (``reality`` and ``calibration`` as their ``to_dict()``; twin only;
     ``misreport_kind``: one component's kind told wrong, drawn from the seed; ``max_lockers``: the most
-    lockers the memory and dual agents' belief allows a component, symbolic only)."""
+    lockers the memory and dual agents' belief allows a component, symbolic only; ``locks``: the twin box's locks,
+    ``contact`` mechanisms or ``latch``)."""
     settings = {
         "sim": sim, "spec": spec.to_dict(), "seed": seed, "agent": agent, "max_actions": max_actions,
         "memory": str(Path(memory).resolve()) if memory else None,
@@ -65,6 +67,8 @@ def trial_task(
         settings["misreport_kind"] = True
     if max_lockers != 1:  # likewise: a k = 1 task is the task it was before k existed
         settings["max_lockers"] = max_lockers
+    if sim == "twin" and locks != "latch":  # a latch task is the task it was before mechanisms existed
+        settings["locks"] = locks
     context = {k: v for k, v in (("video", video), ("record", record)) if v}  # outputs: not part of the record
     return Task(key, run_trial, settings, context=context or None)
 
@@ -103,7 +107,8 @@ def _run(spec: PuzzleSpec, settings: Mapping[str, Any], video: str | None, recor
                               settings["checkpoint"], reality, calibration, on_action=_on_action,
                               misreport_kind=settings.get("misreport_kind", False),
                               max_lockers=settings.get("max_lockers", 1),
-                              record=Path(record) if record else None)  # fmt: skip
+                              record=Path(record) if record else None,
+                              locks=settings.get("locks", "latch"))  # fmt: skip
     agent = make_agent(
         settings["agent"], spec, memory, settings["checkpoint"], max_lockers=settings.get("max_lockers", 1)
     )

@@ -21,6 +21,7 @@ from learning.memory import MemoryStore
 from models import PuzzleSpec
 from models.calibration import CellCalibration
 from models.kinds import PUZZLE_KINDS
+from models.scene import SceneConfig
 from skills import MarkerDetector, SkillError
 from skills.twin_world import TwinWorld
 from twin.errors import SimulationDiverged
@@ -28,7 +29,7 @@ from twin.nominal_calibration import nominal_calibration
 from twin.reality import RealityProfile
 from twin.rerun_log import TrialRecording
 from twin.rollout_video import BackgroundRollout, Caption, RolloutFrame, SceneCameras
-from twin.session import TwinSession
+from twin.session import TwinConfig, TwinSession
 
 
 class RolloutRecorder:
@@ -335,6 +336,7 @@ def run_twin_trial(
     misreport_kind: bool = False,
     max_lockers: int = 1,
     record: Path | None = None,
+    locks: str = "contact",
 ) -> dict[str, Any]:
     """One end-to-end trial; returns the contract's run entry plus a ``timeline`` and figures.
 
@@ -342,10 +344,12 @@ def run_twin_trial(
     calibration (default: the twin's nominal, datasheet calibration — exact only under ``ideal``);
     ``misreport_kind``: the pipeline is told one component's kind wrong (:func:`wrong_kind`; in the entry as
     ``told_kinds``); ``max_lockers``: the most lockers the agent's belief allows one component (1: the paper's);
-    ``record``: a Rerun recording of the trial written there (:mod:`twin.rerun_log`)."""
+    ``record``: a Rerun recording of the trial written there (:mod:`twin.rerun_log`); ``locks``: the box's locks,
+    ``contact`` mechanisms or ``latch`` (:attr:`models.scene.SceneConfig.locks`)."""
     wall = time.perf_counter()
     by_marker = {c.marker: i for i, c in enumerate(spec.components)}
-    with TwinSession(spec, seed=seed, reality=reality) as session:
+    config = TwinConfig(scene=SceneConfig(locks=locks))
+    with TwinSession(spec, seed=seed, reality=reality, config=config) as session:
         spec = session.spec  # placed by the profile, if it places boxes
         told_kinds = wrong_kind(spec, seed) if misreport_kind else {}
         robot = session.robot

@@ -216,6 +216,7 @@ def _tasks(args, specs, reality, calibration, out: Path) -> list:
                 reality=reality.to_dict() if reality is not None else None,
                 calibration=calibration.to_dict() if calibration is not None else None, video=video,
                 misreport_kind=args.wrong_kind, max_lockers=args.max_lockers, record=record,
+                locks=args.locks,
             ))  # fmt: skip
     return tasks
 
@@ -273,6 +274,11 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
     parser.add_argument(
         "--reality", default="ideal", help="twin reality profile: ideal, realistic, harsh or a JSON file"
     )
+    parser.add_argument(
+        "--locks", choices=("contact", "latch"), default="contact",
+        help="twin: the box's lock rules as mechanisms that block by contact (default) or as rule-driven latches "
+        "(the ablation; jams are latches in both)",
+    )  # fmt: skip
     parser.add_argument(
         "--calibration", default=None, help="camera calibration from scripts/calibrate.py (twin; needed for xarm)"
     )
@@ -368,6 +374,8 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
     experiment = {"command": "trial", **{k: v for k, v in vars(args).items() if k not in not_results}}
     if args.max_lockers == 1:  # the default leaves the configuration as it was before k existed (resumable)
         del experiment["max_lockers"]
+    if args.locks == "latch" or args.sim != "twin":  # latches: the configuration made before mechanisms existed
+        del experiment["locks"]
     # symbolic runs last less than a hand-over; a pool is started for no more twin runs than there are
     workers = args.workers or (min(os.cpu_count() or 1, len(specs) * args.runs) if args.sim == "twin" else 1)
     try:

@@ -220,3 +220,55 @@ def test_a_disassembly_scene_is_refused_in_one_line(tmp_path, scene_dict):
     result = generate("mesh", tmp_path / "scene.json", "--out", tmp_path / "out")
     assert_one_line_failure(result, "disassembly scene", "no box")
     assert not (tmp_path / "out").exists()
+
+
+# -- generate.py mjcf --box-only and check-locks: the box alone holds its lock rules by contact ----------------
+
+
+@pytest.fixture(scope="module")
+def paper_box(tmp_path_factory):
+    """A paper test box's spec file (five components, every rule realized by a mechanism)."""
+    out = tmp_path_factory.mktemp("paper")
+    assert generate("paper", "--split", "test", "--out", out).returncode == 0
+    return out / "paper-test-0.json"
+
+
+def test_mjcf_box_only_writes_a_box_without_robot_that_plain_mujoco_steps_without_warning(tmp_path, paper_box):
+    import mujoco
+
+    result = generate("mjcf", paper_box, "--box-only", "--out", tmp_path / "box")
+    assert result.returncode == 0, result.stderr
+    assert "box.xml" in result.stdout and "latches only" not in result.stdout  # every rule has its mechanism
+    assert not (tmp_path / "box" / "scene.xml").exists()
+    model = mujoco.MjModel.from_xml_path(str(tmp_path / "box" / "box.xml"))
+    assert model.nu == 0 and model.nlight >= 1  # no robot; a light to render by
+    assert model.neq == 5 and model.opt.timestep == 0.002  # the five latches, inactive; the scene's step
+    door = model.joint("door-0:joint")
+    assert 1.0 < model.jnt_range[door.id][1] < 1.6, "hinge ranges read as radians, not degrees"
+    data = mujoco.MjData(model)
+    mujoco.mj_step(model, data, nstep=100)
+    assert all(data.warning[i].number == 0 for i in range(len(data.warning)))
+
+
+def test_check_locks_finds_every_transition_of_a_paper_box_agrees(tmp_path, paper_box):
+    result = generate("check-locks", paper_box, "--json", tmp_path / "check.json")
+    assert result.returncode == 0, result.stderr
+    assert "paper-test-0: 30/30 transitions agree" in result.stdout and "0 rule(s) without a mechanism" in result.stdout
+    assert result.stdout.strip().splitlines()[-1].startswith("total (1 box(es)): 30/30")
+    record = json.loads((tmp_path / "check.json").read_text())
+    (box,) = record["boxes"]
+    assert (box["agreeing"], box["total"], box["disagreements"], box["unrealized"]) == (30, 30, [], [])
+    assert box["held_move_max"] < 0.5
+
+
+def test_check_locks_without_mechanisms_finds_held_parts_moving_and_exits_1(paper_box):
+    result = generate("check-locks", paper_box, "--locks", "latch")
+    assert result.returncode == 1, result.stderr
+    assert "paper-test-0: 10/30 transitions agree" in result.stdout, result.stdout
+    assert "  open [none]: slide-1 should be held, moved" in result.stdout  # nothing holds the slide under a door
+
+
+def test_check_locks_names_an_invalid_spec_in_one_line_and_exits_2(tmp_path, paper_box):
+    (tmp_path / "bad.json").write_text('{"name": 1}')
+    result = generate("check-locks", paper_box, tmp_path / "bad.json")
+    assert_one_line_failure(result, "bad.json", "invalid puzzle spec")
