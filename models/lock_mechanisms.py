@@ -55,9 +55,9 @@ __all__ = [
     "paired_rules",
 ]
 
-TUBE_RADIUS = 0.00125
+TUBE_RADIUS = 0.001
 """Radius of a wall's and a rod's capsules [m]."""
-GAP = 0.001
+GAP = 0.0005
 """Clearance between a wall and a rod wherever they must pass each other [m]."""
 MIN_CROSSING_SINE = 0.5
 """Smallest sine of the angle between the two motions at X (30 deg): below it a blocked push would need twice its
