@@ -68,7 +68,7 @@ SAMPLES = 121
 """Points along each motion's path over [-1.2, 1.2] of its travel (every 2 % of the travel)."""
 STEP = 0.02
 """Resolution of the search for ``delta`` and ``1 - theta`` [fraction of the travel]."""
-GRID_STEP = 0.005
+GRID_STEP = 0.008
 """Spacing of the candidate crossing points in plan [m]."""
 DEPTHS = (-0.006, -0.012, -0.02, -0.03, -0.045, -0.06)
 """Candidate heights of the crossing point below the lid's top face [m]."""
@@ -266,14 +266,17 @@ def _design_latch(spec, rule: LockRule, a: JointMotion, b: JointMotion, by_name)
     if not np.any(keep):
         return "no point under the lid where the locker's motion is across the locked part's"
     margin = LUG_HEIGHT + LUG_LENGTH  # the tooth and the lug lie within this of X
+    keep &= grid[:, 2] < -margin  # where they meet, under the lid; a door's tooth may rise through a slot as it opens
+    top = np.full(len(grid), -np.inf)
     for t in np.linspace(0.0, 1.0, 11):
         for motion, direction in ((a, dir_a), (b, dir_b)):
             moved = motion.move(grid, direction * motion.travel * t)
-            keep &= np.all((moved >= lo + margin) & (moved <= hi - margin), axis=1) & (moved[:, 2] < -margin)
+            keep &= np.all((moved >= lo + margin) & (moved <= hi - margin), axis=1)
+            top = np.maximum(top, moved[:, 2] + margin)
     if not np.any(keep):
-        return "no point where the locker's motion is across the locked part's keeps a latch under the lid"
-    # prefer long paths (a small blocking fraction for B, a tooth that leaves fast), then nearness
-    score = LATCH_GAP / nb + 0.01 / na + _distance_cost(grid, by_name, rule)
+        return "no point where the locker's motion is across the locked part's keeps a latch inside the box"
+    # prefer long paths (a small blocking fraction for B, a tooth that leaves fast), then nearness, then hidden
+    score = LATCH_GAP / nb + 0.01 / na + _distance_cost(grid, by_name, rule) + np.where(top > 0, 0.5 + 200 * top, 0)
     order = np.argsort(np.where(keep, score, np.inf))[: int(keep.sum())]
     reasons: dict[str, int] = {}
     q_a, q_b = a.q(rule.locker_state), b.q(rule.locked_state)
@@ -322,8 +325,8 @@ def _latch_clear(x, frame, a, b, dir_a, dir_b, lo, hi) -> str | None:
     turn_b = ts * b.travel if b.joint == "hinge" else 0 * ts
     every = np.vstack([tooth_path, lug_path])
     reach = max(np.linalg.norm(tooth_half), np.linalg.norm(lug_half))
-    if np.any(every < lo + reach) or np.any(every > hi - reach) or np.any(every[:, 2] > -reach):
-        return "it leaves the box or rises through the lid"
+    if np.any(every < lo + reach) or np.any(every > hi - reach):
+        return "it leaves the box"
 
     def overlap(tooth_i, lug_i) -> bool:
         d = (lug_path[lug_i] - tooth_path[tooth_i]) @ frame
@@ -433,7 +436,7 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
         keep &= (2 * TUBE_RADIUS + GAP) / (sine * np.minimum(na, nb)) <= MAX_BLOCKING * 1.25
     # every tube lies on X's paths through A and B over a whole travel each way: inside the box?
     top = np.full(len(grid), -np.inf)
-    for t in np.linspace(-1.0, 1.0, 21):
+    for t in np.linspace(-1.0, 1.0, 9):
         for motion in (a, b):
             moved = motion.move(grid, motion.travel * t)
             keep &= np.all((moved >= lo + TUBE_RADIUS) & (moved <= hi - TUBE_RADIUS), axis=1)
@@ -445,15 +448,14 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
     # near the two parts first (within 2 cm of their footprints), ordered by the guess; then the rest of the lid
     guess = guess + np.where(_near(grid, by_name, first), 0.0, 100.0)
     exposure = np.where(top + TUBE_RADIUS > 0, 0.5 + 200.0 * (top + TUBE_RADIUS), 0.0)
-    candidates = [(float(g), -float(si), *map(float, p[[2, 0, 1]])) for g, si, p in
-                  zip((guess + exposure)[keep], sine[keep], grid[keep], strict=True)]  # fmt: skip
-    candidates.sort()
+    cost = np.where(keep, guess + exposure, np.inf)
+    order = np.argsort(cost, kind="stable")[: int(keep.sum())]
     best = None
     reasons: dict[str, int] = {}
-    for k, (_, neg_sine, z, x, y) in enumerate(candidates):
+    for k, index in enumerate(order):
         if k >= MAX_TRIED and (best is not None or k >= 40 * MAX_TRIED):
             break
-        point = np.array([x, y, z])
+        point = grid[index]
         paths = _paths(point, a, b, dir_a, dir_b)
         fractions = _fractions(paths)
         if fractions is None:
@@ -469,7 +471,7 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
         exposed = float(np.vstack(corners)[:, 2].max() + TUBE_RADIUS)
         score = (1 - theta) + delta + _exposure_cost(exposed)
         if best is None or score < best[0]:
-            best = (score, point, theta, delta, wall0, rod0, -neg_sine, exposed)
+            best = (score, point, theta, delta, wall0, rod0, float(sine[index]), exposed)
     if best is None:
         common = max(reasons, key=reasons.__getitem__) if reasons else "no candidate"
         return f"no crossing point serves the pair (mostly: {common})"

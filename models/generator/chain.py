@@ -37,12 +37,25 @@ class BoxConfig:
     nearest pose that does (:func:`models.reach.fitting_box_pose`); a layout no pose fits is drawn again,
     and more than :data:`MAX_REACHABLE_COMPONENTS` components are refused. False: keep :attr:`pose`
     whatever it leaves out of reach (a box for the symbolic simulator only)."""
+    realizable: bool = True
+    """Draw again until every lock rule is a mechanism that blocks by contact (:mod:`models.lock_mechanisms`), so
+    that the model alone behaves as the spec says; False keeps the first layout drawn (a rule no mechanism serves
+    is then held by a latch in the twin)."""
 
 
 MAX_REACHABLE_COMPONENTS = 28
 """Most components a generated box holds with every handle within the robot's reach: the fraction of
 random layouts some pose fits falls from 20/20 at 16 components to 16/20 at 20, 2/20 at 28 and 0/20 at 32
 (seeds 0-19), with handles allowed 0.20-0.62 m from the base axis."""
+
+
+def realizable(spec: PuzzleSpec, box: BoxConfig) -> bool:
+    """Whether ``spec`` is acceptable under ``box.realizable``: every lock rule a mechanism, or not asked."""
+    if not box.realizable:
+        return True
+    from models.lock_mechanisms import design_mechanisms  # the design search only when generating
+
+    return design_mechanisms(spec).complete
 
 
 def check_reach_size(num_components: int, box: BoxConfig) -> None:
@@ -153,6 +166,9 @@ def generate_chain(
         spec = fit_to_reach(
             assemble(name, kinds, chain_layout(kinds, rng, box.layout), rules, len(kinds) - 1, box), box
         )
-        if spec is not None:
+        if spec is not None and realizable(spec, box):
             return spec
-    raise GeneratorError(f"no layout of the chain {kinds} fits the robot's reach in {MAX_LAYOUT_ATTEMPTS} attempts")
+    raise GeneratorError(
+        f"no layout of the chain {kinds} fits the robot's reach{' with every lock a mechanism' * box.realizable} in "
+        f"{MAX_LAYOUT_ATTEMPTS} attempts"
+    )

@@ -18,7 +18,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from models.errors import GeneratorError
-from models.generator.chain import MAX_LAYOUT_ATTEMPTS, BoxConfig, assemble, check_reach_size, fit_to_reach
+from models.generator.chain import (
+    MAX_LAYOUT_ATTEMPTS,
+    BoxConfig,
+    assemble,
+    check_reach_size,
+    fit_to_reach,
+    realizable,
+)
 from models.generator.layout import Layout
 from models.kinds import PAPER_FAMILY, KindFamily
 from models.spec import PuzzleSpec
@@ -73,9 +80,12 @@ def generate_random(
         if built is not None:
             layout, rules, goal = built
             spec = fit_to_reach(assemble(name, layout.kinds, layout, rules, goal, box), box)
-            if spec is not None:
+            if spec is not None and realizable(spec, box):
                 return spec
-    raise GeneratorError(f"no layout of {n} components that fits the robot's reach in {MAX_LAYOUT_ATTEMPTS} attempts")
+    raise GeneratorError(
+        f"no layout of {n} components that fits the robot's reach{' with every lock a mechanism' * box.realizable} "
+        f"in {MAX_LAYOUT_ATTEMPTS} attempts"
+    )
 
 
 def _try_build(
