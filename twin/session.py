@@ -30,7 +30,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from models import PuzzleSpec, get_kind
+from models import LockTable, PuzzleSpec, get_kind
 from models.calibration import CameraCalibration
 from models.placement import placed, sample_reachable_pose
 from models.scene import Scene, SceneConfig
@@ -130,6 +130,8 @@ class TwinSession:
         self.component_qpos = np.array([m.joint(c.joint).qposadr[0] for c in component_names])
         self.travel = np.array([get_kind(c.kind).travel for c in spec.components])
         self.states = ComponentStates(self.travel, self.config.hysteresis)
+        self.rules = LockTable.from_spec(spec)
+        """The spec's lock semantics (ground truth): what the mechanisms and latches enforce together."""
         self.latches = Latches(m, latched_rules(spec, self.config.scene.locks), [c.latch for c in component_names],
                                self.component_qpos)  # fmt: skip
         camera_names = (names.overview_camera, names.wrist_camera)
@@ -295,11 +297,16 @@ class TwinSession:
                 self.ft.sample()
 
     def _held(self) -> np.ndarray:
-        """Which components the lock rules hold in the current states (recomputed only when a state changed:
-        ``states.states`` is a new array then)."""
+        """Which components the lock rules hold in the current states, whatever holds them (a mechanism or a
+        latch), recomputed only when a state changed (``states.states`` is a new array then)."""
         if self._held_for is not self.states.states:
-            self._held_for, self._held_now = self.states.states, self.latches.held(self.states.states)
+            self._held_for, self._held_now = self.states.states, self.rules.held(self.states.states)
         return self._held_now
+
+    def held_by_rules(self) -> np.ndarray:
+        """``(N,)`` bool: which components a lock rule of the spec holds in the current states (ground truth,
+        whether a mechanism or a latch enforces it)."""
+        return self.rules.held(self.states.states).copy()
 
     def _after_steps(self) -> None:
         d = self.data

@@ -601,7 +601,7 @@ def test_placement_puts_the_box_at_a_reachable_pose_drawn_from_the_seed():
     with session("realistic", seed=3) as s, session("realistic", seed=3) as again:
         assert s.box_pose == again.box_pose == s.spec.box.pose
         assert s.box_pose != session().box_pose
-        assert s.latches.engaged.tolist() == [False, True, True, True, True]
+        assert s.held_by_rules().tolist() == [False, True, True, True, True]
 
 
 def test_same_seed_and_profile_give_bit_identical_images_and_readings():

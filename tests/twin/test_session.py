@@ -46,7 +46,7 @@ def test_latched_joint_stays_put_under_a_20_newton_push(chain_session, name, tol
     session = chain_session
     session.reset()
     j = session.spec.index_of(name)
-    assert session.latches.engaged[j]
+    assert session.held_by_rules()[j]
     before = session.component_positions()[j]
     handle_push(session, name, PUSH_N)
     session.advance(0.5)
@@ -62,7 +62,7 @@ def test_released_joint_moves_freely_once_its_locker_opens(chain_session):
     session.advance(1.0)
     clear_pushes(session)
     assert session.component_states()[session.spec.index_of("slide-0")] == 1
-    assert not session.latches.engaged[door]
+    assert not session.held_by_rules()[door]
     handle_push(session, "door-1", PUSH_N / 4)
     session.advance(1.0)
     clear_pushes(session)
@@ -79,7 +79,7 @@ def test_open_component_is_latched_open_by_its_successor(chain_session):
         session.advance(1.0)
         clear_pushes(session)
     door = session.spec.index_of("door-1")
-    assert session.component_states()[door] == 1 and session.latches.engaged[door]
+    assert session.component_states()[door] == 1 and session.held_by_rules()[door]
     opened = session.component_positions()[door]
     handle_push(session, "door-1", -PUSH_N)  # try to close it
     session.advance(0.5)
@@ -187,7 +187,7 @@ def test_a_turned_and_moved_box_keeps_its_latches():
     spec = paper_family("test")[0]
     spec = replace(spec, box=replace(spec.box, pose=(0.38, 0.12, 1.1)))
     with TwinSession(spec, seed=0) as session:
-        assert session.latches.engaged.tolist() == [False, True, True, True, True]
+        assert session.held_by_rules().tolist() == [False, True, True, True, True]
         session.advance(0.5)
         assert np.abs(session.component_positions()).max() < 0.005
 
