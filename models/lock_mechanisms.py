@@ -74,6 +74,10 @@ DEPTHS = (-0.006, -0.012, -0.02, -0.03, -0.045, -0.06)
 """Candidate heights of the crossing point below the lid's top face [m]."""
 BOX_MARGIN = 0.004
 """How far inside the box's side walls and above its floor every tube stays [m]."""
+BACKING_STEP = 0.0015
+"""Spacing of a tube's backing chains [m] (less than a pin's diameter: the slab has no gap)."""
+BACKING_CHAINS = 2
+"""Backing chains behind each tube's axis: with the pins' 1 mm radius, a slab 5 mm thick."""
 MAX_TRIED = 60
 """Candidate crossing points whose blocking fractions are computed, best first guesses first."""
 SEGMENT_ANGLE = np.radians(8.0)
@@ -102,8 +106,9 @@ class Interlock:
         crossing: X, lid frame [m].
         theta: A's wall covers X while A is within this fraction of its travel from a.
         delta: B's rod covers X once B has left b by this fraction of its travel.
-        wall: ``(n, 3)`` polyline of the wall's axis in the lid frame with every part in state 0 [m].
-        rod: ``(m, 3)`` polyline of the rod's axis, likewise [m].
+        wall: ``(k, n, 3)`` polylines of the wall's chains in the lid frame with every part in state 0 [m]: its axis
+            through X first, then its backing chains.
+        rod: ``(k, m, 3)`` polylines of the rod's chains, likewise [m].
         crossing_sine: sine of the angle between the two motions at X.
         exposed: how far the tubes rise above the lid's top face in any of the four corner states [m] (<= 0: the
             mechanism is hidden under the lid).
@@ -384,16 +389,44 @@ class _Paths:
     distance: np.ndarray
 
 
-def _paths(x: np.ndarray, a: JointMotion, b: JointMotion, dir_a: float, dir_b: float) -> _Paths:
+def _paths(
+    x: np.ndarray, a: JointMotion, b: JointMotion, dir_a: float, dir_b: float, xb: np.ndarray | None = None
+) -> _Paths:
+    """The paths of ``x`` through A and of ``xb`` (default ``x``) through B, and their distances."""
     ts = np.linspace(-1.2, 1.2, SAMPLES)
     pa = a.move(x, dir_a * a.travel * ts)
-    pb = b.move(x, dir_b * b.travel * ts)
+    pb = b.move(x if xb is None else xb, dir_b * b.travel * ts)
     distance = np.linalg.norm(pa[:, None, :] - pb[None, :, :], axis=-1)
     return _Paths(ts, pa, pb, distance)
 
 
 def _index(ts: np.ndarray, t: float) -> int:
     return int(round((t - ts[0]) / (ts[1] - ts[0])))
+
+
+def _backing(x, a: JointMotion, b: JointMotion, dir_a: float, dir_b: float) -> tuple[list, list]:
+    """Offsets [m] of the wall's and the rod's chains at X, their own axis first: the wall is backed along e1 (B's
+    motion), away from the rod's tip, which comes from -e1; the rod along -e2, away from the wall's end, which
+    comes from +e2 (A's motion). Thick where a part would have to pass through, thin where it must pass by:
+    a part flung at a pin (20 N on a 25 g door: ~1 m/s at X, 2 mm a step) meets 5 mm of steel, not 2."""
+    vb = b.velocity(x) * dir_b
+    va = a.velocity(x) * dir_a
+    e1 = vb / np.linalg.norm(vb)
+    e2 = va - (va @ e1) * e1
+    e2 /= np.linalg.norm(e2)
+    steps = [k * BACKING_STEP for k in range(BACKING_CHAINS + 1)]
+    return [s * e1 for s in steps], [-s * e2 for s in steps]
+
+
+def _free_edges_clear(paths: _Paths, theta: float, delta: float) -> bool:
+    """Whether the free edges of the configuration square are clear for these ``theta`` and ``delta``
+    (:func:`_fractions`)."""
+    need = 2 * TUBE_RADIUS + GAP
+    ts, d = paths.ts, paths.distance
+    i_m1, i_p1 = _index(ts, -1.0), _index(ts, 1.0)
+    at_b = d[_index(ts, -theta) : i_p1 + 1, i_m1 : _index(ts, -delta) + 1]
+    anywhere = d[_index(ts, 1.0 - theta) : i_p1 + 1, i_m1 : _index(ts, 1.0 - delta) + 1]
+    return bool(at_b.min() >= need and anywhere.min() >= need)
 
 
 def _fractions(paths: _Paths) -> tuple[float, float] | None:
@@ -462,12 +495,25 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
             reasons["the tubes cannot clear each other"] = reasons.get("the tubes cannot clear each other", 0) + 1
             continue
         theta, delta = fractions
+        wall_offsets, rod_offsets = _backing(point, a, b, dir_a, dir_b)
+        if not all(
+            _free_edges_clear(_paths(point + ow, a, b, dir_a, dir_b, point + orr), theta, delta)
+            for ow in wall_offsets
+            for orr in rod_offsets
+        ):
+            reasons["the backing meets the other tube"] = reasons.get("the backing meets the other tube", 0) + 1
+            continue
         wall_ts, rod_ts = _tube_ts(-theta, 0.0, a, dir_a), _tube_ts(-1.0, -delta, b, dir_b)
-        # the wall and rod with every part closed: X carried back to where the parts stand at state 0
+        # the wall and rod with every part closed: X carried back to where the parts stand at state 0; each is a
+        # slab: its axis through X and backing copies behind it, away from where the other tube comes from
         q0a, q0b = a.q(first.locker_state), b.q(first.locked_state)
-        wall0 = a.move(a.move(point, dir_a * a.travel * wall_ts), -q0a)
-        rod0 = b.move(b.move(point, dir_b * b.travel * rod_ts), -q0b)
-        corners = [np.vstack([a.move(wall0, a.q(sa)), b.move(rod0, b.q(sb))]) for sa in (0, 1) for sb in (0, 1)]
+        wall0 = np.stack([a.move(a.move(point + o, dir_a * a.travel * wall_ts), -q0a) for o in wall_offsets])
+        rod0 = np.stack([b.move(b.move(point + o, dir_b * b.travel * rod_ts), -q0b) for o in rod_offsets])
+        corners = [
+            np.vstack([a.move(wall0.reshape(-1, 3), a.q(sa)), b.move(rod0.reshape(-1, 3), b.q(sb))])
+            for sa in (0, 1)
+            for sb in (0, 1)
+        ]
         exposed = float(np.vstack(corners)[:, 2].max() + TUBE_RADIUS)
         score = (1 - theta) + delta + _exposure_cost(exposed)
         if best is None or score < best[0]:

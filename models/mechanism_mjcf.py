@@ -97,7 +97,8 @@ def add_mechanisms(
         ):
             component = by_name[owner]
             motion = JointMotion.of(get_kind(component.kind), tuple(component.pose))
-            _add_chain(bodies[owner], f"{base}:{role}", motion.to_body(polyline, 0.0), interlock, bit)
+            chains = [motion.to_body(chain, 0.0) for chain in polyline]
+            _add_chain(bodies[owner], f"{base}:{role}", chains, interlock, bit)
     for k, latch in enumerate(layout.latches, start=len(layout.interlocks)):
         bit = 1 << (1 + k % CONTACT_BITS)
         _add_latch(root, latch, bodies, prefixes, by_name, bit)
@@ -147,8 +148,10 @@ def _add_latch(root, latch: OneWayLatch, bodies, prefixes, by_name, bit: int) ->
     )  # fmt: skip
 
 
-def _add_chain(body: mjcf.Element, name: str, points: np.ndarray, interlock: Interlock, bit: int) -> None:
-    for k, (p, q) in enumerate(zip(points[:-1], points[1:], strict=True)):
+def _add_chain(body: mjcf.Element, name: str, chains: list[np.ndarray], interlock: Interlock, bit: int) -> None:
+    """The capsules of a wall's or rod's chains, numbered ``<name>:<k>`` across all of them."""
+    segments = [(p, q) for points in chains for p, q in zip(points[:-1], points[1:], strict=True)]
+    for k, (p, q) in enumerate(segments):
         body.add(
             "geom",
             name=f"{name}:{k}",
