@@ -113,10 +113,15 @@ def reachable_states(spec: PuzzleSpec, limit: int = MAX_STATES) -> list[int]:
 
 
 def check_locks(
-    spec: PuzzleSpec, model: mujoco.MjModel, joint_names: dict[str, str], limit: int = MAX_STATES
+    spec: PuzzleSpec,
+    model: mujoco.MjModel,
+    joint_names: dict[str, str],
+    limit: int = MAX_STATES,
+    open_rest: float = 1.0,
 ) -> LockCheck:
     """Push every part from every reachable state (module docstring) in ``model``, whose joint of each
-    component is ``joint_names[component name]``. Other joints of the model (a robot's, a pawl's) are held
+    component is ``joint_names[component name]``; an open part rests at ``open_rest`` of its travel (1: its end
+    stop; the twin counts a part open from 0.75, and a door opened by a pinch may rest anywhere past that). Other joints of the model (a robot's, a pawl's) are held
     where they stand at reset, but for joints that belong to no component and carry a spring (a mechanism's own
     sprung parts), which move freely."""
     table = LockTable.from_spec(spec)
@@ -142,7 +147,7 @@ def check_locks(
         bits = np.array([(state >> c) & 1 for c in range(len(joints))])
         for c in range(len(joints)):
             mujoco.mj_resetData(model, data)
-            q0 = np.where(bits == 1, travel, 0.0)
+            q0 = np.where(bits == 1, open_rest * travel, 0.0)
             data.qpos[qadr] = q0
             mujoco.mj_forward(model, data)
             hold_q = data.qpos.copy()
@@ -163,7 +168,8 @@ def check_locks(
                 if other_q:
                     data.qpos[other_q] = hold_q[other_q]
                     data.qvel[other_d] = 0.0
-                moved = sign * (data.qpos[qadr[c]] - q0[c]) / travel[c]
+                # how far toward the other state, from where a state's part would stand at its end stop
+                moved = sign * (data.qpos[qadr[c]] - (travel[c] if bits[c] else 0.0)) / travel[c]
                 best = max(best, float(moved))
                 if best >= 0.98:
                     break

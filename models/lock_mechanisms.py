@@ -62,6 +62,10 @@ GAP = 0.0005
 MIN_CROSSING_SINE = 0.5
 """Smallest sine of the angle between the two motions at X (30 deg): below it a blocked push would need twice its
 own force at the contact, and the tubes would have to be long to clear each other."""
+FREE_FROM = 0.75
+"""A part counts as having left a state once it moved this fraction of its travel (the twin's state threshold):
+a locker that far toward 1-a, wherever it rests past that (a door opened by a pinch may stop short of its end
+stop), must have freed the part it held."""
 MAX_BLOCKING = 0.08
 """Largest fraction of its travel a held part may move before its tube meets the other's."""
 SAMPLES = 121
@@ -340,7 +344,7 @@ def _latch_clear(x, frame, a, b, dir_a, dir_b, lo, hi) -> str | None:
 
     if any(overlap(i, 0) for i in range(1, len(ts))):
         return "the tooth meets the lug as the locker leaves"
-    if any(overlap(len(ts) - 1, j) for j in range(len(ts))):
+    if any(overlap(i, j) for i in np.flatnonzero(ts >= FREE_FROM) for j in range(len(ts))):
         return "the lug meets the tooth with the locker away"
     if any(overlap(i, len(ts) - 1) for i in range(len(ts))):
         return "the tooth meets the lug with the locked part away"
@@ -425,17 +429,18 @@ def _free_edges_clear(paths: _Paths, theta: float, delta: float) -> bool:
     ts, d = paths.ts, paths.distance
     i_m1, i_p1 = _index(ts, -1.0), _index(ts, 1.0)
     at_b = d[_index(ts, -theta) : i_p1 + 1, i_m1 : _index(ts, -delta) + 1]
-    anywhere = d[_index(ts, 1.0 - theta) : i_p1 + 1, i_m1 : _index(ts, 1.0 - delta) + 1]
+    anywhere = d[_index(ts, FREE_FROM - theta) : i_p1 + 1, i_m1 : _index(ts, 1.0 - delta) + 1]
     return bool(at_b.min() >= need and anywhere.min() >= need)
 
 
 def _fractions(paths: _Paths) -> tuple[float, float] | None:
     """``(theta, delta)``: the largest theta and smallest delta on the :data:`STEP` grid for which the free edges
-    of the configuration square are clear (module docstring), or None within :data:`MAX_BLOCKING`.
+    of the configuration square are clear (module docstring), or None: delta within :data:`MAX_BLOCKING`, theta
+    within :data:`MAX_BLOCKING` short of :data:`FREE_FROM`.
 
     Free edges, with t the displacement (fraction of travel) that carries X through a part: B at b and A anywhere
-    (wall ``t`` in [-theta, 1], rod in [-1, -delta]) and A at 1-a and B anywhere (wall in [1-theta, 1], rod in
-    [-1, 1-delta])."""
+    (wall ``t`` in [-theta, 1], rod in [-1, -delta]) and A past :data:`FREE_FROM` and B anywhere (wall in
+    [FREE_FROM - theta, 1], rod in [-1, 1-delta])."""
     need = 2 * TUBE_RADIUS + GAP
     ts, d = paths.ts, paths.distance
     i_m1, i_p1 = _index(ts, -1.0), _index(ts, 1.0)
@@ -447,8 +452,8 @@ def _fractions(paths: _Paths) -> tuple[float, float] | None:
         clear_at_b = np.minimum.accumulate(at_b[::-1])[::-1]  # min over wall samples i..t=1
         clear_anywhere = np.minimum.accumulate(anywhere[::-1])[::-1]
         for blocking_a in blockings:
-            theta = 1.0 - blocking_a
-            if clear_at_b[_index(ts, -theta)] >= need and clear_anywhere[_index(ts, 1.0 - theta)] >= need:
+            theta = FREE_FROM - blocking_a  # A frees B wherever it rests past FREE_FROM
+            if clear_at_b[_index(ts, -theta)] >= need and clear_anywhere[_index(ts, FREE_FROM - theta)] >= need:
                 return float(theta), float(delta)
     return None
 
