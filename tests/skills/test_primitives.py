@@ -48,6 +48,18 @@ def test_a_latched_part_of_each_kind_is_reported_blocked_and_stays_put(chain, na
     assert session.robot.gripper_opening() <= PrimitiveConfig().pregrasp_closure + 0.05  # and the robot let go
 
 
+def test_a_blocked_try_is_felt_against_a_mechanism_not_a_latch(chain):
+    # the default box locks by contact: the wrist meets the slide's pin through the door's wall, no constraint
+    session, models = chain
+    session.reset()
+    result = Toggler(session.robot).toggle(models["door-1"])
+    assert result.outcome == "blocked", result.reason
+    assert not session.data.eq_active[session.latches.eq_ids].any()
+    assert session.latches.table.locker.size == 0  # every rule of this chain is a mechanism
+    assert result.peak_opposing_force > 5.0  # felt through the F/T
+    assert session.component_states()[session.spec.index_of("door-1")] == 0
+
+
 def test_a_free_slide_then_the_door_it_released_are_opened(chain):
     session, models = chain
     session.reset()
