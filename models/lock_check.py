@@ -121,9 +121,9 @@ def check_locks(
 ) -> LockCheck:
     """Push every part from every reachable state (module docstring) in ``model``, whose joint of each
     component is ``joint_names[component name]``; an open part rests at ``open_rest`` of its travel (1: its end
-    stop; the twin counts a part open from 0.75, and a door opened by a pinch may rest anywhere past that). Other joints of the model (a robot's, a pawl's) are held
-    where they stand at reset, but for joints that belong to no component and carry a spring (a mechanism's own
-    sprung parts), which move freely."""
+    stop; the twin counts a part open from 0.75, and a door opened by a pinch may rest anywhere past that). Other
+    joints of the model (a robot's) are held where they stand at reset, but for joints that belong to no component
+    and carry a spring (a mechanism's own sprung pawls), which move freely."""
     table = LockTable.from_spec(spec)
     joints = [model.joint(joint_names[c.name]) for c in spec.components]
     qadr = np.array([int(j.qposadr[0]) for j in joints])

@@ -24,8 +24,10 @@ disagrees, 2 if a spec is invalid (one line each) or a box cannot be built. ``--
 result (moves as fractions of the travel).
 
 ``mesh`` exports the box as the MuJoCo model has it (at start, every component closed): one part per
-component plus ``box`` (the shell), in the lid frame (origin at the centre of the lid's top face, z up),
-in metres; STL has no part names, hence one STL per part beside the merged one (``models.mesh_export``).
+component plus ``box`` (the shell) and one per lock mechanism's piece (``<A>-interlocks-<B>-wall``, ``-rod``;
+``<A>-latches-<B>-tooth``, ``-lug``), each one watertight solid, in the lid frame (origin at the centre of the
+lid's top face, z up), in metres; STL has no part names, hence one STL per part beside the merged one
+(``models.mesh_export``).
 
 ``--plot`` on paper/chain/random also writes a top view of each layout (PNG beside the JSON).
 Generated boxes stand where the robot reaches every handle (at most 28 components fit); ``--anywhere``
@@ -379,7 +381,10 @@ def main(argv: list[str] | None = None) -> int:
     check.add_argument("--json", default=None, metavar="FILE", help="also write every box's result to FILE")
     check.set_defaults(run=_check_locks)
 
-    mesh = verbs.add_parser("mesh", help="the box as meshes: DIR/<name>.glb, .obj, .stl and one STL per part")
+    mesh = verbs.add_parser(
+        "mesh",
+        help="the box as meshes: DIR/<name>.glb, .obj, .stl and one STL per part (shell, components, mechanisms)",
+    )
     mesh.add_argument("spec", help="puzzle spec file")
     mesh.add_argument("--out", required=True, help="output directory")
     mesh.set_defaults(run=_mesh)

@@ -188,11 +188,16 @@ def test_mesh_writes_glb_obj_and_stl_per_part(tmp_path):
     path = save_spec(spec, tmp_path / "box.json")
     result = generate("mesh", path, "--out", tmp_path / "out")
     assert result.returncode == 0, result.stderr
-    parts = ["box", *(c.name for c in spec.components)]
+    # the box, each component, and each lock mechanism's wall and rod (a pair of rules each here) as its own part
+    pairs = [(r.locker, r.locked) for r in spec.locks[::2]]
+    mechanisms = [f"{a}-interlocks-{b}-{role}" for a, b in pairs for role in ("wall", "rod")]
+    parts = ["box", *(c.name for c in spec.components), *mechanisms]
     files = {f"{spec.name}.{ext}" for ext in ("glb", "obj", "stl")} | {f"{spec.name}-{p}.stl" for p in parts}
     assert {p.name for p in (tmp_path / "out").iterdir()} == files
     glb = trimesh.load(tmp_path / "out" / f"{spec.name}.glb", force="scene")
     assert set(glb.graph.nodes_geometry) == set(parts)
+    for name in parts:  # every part prints as one closed solid
+        assert trimesh.load(tmp_path / "out" / f"{spec.name}-{name}.stl", force="mesh").is_watertight, name
     # metres in the lid frame: the box spans its length along x and stands on z = -height
     length, width, height = spec.box.size
     lo, hi = trimesh.load(tmp_path / "out" / f"{spec.name}-box.stl", force="mesh").bounds
