@@ -200,3 +200,36 @@ def test_robot_interface_offers_no_ground_truth():
         public = {name for name in dir(session.robot) if not name.startswith("_")}
         assert not {n for n in public if "component" in n or "latch" in n or "state" in n}
         _ = mujoco  # keep the import honest for type checkers
+
+
+def test_a_rule_no_mechanism_serves_is_named_in_a_warning_and_held_by_a_latch():
+    from models.generator import BoxConfig, RandomGraphConfig, generate_random
+    from models.kinds import family_named
+    from twin.latches import UnrealizedLockWarning
+
+    # a lever whose pivot stands 33 mm above the lid cannot latch a slide that moves along its length one way:
+    # the generator, told not to redraw, keeps that box; the twin runs it with a latch for exactly that rule
+    spec = generate_random(RandomGraphConfig(6, family=family_named("all")), seed=2, box=BoxConfig(realizable=False))
+    with pytest.warns(UnrealizedLockWarning, match=r"lever-0 in 0 keeps slide-2 in 0") as caught:
+        session = TwinSession(spec, seed=0)
+    with session:
+        assert len(caught) == 1
+        table = session.latches.table
+        pairs = zip(table.locker, table.locked, strict=True)
+        assert [(spec.components[i].name, spec.components[j].name) for i, j in pairs] == [("lever-0", "slide-2")]
+        slide = spec.index_of("slide-2")
+        assert session.held_by_rules()[slide] and session.latches.engaged[slide]
+        handle_push(session, "slide-2", PUSH_N)
+        session.advance(0.5)
+        clear_pushes(session)
+        assert abs(session.component_positions()[slide]) < 0.001  # the latch holds it where it stands
+    # the ablation: every rule on the latches, no warning
+    import warnings
+
+    from models.scene import SceneConfig
+    from twin.session import TwinConfig
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UnrealizedLockWarning)
+        with TwinSession(spec, seed=0, config=TwinConfig(scene=SceneConfig(locks="latch"))) as latched:
+            assert len(latched.latches.table.locker) == len(spec.locks)
