@@ -3,7 +3,7 @@
     python scripts/trial.py --specs FILE... [--memory MEM.sqlite] --sim {symbolic,twin} --runs K --seed S \
                             --max-actions M --out DIR [--agent NAME] [--max-lockers K] [--video] \
                             [--reality ideal|realistic|harsh|FILE.json] [--calibration FILE.json] [--wrong-kind] \
-                            [--workers K | --ray auto|ADDRESS] [--resume | --force] \
+                            [--locks contact|latch] [--workers K | --ray auto|ADDRESS] [--resume | --force] \
                             [--robot twin|xarm --ip ADDRESS --cell FILE]
 
 ``--sim twin`` runs each trial end to end in the MuJoCo twin (ArUco perception, the agent, mink
@@ -23,7 +23,9 @@ agent's belief hold a component with a set of up to K lockers (default 1: the pa
 2 for boxes made with ``generate.py random --multi-locker``). ``--wrong-kind`` tells the pipeline (skills
 and agent) one
 component's kind wrong in every run, drawn from the run's seed (the run's ``told_kinds``): the force limits
-must hold when a slide is pulled along a wheel's arc.
+must hold when a slide is pulled along a wheel's arc. ``--locks`` (twin) picks how the box holds its lock rules:
+``contact`` (default), the mechanisms in the model that block by contact (``models/lock_mechanisms.py``), or
+``latch``, the rule-driven joint equalities alone (the ablation; the records made before mechanisms existed).
 
 ``--robot xarm --ip ADDRESS --cell FILE --calibration FILE --specs SPEC --runs 1`` runs one trial on a real
 xArm-7 (``real.XArmRobot``, the ``real`` extra) through the same pipeline (``scripts/_real_trial.py``): the box
