@@ -7,8 +7,9 @@ is pushed toward its other state with a bounded generalized force — :data:`SLI
 cannot be pushed out of the way). A free part must reach :data:`FREE_FRACTION` of its travel toward the other
 state (the twin's state threshold); a held part must move less than :data:`HELD_FRACTION`. Only ``mujoco`` runs:
 the model is stepped as it is, no latch engaged, no project code in the loop, so what holds a part is its
-geometry. The push is a robot's, not a bare force's: never more than brings the part to :data:`SLIDE_SPEED` or
-:data:`HINGE_SPEED` (the arm's hand speed) within a step.
+geometry. The push is a robot's, not a bare force's: at most the effort, and the part never faster than
+:data:`SLIDE_SPEED` or :data:`HINGE_SPEED` (the hand's speed): each step, what the part's motion says it was
+pushing against plus what brings it to that speed, so a stalled push builds up to the whole effort in ~10 ms.
 """
 
 from __future__ import annotations
@@ -141,6 +142,7 @@ def check_locks(
     full = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, full)
     inertias = full[dadr, dadr]  # about a fixed axis: the same in every state
+    dt = model.opt.timestep
     steps = int(round(PUSH_TIME / model.opt.timestep))
     transitions: list[Transition] = []
     for state in reachable_states(spec, limit):
@@ -156,11 +158,16 @@ def check_locks(
             speed = HINGE_SPEED if hinge[c] else SLIDE_SPEED
             others = np.array([k for k in range(len(joints)) if k != c], dtype=int)
             best = 0.0
+            push = v_before = 0.0
             for _ in range(steps):
                 data.qfrc_applied[:] = 0.0
-                # at most the effort, and no more than brings the part to the pusher's speed within this step
-                room = inertias[c] * (speed - sign * data.qvel[dadr[c]]) / model.opt.timestep
-                data.qfrc_applied[dadr[c]] = sign * min(effort, max(room, 0.0))
+                # a hand that pushes with at most ``effort`` and moves no faster than ``speed``: what the part's motion
+                # last step says it pushed against, plus what brings it to that speed in this step
+                v = sign * data.qvel[dadr[c]]
+                load = push - inertias[c] * (v - v_before) / dt
+                push = float(np.clip(load + inertias[c] * (speed - v) / dt, 0.0, effort))
+                v_before = v
+                data.qfrc_applied[dadr[c]] = sign * push
                 mujoco.mj_step(model, data)
                 if len(others):
                     data.qpos[qadr[others]] = hold_q[qadr[others]]

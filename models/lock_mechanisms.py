@@ -81,10 +81,13 @@ BOX_MARGIN = 0.004
 BACKING_STEP = 0.0015
 """Spacing of a tube's backing chains [m] (less than a pin's diameter: the slab has no gap)."""
 BACKING_CHAINS = 2
-"""Backing chains behind each tube's axis: with the pins' 1 mm radius, a slab 5 mm thick."""
+"""Backing chains behind each tube's axis: with the pins' 1 mm radius, a slab 5 mm thick (with one, 3.5 mm, a door
+flung by a bare 20 N push passed through; each chain's capsules are geoms collided every step)."""
 MAX_TRIED = 60
 """Candidate crossing points whose blocking fractions are computed, best first guesses first."""
-SEGMENT_ANGLE = np.radians(8.0)
+CHORD_SAGITTA = 0.0002
+"""Largest gap between a hinge tube's capsule chain and the arc it follows [m] (the chords lie inside the arc):
+added to the clearance the free moves are checked with."""
 """Largest turn of a hinge's tube per capsule [rad] (chord error < 0.25 % of its radius)."""
 
 
@@ -425,7 +428,7 @@ def _backing(x, a: JointMotion, b: JointMotion, dir_a: float, dir_b: float) -> t
 def _free_edges_clear(paths: _Paths, theta: float, delta: float) -> bool:
     """Whether the free edges of the configuration square are clear for these ``theta`` and ``delta``
     (:func:`_fractions`)."""
-    need = 2 * TUBE_RADIUS + GAP
+    need = 2 * TUBE_RADIUS + GAP + CHORD_SAGITTA
     ts, d = paths.ts, paths.distance
     i_m1, i_p1 = _index(ts, -1.0), _index(ts, 1.0)
     at_b = d[_index(ts, -theta) : i_p1 + 1, i_m1 : _index(ts, -delta) + 1]
@@ -441,7 +444,7 @@ def _fractions(paths: _Paths) -> tuple[float, float] | None:
     Free edges, with t the displacement (fraction of travel) that carries X through a part: B at b and A anywhere
     (wall ``t`` in [-theta, 1], rod in [-1, -delta]) and A past :data:`FREE_FROM` and B anywhere (wall in
     [FREE_FROM - theta, 1], rod in [-1, 1-delta])."""
-    need = 2 * TUBE_RADIUS + GAP
+    need = 2 * TUBE_RADIUS + GAP + CHORD_SAGITTA
     ts, d = paths.ts, paths.distance
     i_m1, i_p1 = _index(ts, -1.0), _index(ts, 1.0)
     blockings = np.arange(STEP, MAX_BLOCKING + 1e-9, STEP)
@@ -508,7 +511,8 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
         ):
             reasons["the backing meets the other tube"] = reasons.get("the backing meets the other tube", 0) + 1
             continue
-        wall_ts, rod_ts = _tube_ts(-theta, 0.0, a, dir_a), _tube_ts(-1.0, -delta, b, dir_b)
+        wall_ts = _tube_ts(-theta, 0.0, a, _radius(a, point))
+        rod_ts = _tube_ts(-1.0, -delta, b, _radius(b, point))
         # the wall and rod with every part closed: X carried back to where the parts stand at state 0; each is a
         # slab: its axis through X and backing copies behind it, away from where the other tube comes from
         q0a, q0b = a.q(first.locker_state), b.q(first.locked_state)
@@ -551,16 +555,26 @@ def _velocities(motion: JointMotion, points: np.ndarray) -> np.ndarray:
     return np.cross(motion.axis, points - motion.origin)
 
 
+def _radius(motion: JointMotion, point: np.ndarray) -> float:
+    """Distance of ``point`` from a hinge's axis [m] (0 for a slide)."""
+    if motion.joint == "slide":
+        return 0.0
+    v = np.asarray(point) - motion.origin
+    return float(np.linalg.norm(v - (v @ motion.axis) * motion.axis))
+
+
 def _exposure_cost(exposed: float) -> float:
     """What showing a tube above the lid costs, in fractions of travel: 0.5 for showing at all, plus 0.2 per mm."""
     return 0.0 if exposed <= 0 else 0.5 + 200.0 * exposed
 
 
-def _tube_ts(t0: float, t1: float, motion: JointMotion, direction: float) -> np.ndarray:
+def _tube_ts(t0: float, t1: float, motion: JointMotion, radius: float) -> np.ndarray:
     """Displacements (fraction of travel) sampling a tube from ``t0`` to ``t1``: two for a slide (a straight
-    capsule), one per :data:`SEGMENT_ANGLE` of turn for a hinge."""
+    capsule); for a hinge, as few chords as keep the chain within :data:`CHORD_SAGITTA` of its arc of ``radius``
+    [m] about the hinge (few capsules: each is a geom collided every step)."""
     if motion.joint == "slide":
         return np.array([t0, t1])
     turn = abs(t1 - t0) * motion.travel
-    n = max(1, int(np.ceil(turn / SEGMENT_ANGLE)))
+    chord_angle = 2 * np.arccos(max(1.0 - CHORD_SAGITTA / max(radius, 1e-6), -1.0))
+    n = max(1, int(np.ceil(turn / chord_angle)))
     return np.linspace(t0, t1, n + 1)

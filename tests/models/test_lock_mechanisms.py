@@ -36,8 +36,16 @@ def test_paper_box_alone_behaves_as_its_spec_says(name):
     check = _check(spec)
     assert check.disagreements() == []
     assert len(check.transitions) == 30
-    # a bolt holds within a few percent of the travel, a door held open rests near open
-    assert max(check.held_moves()) < 0.08
+    # a bolt holds a closed part within a few percent of its travel; an open part held open rests short of the
+    # open threshold (0.75), where its locker's pin stands so that the locker frees it wherever it rests past that
+    closed = [t.moved for t in check.transitions if not t.expected_free and not (t.state >> _index(spec, t) & 1)]
+    opened = [t.moved for t in check.transitions if not t.expected_free and t.state >> _index(spec, t) & 1]
+    assert closed and max(closed) < 0.08
+    assert opened and max(opened) < 0.35
+
+
+def _index(spec: PuzzleSpec, transition) -> int:
+    return spec.index_of(transition.component)
 
 
 def test_without_mechanisms_held_parts_swing_freely():
@@ -117,7 +125,7 @@ def test_a_paired_interlock_blocks_both_ways():
     # the closed door keeps the slide in ...
     assert _push(spec, "slide-b", {"door-a": 0, "slide-b": 0}) < 0.08
     # ... and the open slide keeps the door open, near open (not a tongue it falls onto)
-    assert _push(spec, "door-a", {"door-a": 1, "slide-b": 1}) < 0.15
+    assert _push(spec, "door-a", {"door-a": 1, "slide-b": 1}) < 0.35  # within 0.25 of the open threshold
     # free moves stay free
     assert _push(spec, "door-a", {"door-a": 0, "slide-b": 0}) > 0.9
     assert _push(spec, "slide-b", {"door-a": 1, "slide-b": 0}) > 0.9
@@ -156,7 +164,9 @@ def test_the_latch_model_has_no_mechanism():
     names = [latch.geom(i).name for i in range(latch.ngeom)]
     assert not [n for n in names if ":interlock:" in n or ":latch:" in n]
     assert contact.ngeom > latch.ngeom
-    assert latch.nbody == contact.nbody  # no pawl: a paper box is made of pairs only
+    assert latch.njnt == contact.njnt  # no pawl: a paper box is made of pairs only
+    extra = {contact.body(b).name for b in range(contact.nbody)} - {latch.body(b).name for b in range(latch.nbody)}
+    assert extra and all(":interlock:" in name for name in extra)  # each tube a body of its own, fixed to its part
 
 
 def test_mechanisms_touch_only_their_partner():
