@@ -411,7 +411,9 @@ def _index(ts: np.ndarray, t: float) -> int:
     return int(round((t - ts[0]) / (ts[1] - ts[0])))
 
 
-def _backing(x, a: JointMotion, b: JointMotion, dir_a: float, dir_b: float) -> tuple[list, list]:
+def _backing(
+    x, a: JointMotion, b: JointMotion, dir_a: float, dir_b: float, chains: int = BACKING_CHAINS
+) -> tuple[list, list]:
     """Offsets [m] of the wall's and the rod's chains at X, their own axis first: the wall is backed along e1 (B's
     motion), away from the rod's tip, which comes from -e1; the rod along -e2, away from the wall's end, which
     comes from +e2 (A's motion). Thick where a part would have to pass through, thin where it must pass by:
@@ -421,7 +423,7 @@ def _backing(x, a: JointMotion, b: JointMotion, dir_a: float, dir_b: float) -> t
     e1 = vb / np.linalg.norm(vb)
     e2 = va - (va @ e1) * e1
     e2 /= np.linalg.norm(e2)
-    steps = [k * BACKING_STEP for k in range(BACKING_CHAINS + 1)]
+    steps = [k * BACKING_STEP for k in range(chains + 1)]
     return [s * e1 for s in steps], [-s * e2 for s in steps]
 
 
@@ -503,14 +505,18 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
             reasons["the tubes cannot clear each other"] = reasons.get("the tubes cannot clear each other", 0) + 1
             continue
         theta, delta = fractions
-        wall_offsets, rod_offsets = _backing(point, a, b, dir_a, dir_b)
-        if not all(
-            _free_edges_clear(_paths(point + ow, a, b, dir_a, dir_b, point + orr), theta, delta)
-            for ow in wall_offsets
-            for orr in rod_offsets
-        ):
-            reasons["the backing meets the other tube"] = reasons.get("the backing meets the other tube", 0) + 1
-            continue
+        # as much backing as the free moves leave room for (none: a plain pin, as thin as the clearance asks)
+        for chains in range(BACKING_CHAINS, -1, -1):
+            wall_offsets, rod_offsets = _backing(point, a, b, dir_a, dir_b, chains)
+            if all(
+                _free_edges_clear(_paths(point + ow, a, b, dir_a, dir_b, point + orr), theta, delta)
+                for ow in wall_offsets[1:]
+                for orr in rod_offsets
+            ) and all(
+                _free_edges_clear(_paths(point, a, b, dir_a, dir_b, point + orr), theta, delta)
+                for orr in rod_offsets[1:]
+            ):
+                break
         wall_ts = _tube_ts(-theta, 0.0, a, _radius(a, point))
         rod_ts = _tube_ts(-1.0, -delta, b, _radius(b, point))
         # the wall and rod with every part closed: X carried back to where the parts stand at state 0; each is a
@@ -524,7 +530,7 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
             for sb in (0, 1)
         ]
         exposed = float(np.vstack(corners)[:, 2].max() + TUBE_RADIUS)
-        score = (1 - theta) + delta + _exposure_cost(exposed)
+        score = (1 - theta) + delta + _exposure_cost(exposed) + 0.05 * (BACKING_CHAINS + 1 - len(wall_offsets))
         if best is None or score < best[0]:
             best = (score, point, theta, delta, wall0, rod0, float(sine[index]), exposed)
     if best is None:
