@@ -15,6 +15,9 @@ from learning.multi_belief import MultiBelief
 from models.generator import TEST_INDICES, TRAIN_INDICES, RandomGraphConfig, generate_random, paper_variant
 from models.generator.chain import BoxConfig
 
+SYMBOLIC_BOX = BoxConfig(realizable=False)
+"""Random boxes as drawn before lock mechanisms existed: these symbolic tests chose their seeds for their graphs."""
+
 EXACT = BeliefConfig(jam_probability=0.0, false_move_probability=0.0)
 
 ONE_LOCKER_FINGERPRINTS = (
@@ -69,7 +72,7 @@ def test_one_locker_agents_decide_to_the_bit_as_before_sets_of_lockers_existed()
 
 
 def test_max_lockers_one_is_the_default_agent():
-    spec = generate_random(RandomGraphConfig(6, multi_locker=True), seed=3)
+    spec = generate_random(RandomGraphConfig(6, multi_locker=True), seed=3, box=SYMBOLIC_BOX)
     runs = []
     for agent in (DualAgent(), DualAgent(DualControllerConfig(max_lockers=1)), make_agent("dual", spec, max_lockers=1)):
         result = run_episode(agent, SymbolicWorld(spec, 0), spec.name, 0, 40)
@@ -82,7 +85,7 @@ def test_two_lockers_solve_a_box_the_one_locker_belief_cycles_on():
     """slide-3 (the goal) is held closed by wheel-0 and by wheel-2. With exact elimination the one-locker
     belief meets tries no single locker explains, falls back to its prior and goes round in circles; the
     belief over pairs of lockers explains them and opens the box."""
-    spec = generate_random(RandomGraphConfig(4, multi_locker=True), seed=4)
+    spec = generate_random(RandomGraphConfig(4, multi_locker=True), seed=4, box=SYMBOLIC_BOX)
     one = run_episode(DualAgent(DualControllerConfig(belief=EXACT)), SymbolicWorld(spec, 0), spec.name, 0, 60)
     two_agent = DualAgent(DualControllerConfig(belief=EXACT, max_lockers=2))
     two = run_episode(two_agent, SymbolicWorld(spec, 0), spec.name, 0, 60)
@@ -93,7 +96,7 @@ def test_two_lockers_solve_a_box_the_one_locker_belief_cycles_on():
 
 def test_a_memory_agent_over_sets_learns_into_the_one_locker_memory():
     store = MemoryStore()
-    spec = generate_random(RandomGraphConfig(5, multi_locker=True), seed=1)
+    spec = generate_random(RandomGraphConfig(5, multi_locker=True), seed=1, box=SYMBOLIC_BOX)
     agent = MemoryAgent(store, DualControllerConfig(max_lockers=2), learn=True)
     run_episode(agent, SymbolicWorld(spec, 0), spec.name, 0, 40)
     assert store.num_episodes == 1
@@ -110,7 +113,7 @@ def test_an_invalid_max_lockers_is_a_clear_error(bad):
 
 
 def test_max_lockers_is_refused_for_agents_without_a_belief():
-    spec = generate_random(RandomGraphConfig(4), seed=0)
+    spec = generate_random(RandomGraphConfig(4), seed=0, box=SYMBOLIC_BOX)
     with pytest.raises(ConfigError, match="has no belief"):
         make_agent("oracle", spec, max_lockers=2)
     assert isinstance(make_agent("dual", spec, max_lockers=2).config, DualControllerConfig)
