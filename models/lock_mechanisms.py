@@ -505,38 +505,36 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
             reasons["the tubes cannot clear each other"] = reasons.get("the tubes cannot clear each other", 0) + 1
             continue
         theta, delta = fractions
-        # as much backing as the free moves leave room for (none: a plain pin, as thin as the clearance asks)
-        for chains in range(BACKING_CHAINS, -1, -1):
-            wall_offsets, rod_offsets = _backing(point, a, b, dir_a, dir_b, chains)
-            if all(
-                _free_edges_clear(_paths(point + ow, a, b, dir_a, dir_b, point + orr), theta, delta)
-                for ow in wall_offsets[1:]
-                for orr in rod_offsets
-            ) and all(
-                _free_edges_clear(_paths(point, a, b, dir_a, dir_b, point + orr), theta, delta)
-                for orr in rod_offsets[1:]
-            ):
-                break
         wall_ts = _tube_ts(-theta, 0.0, a, _radius(a, point))
         rod_ts = _tube_ts(-1.0, -delta, b, _radius(b, point))
-        # the wall and rod with every part closed: X carried back to where the parts stand at state 0; each is a
-        # slab: its axis through X and backing copies behind it, away from where the other tube comes from
+        # the wall and rod with every part closed: X carried back to where the parts stand at state 0
         q0a, q0b = a.q(first.locker_state), b.q(first.locked_state)
-        wall0 = np.stack([a.move(a.move(point + o, dir_a * a.travel * wall_ts), -q0a) for o in wall_offsets])
-        rod0 = np.stack([b.move(b.move(point + o, dir_b * b.travel * rod_ts), -q0b) for o in rod_offsets])
-        corners = [
-            np.vstack([a.move(wall0.reshape(-1, 3), a.q(sa)), b.move(rod0.reshape(-1, 3), b.q(sb))])
-            for sa in (0, 1)
-            for sb in (0, 1)
-        ]
+        wall0 = a.move(a.move(point, dir_a * a.travel * wall_ts), -q0a)
+        rod0 = b.move(b.move(point, dir_b * b.travel * rod_ts), -q0b)
+        corners = [np.vstack([a.move(wall0, a.q(sa)), b.move(rod0, b.q(sb))]) for sa in (0, 1) for sb in (0, 1)]
         exposed = float(np.vstack(corners)[:, 2].max() + TUBE_RADIUS)
-        score = (1 - theta) + delta + _exposure_cost(exposed) + 0.05 * (BACKING_CHAINS + 1 - len(wall_offsets))
+        score = (1 - theta) + delta + _exposure_cost(exposed)
         if best is None or score < best[0]:
-            best = (score, point, theta, delta, wall0, rod0, float(sine[index]), exposed)
+            best = (score, point, theta, delta, wall_ts, rod_ts, float(sine[index]), exposed)
     if best is None:
         common = max(reasons, key=reasons.__getitem__) if reasons else "no candidate"
         return f"no crossing point serves the pair (mostly: {common})"
-    _, point, theta, delta, wall0, rod0, sine, exposed = best
+    _, point, theta, delta, wall_ts, rod_ts, sine, exposed = best
+    # each tube a slab: its axis through X and as much backing behind it, away from where the other tube comes
+    # from, as the free moves leave room for (none: a plain pin, as thin as the clearance asks)
+    for chains in range(BACKING_CHAINS, -1, -1):
+        wall_offsets, rod_offsets = _backing(point, a, b, dir_a, dir_b, chains)
+        if all(
+            _free_edges_clear(_paths(point + ow, a, b, dir_a, dir_b, point + orr), theta, delta)
+            for ow in wall_offsets[1:]
+            for orr in rod_offsets
+        ) and all(
+            _free_edges_clear(_paths(point, a, b, dir_a, dir_b, point + orr), theta, delta) for orr in rod_offsets[1:]
+        ):
+            break
+    q0a, q0b = a.q(first.locker_state), b.q(first.locked_state)
+    wall0 = np.stack([a.move(a.move(point + o, dir_a * a.travel * wall_ts), -q0a) for o in wall_offsets])
+    rod0 = np.stack([b.move(b.move(point + o, dir_b * b.travel * rod_ts), -q0b) for o in rod_offsets])
     return Interlock(
         name=f"{first.locker}-interlocks-{first.locked}",
         locker=first.locker,
