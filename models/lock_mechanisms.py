@@ -267,7 +267,7 @@ def _design_latch(spec, rule: LockRule, a: JointMotion, b: JointMotion, by_name)
     """The best one-way latch for an unpaired rule, or why there is none."""
     dir_a = 1.0 if rule.locker_state == 0 else -1.0
     dir_b = 1.0 if rule.locked_state == 0 else -1.0
-    lo, hi, grid = _candidate_grid(spec, by_name[rule.locker], by_name[rule.locked])
+    lo, hi, grid = _candidate_grid(spec)
     # the parts at a and b: X in the lid frame with every part closed is where the design state puts it
     va = _velocities(a, grid) * (dir_a * a.travel)
     vb = _velocities(b, grid) * (dir_b * b.travel)
@@ -291,7 +291,6 @@ def _design_latch(spec, rule: LockRule, a: JointMotion, b: JointMotion, by_name)
     score = LATCH_GAP / nb + 0.01 / na + _distance_cost(grid, by_name, rule) + np.where(top > 0, 0.5 + 200 * top, 0)
     order = np.argsort(np.where(keep, score, np.inf))[: int(keep.sum())]
     reasons: dict[str, int] = {}
-    q_a, q_b = a.q(rule.locker_state), b.q(rule.locked_state)
     for k in order[: MAX_TRIED * 5]:
         x0 = grid[k]  # with every part closed; move it to the design state (A at a, B at b): X is fixed in space,
         # and the grid is a grid of space points, so X = x0 whatever the parts' states
@@ -314,7 +313,6 @@ def _design_latch(spec, rule: LockRule, a: JointMotion, b: JointMotion, by_name)
             frame=frame,
             crossing_cosine=float(cosine[k]),
         )
-    del q_a, q_b
     common = max(reasons, key=reasons.__getitem__) if reasons else "no candidate"
     return f"no point serves a one-way latch (mostly: {common})"
 
@@ -369,9 +367,9 @@ def _distance_cost(grid: np.ndarray, by_name, rule: LockRule) -> np.ndarray:
     return np.linalg.norm(grid[:, :2] - mid, axis=1) / 0.1
 
 
-def _candidate_grid(spec, ca, cb) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The box's inner bounds ``lo``, ``hi`` and candidate crossing points ``(n, 3)`` under the whole lid (the
-    components ``ca``, ``cb`` only for the signature's sake: where their parts move decides, not where they lie)."""
+def _candidate_grid(spec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The box's inner bounds ``lo``, ``hi`` and candidate crossing points ``(n, 3)`` under the whole lid (where
+    the parts move decides, not where they lie)."""
     length, width, height = spec.box.size
     lo = np.array([-length / 2 + BOX_MARGIN, -width / 2 + BOX_MARGIN, -height + BOX_MARGIN])
     hi = np.array([length / 2 - BOX_MARGIN, width / 2 - BOX_MARGIN, np.inf])
@@ -467,7 +465,7 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
     """The best interlock for a pair of rules, or why there is none."""
     dir_a = 1.0 if first.locker_state == 0 else -1.0  # A goes from a toward 1-a
     dir_b = 1.0 if first.locked_state == 0 else -1.0  # B goes from b toward 1-b
-    lo, hi, grid = _candidate_grid(spec, by_name[first.locker], by_name[first.locked])
+    lo, hi, grid = _candidate_grid(spec)
     va = _velocities(a, grid) * (dir_a * a.travel)  # per unit fraction of travel
     vb = _velocities(b, grid) * (dir_b * b.travel)
     na, nb = np.linalg.norm(va, axis=1), np.linalg.norm(vb, axis=1)

@@ -108,8 +108,6 @@ def _two_part_box(rules: list[tuple[str, int, str, int]]) -> PuzzleSpec:
 def _push(spec, component: str, states: dict[str, int], steps: int = 500) -> float:
     """Push ``component`` toward its other state from ``states`` with the check's bounded push, the others held;
     the largest fraction of its travel it reached."""
-    from models.lock_check import Transition  # noqa: F401  (the check is what pushes)
-
     check = _check(spec)
     index = {c.name: i for i, c in enumerate(spec.components)}
     state = sum(states[n] << index[n] for n in states)
@@ -185,8 +183,10 @@ def test_generators_draw_only_realizable_boxes_and_keep_the_paper_boxes():
         spec = generate_random(RandomGraphConfig(6, multi_locker=True, family=_all_kinds()), seed=seed)
         assert design_mechanisms(spec).complete
     # opting out keeps the first layout drawn, realizable or not
-    loose = generate_random(RandomGraphConfig(6), seed=0, box=BoxConfig(realizable=False))
-    assert loose.locks
+    loose = generate_random(RandomGraphConfig(6, family=_all_kinds()), seed=2, box=BoxConfig(realizable=False))
+    assert not design_mechanisms(loose).complete
+    drawn = generate_random(RandomGraphConfig(6, family=_all_kinds()), seed=2)
+    assert design_mechanisms(drawn).complete and drawn != loose
     assert all(design_mechanisms(s).complete for s in paper_family("all"))
 
 
