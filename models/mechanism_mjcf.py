@@ -47,6 +47,12 @@ MECHANISM_RGBA = (0.72, 0.72, 0.75, 1.0)
 """Steel grey."""
 MECHANISM_SOLIMP = (0.95, 0.99, 0.001)
 """Stiff contacts (as the latches' constraint, DESIGN.md): a bolt gives < 1 mm under the robot's push."""
+LATCH_CONTACT_SOLIMP = (0.99, 0.999, 0.001)
+"""Stiffer still for a one-way latch's tooth and lug. MuJoCo softens a contact by ``(1 - d) / d`` times an
+estimate of its inverse effective mass taken from each body's mobility averaged over directions
+(``body_invweight0``): a pawl (its own spring joint) on a light slide is estimated ~13x more mobile than it is
+along the tooth's normal, across both joints, so with ``d = 0.99`` a wheel's lug 12 mm from its axis, pushed with
+1.5 N m, sank through the tooth (``random-n8-s32``); ``d = 0.999`` holds it within 6 % of its travel."""
 MECHANISM_SOLREF = (0.004, 1.0)
 """Time constant [s] (twice the 2 ms timestep, MuJoCo's stiffest stable value) and damping ratio."""
 MECHANISM_FRICTION = (0.1, 0.005, 0.0001)
@@ -121,7 +127,8 @@ def _add_latch(root, latch: OneWayLatch, bodies, prefixes, by_name, bit: int) ->
     q_a, q_b = a.q(latch.locker_state), b.q(latch.locked_state)
     contact = {
         "contype": bit, "conaffinity": bit, "group": MECHANISM_GROUP, "rgba": list(MECHANISM_RGBA),
-        "friction": list(MECHANISM_FRICTION), "solref": list(MECHANISM_SOLREF), "solimp": list(MECHANISM_SOLIMP),
+        "friction": list(MECHANISM_FRICTION), "solref": list(MECHANISM_SOLREF),
+        "solimp": list(LATCH_CONTACT_SOLIMP),
     }  # fmt: skip
     # the pawl: its frame is (e1, e2, e3) at X, written in the locker's moving body frame
     rotation_a = np.column_stack([a.direction_to_body(latch.frame[:, i], q_a) for i in range(3)])
