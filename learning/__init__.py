@@ -3,7 +3,7 @@ baselines). Imports only ``models`` — never ``twin`` or ``skills`` (DESIGN.md,
 
 import gymnasium
 
-from learning.agents import (
+from puzzlebox.learning.agents import (
     AGENT_NAMES,
     DEEP_AGENT_NAMES,
     Agent,
@@ -13,12 +13,12 @@ from learning.agents import (
     RandomAgent,
     make_agent,
 )
-from learning.errors import ConfigError, InvalidAction, LearningError, UnknownAgent
-from learning.puzzle_env import FaultConfig, PuzzleEnv, PuzzleEnvConfig
-from learning.symbolic_world import SymbolicWorld
-from learning.trial import ActionRecord, RunResult, run_episode, summarise
+from puzzlebox.learning.errors import ConfigError, InvalidAction, LearningError, UnknownAgent
+from puzzlebox.learning.puzzle_env import FaultConfig, PuzzleEnv, PuzzleEnvConfig
+from puzzlebox.learning.symbolic_world import SymbolicWorld
+from puzzlebox.learning.trial import ActionRecord, RunResult, run_episode, summarise
 
-gymnasium.register(id="puzzlebox/Puzzle-v0", entry_point="learning.puzzle_env:PuzzleEnv")
+gymnasium.register(id="puzzlebox/Puzzle-v0", entry_point="puzzlebox.learning.puzzle_env:PuzzleEnv")
 """``gymnasium.make("puzzlebox/Puzzle-v0", spec=..., config=...)`` builds a :class:`PuzzleEnv`."""
 
 __all__ = [

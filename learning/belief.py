@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from learning.errors import ConfigError
-from learning.locker_tables import locker_free_table, open_free_rows
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.locker_tables import locker_free_table, open_free_rows
 
 
 @dataclass(frozen=True)

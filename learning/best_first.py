@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from learning.belief import Belief
+from puzzlebox.learning.belief import Belief
 
 COST_TOLERANCE = 1e-12
 """A path within this [nats] of the best one counts as equal to it: without it, the many paths of

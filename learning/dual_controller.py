@@ -16,12 +16,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from learning.belief import Belief, BeliefConfig
-from learning.errors import ConfigError
-from learning.exploration import information_values
-from learning.lock_belief import LockBelief
-from learning.multi_belief import MultiBelief
-from learning.planner import PlannerConfig, exploit_values
+from puzzlebox.learning.belief import Belief, BeliefConfig
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.exploration import information_values
+from puzzlebox.learning.lock_belief import LockBelief
+from puzzlebox.learning.multi_belief import MultiBelief
+from puzzlebox.learning.planner import PlannerConfig, exploit_values
 
 TIE_TOLERANCE = 1e-12
 MAX_LOCKERS = 3

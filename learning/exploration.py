@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from learning.lock_belief import LockBelief
+from puzzlebox.learning.lock_belief import LockBelief
 
 
 def kl_divergence(p: np.ndarray, q: np.ndarray) -> float:

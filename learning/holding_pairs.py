@@ -12,8 +12,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from learning.errors import ConfigError
-from models.disassembly_kinds import holding_states
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.models.disassembly_kinds import holding_states
 
 
 def holding_pairs(kinds: Sequence[str]) -> np.ndarray:

@@ -17,7 +17,7 @@ from typing import Protocol
 
 import numpy as np
 
-from learning.belief import BeliefConfig
+from puzzlebox.learning.belief import BeliefConfig
 
 
 class LockBelief(Protocol):

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from learning.errors import ConfigError
+from puzzlebox.learning.errors import ConfigError
 
 
 @dataclass(frozen=True, eq=False)

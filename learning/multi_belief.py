@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from learning.belief import (
+from puzzlebox.learning.belief import (
     BeliefConfig,
     block_confidence,
     block_entropy,
@@ -26,9 +26,9 @@ from learning.belief import (
     normalised_blocks,
     state_bits,
 )
-from learning.errors import ConfigError
-from learning.locker_sets import LockerSets, locker_sets
-from learning.set_prior import membership_set_prior, set_prior
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.locker_sets import LockerSets, locker_sets
+from puzzlebox.learning.set_prior import membership_set_prior, set_prior
 
 CHUNK_ENTRIES = 1 << 21
 """Joint states x hypotheses evaluated per chunk of a table (~17 MB of float64), so that tables over

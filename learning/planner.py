@@ -27,12 +27,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from learning.belief import Belief
-from learning.best_first import BestFirstPlanner
-from learning.lock_belief import LockBelief
-from learning.locker_tables import SMALL_N
-from learning.locker_tables import open_free_rows as open_free_rows  # re-exported: its home was here
-from learning.set_best_first import SetBestFirstPlanner
+from puzzlebox.learning.belief import Belief
+from puzzlebox.learning.best_first import BestFirstPlanner
+from puzzlebox.learning.lock_belief import LockBelief
+from puzzlebox.learning.locker_tables import SMALL_N
+from puzzlebox.learning.locker_tables import open_free_rows as open_free_rows  # re-exported: its home was here
+from puzzlebox.learning.set_best_first import SetBestFirstPlanner
 
 EXACT_MAX_COMPONENTS = 18
 """Largest N planned by value iteration over all 2^N states (2^18 states x N floats: ~40 MB)."""

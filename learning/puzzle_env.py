@@ -16,10 +16,10 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from learning.errors import ConfigError, InvalidAction
-from models import LockTable, PuzzleSpec
-from models.disassembly_kinds import family_kind_names
-from models.geometry import wrap_angle
+from puzzlebox.learning.errors import ConfigError, InvalidAction
+from puzzlebox.models import LockTable, PuzzleSpec
+from puzzlebox.models.disassembly_kinds import family_kind_names
+from puzzlebox.models.geometry import wrap_angle
 
 
 @dataclass(frozen=True)

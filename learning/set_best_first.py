@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from learning.best_first import HEURISTIC_SHAVE, BestFirstPlanner
-from learning.lock_belief import LockBelief
+from puzzlebox.learning.best_first import HEURISTIC_SHAVE, BestFirstPlanner
+from puzzlebox.learning.lock_belief import LockBelief
 
 
 class SetBestFirstPlanner(BestFirstPlanner):

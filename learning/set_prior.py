@@ -24,9 +24,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from learning.belief import hypothesis_count
-from learning.errors import ConfigError
-from learning.locker_sets import LockerSets
+from puzzlebox.learning.belief import hypothesis_count
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.locker_sets import LockerSets
 
 
 def set_prior(single_probs: np.ndarray, sets: LockerSets) -> np.ndarray:

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from learning.puzzle_env import PuzzleEnv, PuzzleEnvConfig
-from models import ComponentObservation, PuzzleSpec, SceneObservation, TryResult
+from puzzlebox.learning.puzzle_env import PuzzleEnv, PuzzleEnvConfig
+from puzzlebox.models import ComponentObservation, PuzzleSpec, SceneObservation, TryResult
 
 
 class SymbolicWorld:

@@ -9,8 +9,8 @@ from typing import Any
 
 import numpy as np
 
-from learning.agents.base import Agent
-from models import World
+from puzzlebox.learning.agents.base import Agent
+from puzzlebox.models import World
 
 MAX_FAILURES_IN_A_ROW = 3
 """A run ends when one component fails this many tries in a row (each already retried by the world):

@@ -7,7 +7,7 @@ import os
 # renders on the CPU here); a user's own MUJOCO_GL wins.
 os.environ.setdefault("MUJOCO_GL", "egl")
 
-from models.errors import (
+from puzzlebox.models.errors import (
     GeneratorError,
     ModelsError,
     ReachabilityUndecided,
@@ -15,16 +15,16 @@ from models.errors import (
     SpecProblem,
     UnknownKindError,
 )
-from models.kinds import ALLOWED_NEIGHBOURS, KIND_NAMES, PUZZLE_KINDS, KindTemplate, get_kind, kind_code
-from models.lock_table import LockTable
-from models.observation import ComponentObservation, SceneObservation
-from models.robot import CameraImage, Robot
-from models.spec import SPEC_FORMAT, Box, Component, Goal, LockRule, PuzzleSpec, save_spec
-from models.spec_loading import load_spec, spec_from_dict, spec_from_json
-from models.toggle_log import ToggleLog, load_toggles, save_toggles
-from models.try_outcome import OUTCOMES, Outcome, TryResult
-from models.validation import validate_data
-from models.world import World
+from puzzlebox.models.kinds import ALLOWED_NEIGHBOURS, KIND_NAMES, PUZZLE_KINDS, KindTemplate, get_kind, kind_code
+from puzzlebox.models.lock_table import LockTable
+from puzzlebox.models.observation import ComponentObservation, SceneObservation
+from puzzlebox.models.robot import CameraImage, Robot
+from puzzlebox.models.spec import SPEC_FORMAT, Box, Component, Goal, LockRule, PuzzleSpec, save_spec
+from puzzlebox.models.spec_loading import load_spec, spec_from_dict, spec_from_json
+from puzzlebox.models.toggle_log import ToggleLog, load_toggles, save_toggles
+from puzzlebox.models.try_outcome import OUTCOMES, Outcome, TryResult
+from puzzlebox.models.validation import validate_data
+from puzzlebox.models.world import World
 
 __all__ = [
     "ALLOWED_NEIGHBOURS",

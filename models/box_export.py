@@ -23,11 +23,11 @@ from pathlib import Path
 import mujoco
 from dm_control import mjcf
 
-from models.atomic import write_atomically, write_text_atomically
-from models.errors import ModelsError
-from models.mechanism_mjcf import LOCK_MODES, LockMode
-from models.puzzle_box import build_puzzle_box, component_prefixes
-from models.spec import PuzzleSpec
+from puzzlebox.models.atomic import write_atomically, write_text_atomically
+from puzzlebox.models.errors import ModelsError
+from puzzlebox.models.mechanism_mjcf import LOCK_MODES, LockMode
+from puzzlebox.models.puzzle_box import build_puzzle_box, component_prefixes
+from puzzlebox.models.spec import PuzzleSpec
 
 __all__ = ["BOX_XML", "TIMESTEP", "NotAPuzzleBox", "build_box_model", "compile_box", "export_box"]
 

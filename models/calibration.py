@@ -24,8 +24,8 @@ from typing import Any
 
 import numpy as np
 
-from models.atomic import write_text_atomically
-from models.errors import ModelsError
+from puzzlebox.models.atomic import write_text_atomically
+from puzzlebox.models.errors import ModelsError
 
 CALIBRATION_FORMAT = "puzzlebox-calibration/1"
 

@@ -27,8 +27,8 @@ from typing import Any
 
 import cv2
 
-from models.atomic import write_text_atomically
-from models.errors import ModelsError
+from puzzlebox.models.atomic import write_text_atomically
+from puzzlebox.models.errors import ModelsError
 
 CELL_CONFIG_FORMAT = "puzzlebox-cell/1"
 STOP_FORCE_FACTOR = 1.5

@@ -39,8 +39,8 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
-from models.errors import ModelsError
-from models.markers import add_png_material, aruco_dictionary, png_bytes
+from puzzlebox.models.errors import ModelsError
+from puzzlebox.models.markers import add_png_material, aruco_dictionary, png_bytes
 
 if TYPE_CHECKING:
     from dm_control import mjcf

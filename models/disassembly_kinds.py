@@ -37,8 +37,8 @@ relations).
 
 from __future__ import annotations
 
-from models.errors import UnknownKindError
-from models.kinds import KIND_NAMES, registered_kinds, registry_family
+from puzzlebox.models.errors import UnknownKindError
+from puzzlebox.models.kinds import KIND_NAMES, registered_kinds, registry_family
 
 DISASSEMBLY_FAMILY = "disassembly"
 """Name of this kind family."""

@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from models.spec import PuzzleSpec
-from models.spec_loading import spec_from_dict
+from puzzlebox.models.spec import PuzzleSpec
+from puzzlebox.models.spec_loading import spec_from_dict
 
 
 @dataclass(frozen=True)

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.kinds.parts import PLATE_THICKNESS
-from models.kinds.template import KindTemplate
+from puzzlebox.models.kinds.parts import PLATE_THICKNESS
+from puzzlebox.models.kinds.template import KindTemplate
 
 __all__ = ["JointMotion"]
 

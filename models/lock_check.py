@@ -19,8 +19,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from models.lock_table import LockTable
-from models.spec import PuzzleSpec
+from puzzlebox.models.lock_table import LockTable
+from puzzlebox.models.spec import PuzzleSpec
 
 __all__ = [
     "FREE_FRACTION",

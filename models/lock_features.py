@@ -41,13 +41,13 @@ from typing import Literal
 import numpy as np
 import trimesh
 
-from models.errors import UnknownKindError
-from models.geometry import circle_polygon, polygon_gap, rectangle, transform_points
-from models.kinds.parts import PLATE_THICKNESS
-from models.kinds.registry import get_kind
-from models.kinds.template import HANDLE_SIZE, MARKER_SIZE, KindTemplate
-from models.lock_table import LockTable
-from models.spec import LockRule, PuzzleSpec
+from puzzlebox.models.errors import UnknownKindError
+from puzzlebox.models.geometry import circle_polygon, polygon_gap, rectangle, transform_points
+from puzzlebox.models.kinds.parts import PLATE_THICKNESS
+from puzzlebox.models.kinds.registry import get_kind
+from puzzlebox.models.kinds.template import HANDLE_SIZE, MARKER_SIZE, KindTemplate
+from puzzlebox.models.lock_table import LockTable
+from puzzlebox.models.spec import LockRule, PuzzleSpec
 
 __all__ = [
     "BOLT_KINDS",

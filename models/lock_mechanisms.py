@@ -39,10 +39,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from models.errors import UnknownKindError
-from models.joint_motion import JointMotion
-from models.kinds.registry import get_kind
-from models.spec import LockRule, PuzzleSpec
+from puzzlebox.models.errors import UnknownKindError
+from puzzlebox.models.joint_motion import JointMotion
+from puzzlebox.models.kinds.registry import get_kind
+from puzzlebox.models.spec import LockRule, PuzzleSpec
 
 __all__ = [
     "GAP",

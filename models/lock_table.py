@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.errors import ReachabilityUndecided
-from models.spec import PuzzleSpec
+from puzzlebox.models.errors import ReachabilityUndecided
+from puzzlebox.models.spec import PuzzleSpec
 
 DENSE_SEARCH_MAX_COMPONENTS = 22
 """Up to this many components, reachability uses a dense parent array (8 * 2**N bytes)."""

@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
-from models.errors import ModelsError
+from puzzlebox.models.errors import ModelsError
 
 if TYPE_CHECKING:
     from dm_control import mjcf

@@ -19,10 +19,10 @@ from typing import TYPE_CHECKING, Literal
 import mujoco
 import numpy as np
 
-from models.joint_motion import JointMotion
-from models.kinds.parts import PART_DENSITY
-from models.kinds.registry import get_kind
-from models.lock_mechanisms import (
+from puzzlebox.models.joint_motion import JointMotion
+from puzzlebox.models.kinds.parts import PART_DENSITY
+from puzzlebox.models.kinds.registry import get_kind
+from puzzlebox.models.lock_mechanisms import (
     TOOTH_HALF_WIDTH,
     TOOTH_RISE,
     Interlock,
@@ -30,7 +30,7 @@ from models.lock_mechanisms import (
     OneWayLatch,
     design_mechanisms,
 )
-from models.spec import PuzzleSpec
+from puzzlebox.models.spec import PuzzleSpec
 
 if TYPE_CHECKING:
     from dm_control import mjcf

@@ -52,13 +52,13 @@ import numpy as np
 import scipy.spatial
 import trimesh
 
-from models.atomic import write_atomically
-from models.errors import ModelsError
-from models.lock_features import lock_features as features_of
-from models.mechanism_mjcf import LockMode
-from models.puzzle_box import component_prefixes
-from models.scene import BOX, SceneConfig, build_scene
-from models.spec import PuzzleSpec
+from puzzlebox.models.atomic import write_atomically
+from puzzlebox.models.errors import ModelsError
+from puzzlebox.models.lock_features import lock_features as features_of
+from puzzlebox.models.mechanism_mjcf import LockMode
+from puzzlebox.models.puzzle_box import component_prefixes
+from puzzlebox.models.scene import BOX, SceneConfig, build_scene
+from puzzlebox.models.spec import PuzzleSpec
 
 BOX_PART = "box"
 """Name of the part holding the box shell (the geoms no component carries)."""

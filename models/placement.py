@@ -8,8 +8,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from models.scene import SceneConfig, SceneError, unreachable_handles
-from models.spec import PuzzleSpec
+from puzzlebox.models.scene import SceneConfig, SceneError, unreachable_handles
+from puzzlebox.models.spec import PuzzleSpec
 
 
 @dataclass(frozen=True)

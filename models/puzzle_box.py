@@ -27,13 +27,13 @@ import re
 import numpy as np
 from dm_control import mjcf
 
-from models.geometry import upright_pose
-from models.kinds.parts import PLATE_THICKNESS
-from models.kinds.registry import registered_kind
-from models.kinds.template import HANDLE_HEIGHT
-from models.markers import add_marker_geom
-from models.mechanism_mjcf import LOCK_MODES, LockMode, add_mechanisms
-from models.spec import PuzzleSpec
+from puzzlebox.models.geometry import upright_pose
+from puzzlebox.models.kinds.parts import PLATE_THICKNESS
+from puzzlebox.models.kinds.registry import registered_kind
+from puzzlebox.models.kinds.template import HANDLE_HEIGHT
+from puzzlebox.models.markers import add_marker_geom
+from puzzlebox.models.mechanism_mjcf import LOCK_MODES, LockMode, add_mechanisms
+from puzzlebox.models.spec import PuzzleSpec
 
 MARKER_Z = PLATE_THICKNESS + 0.0005
 """Height of the marker's top face above the lid [m] (just proud of the plate so it never z-fights)."""
@@ -139,7 +139,7 @@ def _add_lock_features(
     root: mjcf.RootElement, spec: PuzzleSpec, bodies: dict[str, mjcf.Element], prefixes: dict[str, str]
 ) -> None:
     """Each lock feature as a visual-only mesh geom in its locker's body (see :func:`build_puzzle_box`)."""
-    from models.lock_features import lock_features as features_of  # imports trimesh only when asked
+    from puzzlebox.models.lock_features import lock_features as features_of  # imports trimesh only when asked
 
     poses = {c.name: c.pose for c in spec.components}
     for feature in features_of(spec):

@@ -14,8 +14,8 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from models.kinds import get_kind
-from models.spec import PuzzleSpec
+from puzzlebox.models.kinds import get_kind
+from puzzlebox.models.spec import PuzzleSpec
 
 MIN_REACH = 0.20
 """Closest a handle may be to the robot's base axis, horizontally [m]."""

@@ -16,12 +16,12 @@ import mujoco
 import numpy as np
 from dm_control import mjcf
 
-from models import reach
-from models.errors import ModelsError
-from models.kinds import get_kind
-from models.puzzle_box import LockMode, build_puzzle_box, component_prefixes, lid_to_world, yaw_quat
-from models.spec import PuzzleSpec
-from models.xarm7 import ARM_JOINTS, XArm7Config, build_xarm7, compensate_gravity
+from puzzlebox.models import reach
+from puzzlebox.models.errors import ModelsError
+from puzzlebox.models.kinds import get_kind
+from puzzlebox.models.puzzle_box import LockMode, build_puzzle_box, component_prefixes, lid_to_world, yaw_quat
+from puzzlebox.models.spec import PuzzleSpec
+from puzzlebox.models.xarm7 import ARM_JOINTS, XArm7Config, build_xarm7, compensate_gravity
 
 DEFAULT_BOX_POSE = (0.45, 0.0, 0.0)
 """Where the box stands when the spec leaves ``box.pose`` out: centred 45 cm in front of the robot [m, m, rad]."""
@@ -192,7 +192,7 @@ def build_scene(spec: PuzzleSpec, config: SceneConfig | None = None) -> Scene:
     x, y, yaw = box_pose
     world.add("site", name="box_mount", pos=[x, y, height], quat=yaw_quat(yaw), size=[0.001], group=4).attach(box_model)
     if config.calibration_board:
-        from models.charuco import add_board_body
+        from puzzlebox.models.charuco import add_board_body
 
         add_board_body(world)
     return Scene(spec, root, _names(spec), tuple(box_pose), T_world_lid, config)

@@ -14,9 +14,9 @@ from typing import Any
 
 import numpy as np
 
-from models.atomic import write_text_atomically
-from models.disassembly_kinds import DISASSEMBLY_FAMILY, DISASSEMBLY_KINDS, PUZZLE_BOX_FAMILY
-from models.geometry import compose, wrap_angle
+from puzzlebox.models.atomic import write_text_atomically
+from puzzlebox.models.disassembly_kinds import DISASSEMBLY_FAMILY, DISASSEMBLY_KINDS, PUZZLE_BOX_FAMILY
+from puzzlebox.models.geometry import compose, wrap_angle
 
 SPEC_FORMAT = "puzzlebox-spec/1"
 """The only value of the ``format`` field this version reads and writes."""

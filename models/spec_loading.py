@@ -8,9 +8,9 @@ import json
 from pathlib import Path
 from typing import Any
 
-from models.errors import SpecError, SpecProblem
-from models.spec import PuzzleSpec, build_from_valid_data
-from models.validation import validate_data
+from puzzlebox.models.errors import SpecError, SpecProblem
+from puzzlebox.models.spec import PuzzleSpec, build_from_valid_data
+from puzzlebox.models.validation import validate_data
 
 
 def spec_from_dict(data: Any, source: str | None = None) -> PuzzleSpec:

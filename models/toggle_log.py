@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from models.atomic import write_atomically
+from puzzlebox.models.atomic import write_atomically
 
 PHASES: tuple[str, ...] = ("moving", "approaching", "descending", "grasping", "actuating", "retreating")
 """What the primitive may be doing at a tick (``skills.primitives.Toggler.phase``); a log stores the index."""

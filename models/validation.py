@@ -18,14 +18,14 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from models.disassembly_kinds import DISASSEMBLY_KIND_NAMES, DISASSEMBLY_KINDS, DISASSEMBLY_POSE_SIZE
-from models.errors import ReachabilityUndecided, SpecProblem
-from models.geometry import polygon_gap
-from models.kinds import get_kind, registered_kinds
-from models.kinds.template import KindTemplate
-from models.lock_table import LockTable
-from models.markers import MAX_MARKER_ID
-from models.spec import SPEC_FORMAT, build_from_valid_data
+from puzzlebox.models.disassembly_kinds import DISASSEMBLY_KIND_NAMES, DISASSEMBLY_KINDS, DISASSEMBLY_POSE_SIZE
+from puzzlebox.models.errors import ReachabilityUndecided, SpecProblem
+from puzzlebox.models.geometry import polygon_gap
+from puzzlebox.models.kinds import get_kind, registered_kinds
+from puzzlebox.models.kinds.template import KindTemplate
+from puzzlebox.models.lock_table import LockTable
+from puzzlebox.models.markers import MAX_MARKER_ID
+from puzzlebox.models.spec import SPEC_FORMAT, build_from_valid_data
 
 MAX_COMPONENTS = 62
 """Symbolic states are 64-bit bitmasks; more components than this cannot be represented."""

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from typing import Protocol, runtime_checkable
 
-from models.observation import SceneObservation
-from models.try_outcome import TryResult
+from puzzlebox.models.observation import SceneObservation
+from puzzlebox.models.try_outcome import TryResult
 
 
 @runtime_checkable

@@ -29,7 +29,7 @@ from pathlib import Path
 import mujoco
 from dm_control import mjcf
 
-from models.errors import ModelsError
+from puzzlebox.models.errors import ModelsError
 
 ROBOSUITE_VERSION = "1.5.2"
 ARM_JOINTS = tuple(f"joint{i}" for i in range(1, 8))

@@ -3,8 +3,8 @@
 Importing this package imports no SDK: :class:`XArmRobot` imports ``xarm-python-sdk`` when it is constructed.
 """
 
-from real import errors
-from real.errors import *  # noqa: F403 - the typed errors, listed in real.errors.__all__
-from real.xarm_driver import XARM_CONTROL_PORT, XArmRobot, probe_controller
+from puzzlebox.real import errors
+from puzzlebox.real.errors import *  # noqa: F403 - the typed errors, listed in real.errors.__all__
+from puzzlebox.real.xarm_driver import XARM_CONTROL_PORT, XArmRobot, probe_controller
 
 __all__ = [*errors.__all__, "XARM_CONTROL_PORT", "XArmRobot", "probe_controller"]

@@ -40,9 +40,9 @@ from typing import Any
 
 import numpy as np
 
-from models.cell_config import CellConfig
-from models.robot import CameraImage
-from real.errors import (
+from puzzlebox.models.cell_config import CellConfig
+from puzzlebox.models.robot import CameraImage
+from puzzlebox.real.errors import (
     ArmStopped,
     ArmUnreachable,
     CommandRefused,

@@ -16,7 +16,7 @@
   first in the process (renderer, scene and IK model built) and a second one (kept from the first);
 - twin trial outputs: wall time of the same oracle trial plain, with ``--video`` and with ``--record``, in turn
   (medians of 3), and the ratios to plain; the rollout views' box visibility over every frame of 5 trials;
-- scale (``scripts/_bench_scale.py``): each executor's overhead per no-op task, and twin trials per hour of
+- scale (``puzzlebox/lab/bench_scale.py``): each executor's overhead per no-op task, and twin trials per hour of
   the same T oracle trials on one worker, on a local pool (one worker per core) and on a local Ray cluster,
   one after the other in this run, with each one's speed-up over one worker: start-up included, and warm
   (after one trial per worker).
@@ -36,13 +36,13 @@ import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
-from _cli import fail, versions, write_json  # noqa: E402
 
-from learning import DualAgent, PuzzleEnv, PuzzleEnvConfig, SymbolicWorld  # noqa: E402
-from learning.dual_controller import DualControllerConfig  # noqa: E402
-from models.generator import RandomGraphConfig, generate_random  # noqa: E402
-from models.generator.chain import MAX_REACHABLE_COMPONENTS, BoxConfig  # noqa: E402
-from models.spec_loading import load_spec  # noqa: E402
+from puzzlebox.lab.cli import fail, versions, write_json  # noqa: E402
+from puzzlebox.learning import DualAgent, PuzzleEnv, PuzzleEnvConfig, SymbolicWorld  # noqa: E402
+from puzzlebox.learning.dual_controller import DualControllerConfig  # noqa: E402
+from puzzlebox.models.generator import RandomGraphConfig, generate_random  # noqa: E402
+from puzzlebox.models.generator.chain import MAX_REACHABLE_COMPONENTS, BoxConfig  # noqa: E402
+from puzzlebox.models.spec_loading import load_spec  # noqa: E402
 
 SIZES = (5, 10, 16, 32)
 
@@ -134,10 +134,10 @@ def env_steps_per_second(seconds: float = 1.0) -> float:
 def twin_figures(quick: bool) -> dict[str, float]:
     import mujoco
 
-    from models.generator import paper_family
-    from models.scene import build_scene
-    from twin.rendering import RenderConfig, Renderer
-    from twin.session import TwinSession
+    from puzzlebox.models.generator import paper_family
+    from puzzlebox.models.scene import build_scene
+    from puzzlebox.twin.rendering import RenderConfig, Renderer
+    from puzzlebox.twin.session import TwinSession
 
     specs = paper_family("test")
     build_times = []
@@ -185,9 +185,8 @@ def twin_trial_figures(quick: bool) -> dict[str, float]:
     """Simulated over wall time of oracle twin trials on the first paper test box, ideal cell: a first trial
     in this process and, unless ``quick``, a second one with what the process kept from the first. Quick: one
     try after the survey instead of the whole box."""
-    from _twin_trial import run_twin_trial
-
-    from models.generator import paper_family
+    from puzzlebox.lab.twin_trial import run_twin_trial
+    from puzzlebox.models.generator import paper_family
 
     spec = paper_family("test")[0]
     out: dict[str, float] = {}
@@ -207,9 +206,8 @@ def rollout_figures(quick: bool) -> dict[str, float]:
     warm-up trial, ``repeats`` times each: medians and the ratios to plain (targets x1.5 and x1.3)."""
     import tempfile
 
-    from _twin_trial import run_twin_trial
-
-    from models.generator import paper_family
+    from puzzlebox.lab.twin_trial import run_twin_trial
+    from puzzlebox.models.generator import paper_family
 
     spec = paper_family("test")[0]
     repeats = 1 if quick else 3
@@ -235,10 +233,9 @@ def box_visibility_figures(quick: bool) -> dict[str, float]:
     trials (the 3 paper test boxes and two five-kind chains; quick: one), every frame's state kept, and per frame
     the best view's share of the box's pixels seen with the arm against the same view without it (MuJoCo's
     segmentation rendering, :meth:`twin.rollout_video.RolloutDrawer.box_visibility`)."""
-    import _twin_trial
-
-    from models.generator import generate_chain, paper_family
-    from twin.rollout_video import FrameCollector, RolloutDrawer
+    from puzzlebox.lab import twin_trial as _twin_trial
+    from puzzlebox.models.generator import generate_chain, paper_family
+    from puzzlebox.twin.rollout_video import FrameCollector, RolloutDrawer
 
     specs = [*paper_family("test"), generate_chain(["lever", "slide", "door", "drawer", "wheel"], seed=0),
              generate_chain(["wheel", "drawer", "lever", "door", "slide"], seed=3)][: 1 if quick else 5]  # fmt: skip
@@ -318,7 +315,7 @@ def main(argv: list[str] | None = None) -> int:
     path = write_json(Path(args.out), results)  # what is measured so far is kept if the scale part fails
     trials = args.scale_trials if args.scale_trials is not None else (4 if args.quick else 40)
     if trials:
-        from _bench_scale import overhead_ms, twin_throughput
+        from puzzlebox.lab.bench_scale import overhead_ms, twin_throughput
 
         results["executor_overhead_ms_per_noop_task"] = overhead = overhead_ms(50 if args.quick else 200)
         print("per-task overhead on no-op tasks: " + ", ".join(f"{k} {v:.2f} ms" for k, v in overhead.items()))

@@ -29,7 +29,7 @@ import dataclasses
 import time
 from pathlib import Path
 
-from _cli import fail, one_line, versions, write_json
+from puzzlebox.lab.cli import fail, one_line, versions, write_json
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -54,10 +54,10 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
 
 
 def load_inputs(args: argparse.Namespace):
-    from models import ModelsError, load_spec
-    from models.generator import paper_family
-    from twin.errors import TwinError
-    from twin.reality import load_profile
+    from puzzlebox.models import ModelsError, load_spec
+    from puzzlebox.models.generator import paper_family
+    from puzzlebox.twin.errors import TwinError
+    from puzzlebox.twin.reality import load_profile
 
     try:
         spec = load_spec(args.spec) if args.spec is not None else paper_family("test", seed=0)[0]
@@ -77,7 +77,7 @@ def main(argv: list[str] | None = None) -> int:
     spec, profile = load_inputs(args)
     start = time.perf_counter()
 
-    from _calibration_run import CellCalibrationError, calibrate_cell
+    from puzzlebox.lab.calibration_run import CellCalibrationError, calibrate_cell
 
     try:
         run = calibrate_cell(spec, profile, args.seed, args.overview_views, args.wrist_views)

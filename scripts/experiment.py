@@ -24,7 +24,7 @@ a time (default: one per core; ``--ray auto|ADDRESS``: on Ray). Every finished j
 ``DIR/jobs/`` at once: run the same command again after an
 interruption and it resumes, reusing every finished job.
 
-``reality`` (``scripts/_reality_sweep.py``) runs the memory agent end to end in the twin on the paper
+``reality`` (``puzzlebox/lab/reality_sweep.py``) runs the memory agent end to end in the twin on the paper
 test boxes at ``--runs`` random reachable placements each (default 4), with each factor of the reality
 gap alone at levels 0 (ideal), 1 (realistic) and 2 (harsh), all factors together, and the F/T force noise
 alone over σ; each profile's cell is calibrated from ChArUco images first. It writes
@@ -33,7 +33,7 @@ factor's level; the F/T noise at which outcome agreement drops below 99 %) and k
 trial in ``DIR/calibrations/`` and ``DIR/trials/``: the same command resumes. ``--memory`` is the memory
 agent's store (default: trained into ``DIR/memory.sqlite`` on the paper training boxes).
 
-``sysid`` (``scripts/_sysid.py``) identifies the box's per-kind joint damping, joint friction and latch
+``sysid`` (``puzzlebox/lab/sysid.py``) identifies the box's per-kind joint damping, joint friction and latch
 compliance from logged robot data of toggles (oracle trials in the twin under ``realistic``, three cells) and
 reports the nominal and the fitted twin's prediction errors of the wrench and the part's motion on held-out
 toggles: ``DIR/sysid.{json,md,png}``, every trial's log in ``DIR/logs/``; the same command resumes.
@@ -48,12 +48,12 @@ against training episodes (memory: 1-20, with the paper's one-locker belief and 
 chosen); ``--no-holding-rule`` lets the belief agents believe that a removed part holds another (the paper's
 hypothesis space, an ablation).
 
-``kinds`` (``scripts/_kinds_experiment.py``) runs boxes mixing every registered kind (door, slide, wheel,
+``kinds`` (``puzzlebox/lab/kinds_experiment.py``) runs boxes mixing every registered kind (door, slide, wheel,
 drawer, lever): every five-kind chain and 100 random boxes symbolically, and 3 held-out chains end to end in the
 twin under ``ideal`` and ``realistic``, by the memory agent trained on the other chains:
 ``DIR/kinds.{json,md,png}``; every step resumes.
 
-``faults`` (``scripts/_faults.py``) runs each fault class on purpose in real processes — ``trial.py``
+``faults`` (``puzzlebox/lab/faults.py``) runs each fault class on purpose in real processes — ``trial.py``
 SIGKILLed at random moments and resumed (``--runs`` runs in the twin; ``--quick``: symbolic), concurrent
 trainers on one memory, a memory truncated at every page, the ordinary command-line mistakes — and writes
 ``DIR/faults.{json,md}``: cases, detected, survived, data kept.
@@ -67,13 +67,25 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
-from _cli import fail, versions, write_json
-
-from learning.agents.factory import POSE_ENCODINGS
-from learning.errors import LearningError
-from learning.experiments import PROTOCOLS, SYMBOLIC_AGENTS, ProtocolConfig, comparison_table, plot, results_table
-from learning.experiments.deep_protocols import DEEP_AGENTS, DeepSchedule, jobs_for, merge_deep_points, run_jobs
-from learning.experiments.report import episodes_to_solve_table
+from puzzlebox.lab.cli import fail, versions, write_json
+from puzzlebox.learning.agents.factory import POSE_ENCODINGS
+from puzzlebox.learning.errors import LearningError
+from puzzlebox.learning.experiments import (
+    PROTOCOLS,
+    SYMBOLIC_AGENTS,
+    ProtocolConfig,
+    comparison_table,
+    plot,
+    results_table,
+)
+from puzzlebox.learning.experiments.deep_protocols import (
+    DEEP_AGENTS,
+    DeepSchedule,
+    jobs_for,
+    merge_deep_points,
+    run_jobs,
+)
+from puzzlebox.learning.experiments.report import episodes_to_solve_table
 
 DISASSEMBLY = "disassembly"
 REALITY = "reality"
@@ -188,7 +200,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _reality(args: argparse.Namespace) -> int:
-    from _reality_sweep import SweepConfig, run_sweep
+    from puzzlebox.lab.reality_sweep import SweepConfig, run_sweep
 
     if args.agents not in (None, "memory"):
         fail(f"the reality protocol runs the memory agent only, got --agents {args.agents}")
@@ -212,7 +224,7 @@ def _reality(args: argparse.Namespace) -> int:
 
 
 def _twin_learning(args: argparse.Namespace) -> int:
-    from _twin_learning import TwinLearningConfig, run_twin_learning
+    from puzzlebox.lab.twin_learning import TwinLearningConfig, run_twin_learning
 
     if args.memory is not None:
         fail("the twin-learning protocol runs the memory agent from its own memories (no --memory)")
@@ -240,7 +252,7 @@ def _twin_learning(args: argparse.Namespace) -> int:
 
 
 def _kinds(args: argparse.Namespace) -> int:
-    from _kinds_experiment import KindsConfig, run_kinds
+    from puzzlebox.lab.kinds_experiment import KindsConfig, run_kinds
 
     given = [f"--{k}" for k in ("agents", "seeds", "ray", "memory") if getattr(args, k) is not None]
     if given:
@@ -255,7 +267,7 @@ def _kinds(args: argparse.Namespace) -> int:
 
 
 def _sysid(args: argparse.Namespace) -> int:
-    from _sysid import SysIdConfig, run_sysid
+    from puzzlebox.lab.sysid import SysIdConfig, run_sysid
 
     given = [f"--{name}" for name in ("agents", "runs", "seeds", "ray", "memory") if getattr(args, name) is not None]
     if given:
@@ -283,10 +295,10 @@ def _sysid(args: argparse.Namespace) -> int:
 
 
 def _disassembly(args: argparse.Namespace) -> int:
-    from learning.experiments.disassembly import AGENTS as DISASSEMBLY_AGENTS
-    from learning.experiments.disassembly import DisassemblyConfig, run_disassembly
-    from learning.experiments.disassembly_report import plot as plot_disassembly
-    from learning.experiments.disassembly_report import table as disassembly_table
+    from puzzlebox.learning.experiments.disassembly import AGENTS as DISASSEMBLY_AGENTS
+    from puzzlebox.learning.experiments.disassembly import DisassemblyConfig, run_disassembly
+    from puzzlebox.learning.experiments.disassembly_report import plot as plot_disassembly
+    from puzzlebox.learning.experiments.disassembly_report import table as disassembly_table
 
     if args.memory is not None:
         fail("the disassembly protocol trains its own memories (no --memory)")
@@ -315,7 +327,7 @@ def _disassembly(args: argparse.Namespace) -> int:
 
 
 def _faults(args: argparse.Namespace) -> int:
-    from _faults import FaultsConfig, run_faults
+    from puzzlebox.lab.faults import FaultsConfig, run_faults
 
     if any(v is not None for v in (args.agents, args.seeds, args.workers, args.ray, args.memory)):
         fail("the faults protocol takes only --out, --quick and --runs")

@@ -49,24 +49,24 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from _cli import fail, one_line
 from tqdm import tqdm
 
-from models import LockRule, LockTable, ModelsError, PuzzleSpec, SpecError, load_spec, save_spec
-from models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random, paper_family
-from models.kinds import family_named
-from models.mechanism_mjcf import LOCK_MODES, mechanism_layout
+from puzzlebox.lab.cli import fail, one_line
+from puzzlebox.models import LockRule, LockTable, ModelsError, PuzzleSpec, SpecError, load_spec, save_spec
+from puzzlebox.models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random, paper_family
+from puzzlebox.models.kinds import family_named
+from puzzlebox.models.mechanism_mjcf import LOCK_MODES, mechanism_layout
 
 if TYPE_CHECKING:
     import mujoco
 
-    from models.lock_check import LockCheck
+    from puzzlebox.models.lock_check import LockCheck
 
 
 def _write(spec: PuzzleSpec, path: Path, plot: bool) -> None:
     print(f"wrote {save_spec(spec, path)}  ({'-'.join(spec.kinds)})")
     if plot:
-        from _spec_plot import plot_spec  # matplotlib only when asked
+        from puzzlebox.lab.spec_plot import plot_spec  # matplotlib only when asked
 
         print(f"wrote {plot_spec(spec, path.with_suffix('.png'))}")
 
@@ -86,10 +86,9 @@ def _chain(args: argparse.Namespace) -> None:
 
 def _dataset(args: argparse.Namespace, generator: dict) -> None:
     """``--count N``: N specs (seeds S..S+N-1) and a manifest in the directory ``--out``, made in parallel."""
-    from _dataset import spec_task, write_manifest, write_spec
-    from _interrupt import StopRequests
-
-    from learning.runner import RunnerError, make_executor
+    from puzzlebox.lab.dataset import spec_task, write_manifest, write_spec
+    from puzzlebox.lab.interrupt import StopRequests
+    from puzzlebox.learning.runner import RunnerError, make_executor
 
     if args.count < 1:
         fail(f"--count must be >= 1, got {args.count}")
@@ -108,7 +107,7 @@ def _dataset(args: argparse.Namespace, generator: dict) -> None:
                     fail(f"seed {done.task.settings['seed']}: {str(done.payload).splitlines()[0]}")
                 path = write_spec(out, done.payload)
                 if args.plot:
-                    from _spec_plot import plot_spec
+                    from puzzlebox.lab.spec_plot import plot_spec
 
                     plot_spec(load_spec(path), path.with_suffix(".png"))
                 entries.append(done.payload["entry"])
@@ -166,11 +165,11 @@ def _mjcf(args: argparse.Namespace) -> None:
     spec = _load_box_spec(args.spec)
     try:
         if args.box_only:
-            from models.box_export import export_box  # MuJoCo only when asked
+            from puzzlebox.models.box_export import export_box  # MuJoCo only when asked
 
             path = export_box(spec, args.out, locks=args.locks)
         else:
-            from models.scene import SceneConfig, build_scene
+            from puzzlebox.models.scene import SceneConfig, build_scene
 
             path = build_scene(spec, SceneConfig(locks=args.locks)).export(args.out)
     except ModelsError as err:  # an unknown kind, a box pose out of the robot's reach
@@ -185,9 +184,8 @@ def _mjcf(args: argparse.Namespace) -> None:
 def _check_locks(args: argparse.Namespace) -> int:
     """Push every part of each box from every reachable state (``models.lock_check``): one line per box, one per
     disagreement; exit 1 if any transition disagrees, 2 if a box could not be built."""
-    from _cli import write_json
-
-    from models.lock_check import check_locks  # MuJoCo only when asked
+    from puzzlebox.lab.cli import write_json
+    from puzzlebox.models.lock_check import check_locks  # MuJoCo only when asked
 
     loaded = [(file, _box_spec(file)) for file in args.specs]  # every file read before any box is built
     problems = [spec for _, spec in loaded if isinstance(spec, str)]
@@ -233,10 +231,10 @@ def _check_locks(args: argparse.Namespace) -> int:
 def _compiled(spec: PuzzleSpec, locks: str, with_robot: bool) -> tuple[mujoco.MjModel, dict[str, str]]:
     """The compiled model of ``spec`` (the box alone, or the whole scene) and each component's joint name."""
     if not with_robot:
-        from models.box_export import compile_box
+        from puzzlebox.models.box_export import compile_box
 
         return compile_box(spec, locks)
-    from models.scene import SceneConfig, build_scene
+    from puzzlebox.models.scene import SceneConfig, build_scene
 
     scene = build_scene(spec, SceneConfig(locks=locks))  # UnreachableBoxPose: a ModelsError
     return scene.compile(), {name: names.joint for name, names in scene.names.components.items()}
@@ -272,8 +270,8 @@ def _box_line(box: dict) -> str:
 
 
 def _mesh(args: argparse.Namespace) -> None:
-    from models.lock_features import layout_lock_features
-    from models.mesh_export import export_meshes  # MuJoCo and trimesh only when asked
+    from puzzlebox.models.lock_features import layout_lock_features
+    from puzzlebox.models.mesh_export import export_meshes  # MuJoCo and trimesh only when asked
 
     try:
         spec = load_spec(args.spec)

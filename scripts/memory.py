@@ -16,10 +16,9 @@ import argparse
 import json
 import sys
 
-from _cli import fail
-
-from learning.errors import MemoryFileError
-from learning.memory import MemoryStore
+from puzzlebox.lab.cli import fail
+from puzzlebox.learning.errors import MemoryFileError
+from puzzlebox.learning.memory import MemoryStore
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -17,14 +17,14 @@ import json
 from pathlib import Path
 
 import imageio.v3 as iio
-from _cli import fail, one_line, versions, write_json
 
-from models import ModelsError, SpecError, load_spec
-from twin.errors import TwinError
-from twin.rendering import RenderConfig, Renderer
-from twin.scripted_sweep import sweep_open
-from twin.session import TwinSession
-from twin.video import VideoWriter
+from puzzlebox.lab.cli import fail, one_line, versions, write_json
+from puzzlebox.models import ModelsError, SpecError, load_spec
+from puzzlebox.twin.errors import TwinError
+from puzzlebox.twin.rendering import RenderConfig, Renderer
+from puzzlebox.twin.scripted_sweep import sweep_open
+from puzzlebox.twin.session import TwinSession
+from puzzlebox.twin.video import VideoWriter
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -80,7 +80,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _gallery(spec, out: Path, config: RenderConfig, args: argparse.Namespace) -> int:
-    from twin.gallery import Gallery
+    from puzzlebox.twin.gallery import Gallery
 
     try:
         with Gallery(spec, config) as gallery:

@@ -25,10 +25,9 @@ import subprocess
 import time
 from pathlib import Path
 
-from _cli import fail, one_line
-from _report_html import ReportError, build_page, load_results_dir
-
-from models.atomic import write_text_atomically
+from puzzlebox.lab.cli import fail, one_line
+from puzzlebox.lab.report_html import ReportError, build_page, load_results_dir
+from puzzlebox.models.atomic import write_text_atomically
 
 
 def measure_load(page: Path, timeout_s: float = 60.0) -> tuple[float, float] | None:

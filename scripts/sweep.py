@@ -3,7 +3,7 @@ aggregate it.
 
     python scripts/sweep.py SWEEP.json --out DIR [--workers K | --ray auto|ADDRESS] [--resume | --force]
 
-The sweep file's format is in ``scripts/_sweep_grid.py``. Writes ``DIR/results.json`` (the contract of
+The sweep file's format is in ``puzzlebox/lab/sweep_grid.py``. Writes ``DIR/results.json`` (the contract of
 ``trial.py``: success rate, mean actions, every run; plus ``cells``, one summary per spec, placement, agent
 and profile), ``DIR/cells.md`` (the per-cell table) and ``DIR/cells.png`` (success and mean actions per
 cell). Every trial is a task of ``learning.runner``, its record in ``DIR/runs/`` the moment it ends: a
@@ -17,16 +17,15 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from _cell_bars import cell_bars
-from _cli import fail
-from _interrupt import StopRequests
-from _run_store import Periodic, RunStore
-from _sweep_grid import Cell, SweepError, grid, load_sweep
-
-from learning import LearningError, summarise
-from learning.runner import RunnerError, make_executor, run_tasks
-from models import ModelsError
-from twin.errors import TwinError
+from puzzlebox.lab.cell_bars import cell_bars
+from puzzlebox.lab.cli import fail
+from puzzlebox.lab.interrupt import StopRequests
+from puzzlebox.lab.run_store import Periodic, RunStore
+from puzzlebox.lab.sweep_grid import Cell, SweepError, grid, load_sweep
+from puzzlebox.learning import LearningError, summarise
+from puzzlebox.learning.runner import RunnerError, make_executor, run_tasks
+from puzzlebox.models import ModelsError
+from puzzlebox.twin.errors import TwinError
 
 
 def cell_summaries(records: dict[str, dict], cells: dict[str, Cell], max_actions: int) -> list[dict[str, Any]]:

@@ -38,15 +38,15 @@ import sqlite3
 import sys
 from pathlib import Path
 
-from _cli import fail, versions, write_json
-from _interrupt import StopRequests
 from tqdm import tqdm
 
-from learning import DEEP_AGENT_NAMES, MemoryAgent, SymbolicWorld, run_episode
-from learning.dual_controller import DualControllerConfig
-from learning.errors import LearningError
-from learning.memory import MemoryStore
-from models import SpecError, load_spec
+from puzzlebox.lab.cli import fail, versions, write_json
+from puzzlebox.lab.interrupt import StopRequests
+from puzzlebox.learning import DEEP_AGENT_NAMES, MemoryAgent, SymbolicWorld, run_episode
+from puzzlebox.learning.dual_controller import DualControllerConfig
+from puzzlebox.learning.errors import LearningError
+from puzzlebox.learning.memory import MemoryStore
+from puzzlebox.models import SpecError, load_spec
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -159,11 +159,10 @@ def _resumed_run(store: MemoryStore, command: dict) -> tuple[int | None, set[int
 def _twin_setup(args: argparse.Namespace, specs: list):
     """The twin episode runner for ``--sim twin`` (the twin loads only when asked); a calibration must be the
     one of this cell (profile and box height), as ``trial.py`` checks."""
-    from _twin_training import TwinTraining
-
-    from models.calibration import CalibrationError, CellCalibration
-    from twin.errors import TwinError
-    from twin.reality import load_profile
+    from puzzlebox.lab.twin_training import TwinTraining
+    from puzzlebox.models.calibration import CalibrationError, CellCalibration
+    from puzzlebox.twin.errors import TwinError
+    from puzzlebox.twin.reality import load_profile
 
     try:
         reality = load_profile(args.reality or "ideal")
@@ -193,7 +192,7 @@ def _check_writable(path: Path, flag: str) -> None:
 
 
 def _train_deep(args: argparse.Namespace, specs: list) -> int:
-    from learning.baselines import make_learner, save_checkpoint  # torch only when asked
+    from puzzlebox.learning.baselines import make_learner, save_checkpoint  # torch only when asked
 
     agent = make_learner(args.agent, args.seed)
     log = {"command": "train", **vars(args), "versions": versions(), "runs": []}

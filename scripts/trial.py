@@ -28,7 +28,7 @@ must hold when a slide is pulled along a wheel's arc. ``--locks`` (twin) picks h
 ``latch``, the rule-driven joint equalities alone (the ablation; the records made before mechanisms existed).
 
 ``--robot xarm --ip ADDRESS --cell FILE --calibration FILE --specs SPEC --runs 1`` runs one trial on a real
-xArm-7 (``real.XArmRobot``, the ``real`` extra) through the same pipeline (``scripts/_real_trial.py``): the box
+xArm-7 (``real.XArmRobot``, the ``real`` extra) through the same pipeline (``puzzlebox/lab/real_trial.py``): the box
 on the table is the one spec given; the cell config (``models/cell_config.py``) gives the cameras, the ArUco
 dictionary and marker size, the force limit and latch threshold and the rest posture (the arm goes there
 first); ``--calibration`` is the cell's camera calibration. Its record holds only what was sensed (no ground
@@ -62,35 +62,36 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import _trial_task
-from _cli import fail, one_line, write_json
-from _interrupt import StopRequests
-from _run_store import Periodic, RunStore
 from tqdm import tqdm
 
-from learning import AGENT_NAMES, LearningError, make_agent, summarise
-from learning.agents.factory import BELIEF_AGENT_NAMES
-from learning.dual_controller import DualControllerConfig
-from learning.memory import MemoryStore
-from learning.runner import InlineExecutor, RunnerError, make_executor, run_tasks
-from models import SpecError, load_spec
-from twin.errors import TwinError
+from puzzlebox.lab import trial_task as _trial_task
+from puzzlebox.lab.cli import fail, one_line, write_json
+from puzzlebox.lab.interrupt import StopRequests
+from puzzlebox.lab.run_store import Periodic, RunStore
+from puzzlebox.lab.trial_figures import twin_figures
+from puzzlebox.learning import AGENT_NAMES, LearningError, make_agent, summarise
+from puzzlebox.learning.agents.factory import BELIEF_AGENT_NAMES
+from puzzlebox.learning.dual_controller import DualControllerConfig
+from puzzlebox.learning.memory import MemoryStore
+from puzzlebox.learning.runner import InlineExecutor, RunnerError, make_executor, run_tasks
+from puzzlebox.models import SpecError, load_spec
+from puzzlebox.twin.errors import TwinError
 
 SIMS = ("symbolic", "twin")
 ROBOTS = ("twin", "xarm")
 
 
 def _real_main(args, arm: Callable[[str, Any], Any] | None = None) -> int:
-    """``--robot xarm``: one trial on the real arm (``scripts/_real_trial.py``), refusing clearly, in one line, what
+    """``--robot xarm``: one trial on the real arm (``puzzlebox/lab/real_trial.py``), refusing clearly, in one line, what
     cannot run; an address where no arm answers is refused first, in about a second. ``arm(ip, cell)`` connects
     to the arm (default ``real.XArmRobot``, after probing the address; a test passes one over a test double)."""
     if args.ip is None or args.cell is None:
         fail("--robot xarm needs --ip ADDRESS (the arm's controller) and --cell FILE (the cell config)")
     if args.sim != "twin":
         fail("--robot xarm runs the perception and skills pipeline: give --sim twin")
-    from models.calibration import CalibrationError, CellCalibration
-    from models.cell_config import CellConfigError, load_cell_config
-    from real import RealError, XArmRobot, probe_controller
+    from puzzlebox.models.calibration import CalibrationError, CellCalibration
+    from puzzlebox.models.cell_config import CellConfigError, load_cell_config
+    from puzzlebox.real import RealError, XArmRobot, probe_controller
 
     try:
         cell = load_cell_config(args.cell)
@@ -124,7 +125,7 @@ def _real_main(args, arm: Callable[[str, Any], Any] | None = None) -> int:
         fail(f"unknown agent {args.agent!r}. Available agents: {sorted(AGENT_NAMES)}")
     if (args.agent == "memory") != (args.memory is not None):
         fail("--memory goes with --agent memory (and only with it): train one with scripts/train.py")
-    from _real_trial import cell_configs, run_real_trial
+    from puzzlebox.lab.real_trial import cell_configs, run_real_trial
 
     try:
         cell_configs(cell)
@@ -162,32 +163,6 @@ def _real_main(args, arm: Callable[[str, Any], Any] | None = None) -> int:
     if record["ended"]:
         print(f"unsolved: {record['ended']}")
     return 0
-
-
-def twin_figures(runs: list) -> dict:
-    """Outcome agreement with ground truth, perception error and speed over all twin runs."""
-    actions = [a for r in runs for a in r["timeline"]]
-    reasons: dict[str, int] = {}
-    for a in actions:
-        if a["outcome"] == "failed":
-            key = a["reason"].split(":")[0] or "unknown"
-            reasons[key] = reasons.get(key, 0) + 1
-    errors = [e for r in runs for e in r["perceived_position_error_m"].values()]
-    sim, wall = sum(r["sim_time_s"] for r in runs), sum(r["wall_time_s"] for r in runs)
-    return {
-        "outcome_agreement": float(sum(a["moved"] == a["true_moved"] for a in actions) / max(len(actions), 1)),
-        "actions_total": len(actions),
-        "perceived_position_error_max_m": max(errors, default=0.0),
-        "perceived_position_error_mean_m": sum(errors) / max(len(errors), 1),
-        "wall_time_per_trial_s_max": max((r["wall_time_s"] for r in runs), default=0.0),
-        "wall_time_per_trial_s_mean": wall / max(len(runs), 1),
-        "sim_over_wall": sim / wall if wall else 0.0,
-        "failed_tries_by_reason": reasons,
-        "unsolved_reasons": [
-            f"{r['spec']} seed {r['seed']}: {r.get('ended') or 'out of actions'}" for r in runs if not r["solved"]
-        ],  # fmt: skip
-        "peak_true_wrist_force_n": max((r["peak_true_wrist_force_n"] for r in runs), default=0.0),
-    }
 
 
 def _results(runs: list[dict], args, planned: int) -> dict:
@@ -341,8 +316,8 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
         fail("--wrong-kind needs --sim twin (the symbolic protocols' faults: experiment.py noise)")
     reality = calibration = None
     if args.sim == "twin":
-        from models.calibration import CalibrationError, CellCalibration
-        from twin.reality import load_profile
+        from puzzlebox.models.calibration import CalibrationError, CellCalibration
+        from puzzlebox.twin.reality import load_profile
 
         try:
             reality = load_profile(args.reality)

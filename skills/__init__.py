@@ -1,9 +1,9 @@
 """puzzlebox skills: the robot's pipeline — perception, joint models, primitives — over the twin's
 robot interface only (DESIGN.md, "Layers": never simulator ground truth)."""
 
-from skills.errors import MarkersNotFound, SkillError, UnknownMarker
-from skills.joint_model import JointModel, joint_model
-from skills.perception import (
+from puzzlebox.skills.errors import MarkersNotFound, SkillError, UnknownMarker
+from puzzlebox.skills.joint_model import JointModel, joint_model
+from puzzlebox.skills.perception import (
     MarkerDetection,
     MarkerDetector,
     PerceptionConfig,
@@ -12,7 +12,7 @@ from skills.perception import (
     select_markers,
     upright_pose,
 )
-from skills.toggle_recorder import ToggleRecorder
+from puzzlebox.skills.toggle_recorder import ToggleRecorder
 
 __all__ = [
     "JointModel",

@@ -34,8 +34,8 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-from models.charuco import DEFAULT_BOARD, CharucoBoardSpec
-from skills.errors import BoardNotFound, InconsistentViews, TooFewViews
+from puzzlebox.models.charuco import DEFAULT_BOARD, CharucoBoardSpec
+from puzzlebox.skills.errors import BoardNotFound, InconsistentViews, TooFewViews
 
 __all__ = [
     "BoardView",

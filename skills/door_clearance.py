@@ -17,10 +17,10 @@ import math
 
 import numpy as np
 
-from models.kinds import DOOR_HALF, HANDLE_HEIGHT, HANDLE_MARGIN, HANDLE_SIZE
-from models.puzzle_box import PLATE_THICKNESS
-from skills.door_push import DoorPush
-from skills.joint_model import JointModel
+from puzzlebox.models.kinds import DOOR_HALF, HANDLE_HEIGHT, HANDLE_MARGIN, HANDLE_SIZE
+from puzzlebox.models.puzzle_box import PLATE_THICKNESS
+from puzzlebox.skills.door_push import DoorPush
+from puzzlebox.skills.joint_model import JointModel
 
 SAMPLED_ANGLES = 9
 """Door angles sampled between the lowest and the end stop (the footprint's ends move monotonically but the

@@ -19,11 +19,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.kinds import HANDLE_HEIGHT, HANDLE_MARGIN, HANDLE_SIZE
-from skills.errors import IKFailure
-from skills.joint_model import GRASP_DEPTH, JointModel, cross
-from skills.kinematics import top_down
-from skills.toggle_result import ToggleResult
+from puzzlebox.models.kinds import HANDLE_HEIGHT, HANDLE_MARGIN, HANDLE_SIZE
+from puzzlebox.skills.errors import IKFailure
+from puzzlebox.skills.joint_model import GRASP_DEPTH, JointModel, cross
+from puzzlebox.skills.kinematics import top_down
+from puzzlebox.skills.toggle_result import ToggleResult
 
 PUSHED_IN_VAIN = "latched: pushed without progress"
 

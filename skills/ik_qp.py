@@ -16,7 +16,7 @@ import mink
 import mujoco
 import numpy as np
 
-from skills.errors import IKFailure
+from puzzlebox.skills.errors import IKFailure
 
 
 class VelocityQP:

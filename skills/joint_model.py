@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.kinds import HANDLE_HEIGHT, Handling, get_kind, registered_kind
-from models.puzzle_box import PLATE_THICKNESS
+from puzzlebox.models.kinds import HANDLE_HEIGHT, Handling, get_kind, registered_kind
+from puzzlebox.models.puzzle_box import PLATE_THICKNESS
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:

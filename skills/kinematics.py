@@ -21,9 +21,9 @@ import mujoco
 import numpy as np
 from dm_control import mjcf
 
-from models.xarm7 import ARM_JOINTS, build_xarm7
-from skills.errors import IKFailure
-from skills.ik_qp import VelocityQP
+from puzzlebox.models.xarm7 import ARM_JOINTS, build_xarm7
+from puzzlebox.skills.errors import IKFailure
+from puzzlebox.skills.ik_qp import VelocityQP
 
 TCP_SITE = "gripper/tcp"
 

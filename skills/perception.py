@@ -24,13 +24,13 @@ from typing import Any
 import cv2
 import numpy as np
 
-from models import geometry
-from models.calibration import CameraCalibration
-from models.cell_config import CellConfig, aruco_dictionary_name
-from models.kinds import MARKER_SIZE
-from models.markers import ARUCO_DICTIONARY, aruco_dictionary
-from models.robot import CameraImage
-from skills.errors import MarkersNotFound, UnknownMarker
+from puzzlebox.models import geometry
+from puzzlebox.models.calibration import CameraCalibration
+from puzzlebox.models.cell_config import CellConfig, aruco_dictionary_name
+from puzzlebox.models.kinds import MARKER_SIZE
+from puzzlebox.models.markers import ARUCO_DICTIONARY, aruco_dictionary
+from puzzlebox.models.robot import CameraImage
+from puzzlebox.skills.errors import MarkersNotFound, UnknownMarker
 
 
 @dataclass(frozen=True)

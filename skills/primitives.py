@@ -48,12 +48,12 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
-from models.cell_config import CellConfig
-from skills.door_push import DoorPushConfig, DoorPushing
-from skills.errors import ForceLimitExceeded, GraspFailure, IKFailure, SlipDetected
-from skills.joint_model import JointModel
-from skills.kinematics import ArmKinematics, top_down
-from skills.toggle_result import ToggleResult
+from puzzlebox.models.cell_config import CellConfig
+from puzzlebox.skills.door_push import DoorPushConfig, DoorPushing
+from puzzlebox.skills.errors import ForceLimitExceeded, GraspFailure, IKFailure, SlipDetected
+from puzzlebox.skills.joint_model import JointModel
+from puzzlebox.skills.kinematics import ArmKinematics, top_down
+from puzzlebox.skills.toggle_result import ToggleResult
 
 SLIPPED_OFF = "latched: held until the grasp slipped"
 INCOMPLETE_TRAVEL = "IncompleteTravel"

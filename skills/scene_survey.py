@@ -25,14 +25,14 @@ from typing import Any
 
 import numpy as np
 
-from models.calibration import CellCalibration
-from models.cell_config import CellConfig
-from models.reach import MIN_REACH
-from models.robot import Robot
-from skills.errors import ForceLimitExceeded, IKFailure, MarkersNotFound
-from skills.kinematics import top_down
-from skills.perception import MarkerDetection, MarkerDetector, lid_height, select_markers
-from skills.primitives import Toggler
+from puzzlebox.models.calibration import CellCalibration
+from puzzlebox.models.cell_config import CellConfig
+from puzzlebox.models.reach import MIN_REACH
+from puzzlebox.models.robot import Robot
+from puzzlebox.skills.errors import ForceLimitExceeded, IKFailure, MarkersNotFound
+from puzzlebox.skills.kinematics import top_down
+from puzzlebox.skills.perception import MarkerDetection, MarkerDetector, lid_height, select_markers
+from puzzlebox.skills.primitives import Toggler
 
 OVERVIEW_CAMERA = "overview"
 WRIST_CAMERA = "xarm7/gripper/wrist_camera"

@@ -19,11 +19,11 @@ from typing import Any
 
 import numpy as np
 
-from models.robot import Robot
-from models.toggle_log import PHASES, ToggleLog
-from skills.joint_model import JointModel
-from skills.perception import upright_pose
-from skills.toggle_result import ToggleResult
+from puzzlebox.models.robot import Robot
+from puzzlebox.models.toggle_log import PHASES, ToggleLog
+from puzzlebox.skills.joint_model import JointModel
+from puzzlebox.skills.perception import upright_pose
+from puzzlebox.skills.toggle_result import ToggleResult
 
 
 class _Ticks:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from models.try_outcome import Outcome
+from puzzlebox.models.try_outcome import Outcome
 
 
 @dataclass

@@ -32,16 +32,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from models import ComponentObservation, SceneObservation, TryResult
-from models.calibration import CellCalibration
-from models.geometry import wrap_angle
-from models.kinds import get_kind
-from models.robot import Robot
-from skills.door_clearance import lean_away, near_open_door
-from skills.joint_model import JointModel, joint_model
-from skills.perception import MarkerDetection, MarkerDetector, kind_of, lid_height, upright_pose
-from skills.primitives import STOPPED_DESCENDING, PrimitiveConfig, Toggler, ToggleResult
-from skills.scene_survey import SceneSurvey, SurveyConfig
+from puzzlebox.models import ComponentObservation, SceneObservation, TryResult
+from puzzlebox.models.calibration import CellCalibration
+from puzzlebox.models.geometry import wrap_angle
+from puzzlebox.models.kinds import get_kind
+from puzzlebox.models.robot import Robot
+from puzzlebox.skills.door_clearance import lean_away, near_open_door
+from puzzlebox.skills.joint_model import JointModel, joint_model
+from puzzlebox.skills.perception import MarkerDetection, MarkerDetector, kind_of, lid_height, upright_pose
+from puzzlebox.skills.primitives import STOPPED_DESCENDING, PrimitiveConfig, Toggler, ToggleResult
+from puzzlebox.skills.scene_survey import SceneSurvey, SurveyConfig
 
 MOVED_DISTANCE = 0.01
 """A re-observed marker this far from its closed pose has moved [m]..."""

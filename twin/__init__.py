@@ -15,8 +15,8 @@ from typing import Any
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # before mujoco/dm_control load: headless EGL by default
 
-from twin.component_states import ComponentStates, HysteresisConfig  # noqa: E402
-from twin.errors import (  # noqa: E402
+from puzzlebox.twin.component_states import ComponentStates, HysteresisConfig  # noqa: E402
+from puzzlebox.twin.errors import (  # noqa: E402
     CommandError,
     ProfileError,
     RenderingError,
@@ -25,24 +25,24 @@ from twin.errors import (  # noqa: E402
     UnknownCamera,
     VideoError,
 )
-from twin.rendering import RenderConfig, Renderer  # noqa: E402
-from twin.video import VideoWriter  # noqa: E402
+from puzzlebox.twin.rendering import RenderConfig, Renderer  # noqa: E402
+from puzzlebox.twin.video import VideoWriter  # noqa: E402
 
 _LAZY = {
-    "PRESETS": "twin.reality",
-    "RealityProfile": "twin.reality",
-    "load_profile": "twin.reality",
-    "RobotInterface": "twin.robot_interface",
-    "TwinConfig": "twin.session",
-    "TwinSession": "twin.session",
-    "TwinState": "twin.session",
-    "sweep_open": "twin.scripted_sweep",
-    "KindScales": "twin.toggle_replay",
-    "ToggleReplay": "twin.toggle_replay",
-    "FitConfig": "twin.system_id",
-    "fit_kind": "twin.system_id",
-    "prepare": "twin.toggle_scoring",
-    "toggle_errors": "twin.toggle_scoring",
+    "PRESETS": "puzzlebox.twin.reality",
+    "RealityProfile": "puzzlebox.twin.reality",
+    "load_profile": "puzzlebox.twin.reality",
+    "RobotInterface": "puzzlebox.twin.robot_interface",
+    "TwinConfig": "puzzlebox.twin.session",
+    "TwinSession": "puzzlebox.twin.session",
+    "TwinState": "puzzlebox.twin.session",
+    "sweep_open": "puzzlebox.twin.scripted_sweep",
+    "KindScales": "puzzlebox.twin.toggle_replay",
+    "ToggleReplay": "puzzlebox.twin.toggle_replay",
+    "FitConfig": "puzzlebox.twin.system_id",
+    "fit_kind": "puzzlebox.twin.system_id",
+    "prepare": "puzzlebox.twin.toggle_scoring",
+    "toggle_errors": "puzzlebox.twin.toggle_scoring",
 }
 
 

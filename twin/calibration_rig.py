@@ -31,14 +31,14 @@ import mujoco
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from models.calibration import CameraCalibration
-from models.charuco import BOARD_BODY, DEFAULT_BOARD, CharucoBoardSpec, board_pose_flat
-from models.robot import CameraImage
-from models.spec import PuzzleSpec
-from twin.errors import TwinError
-from twin.nominal_calibration import nominal_calibration
-from twin.reality import RealityProfile, load_profile
-from twin.session import TwinConfig, TwinSession
+from puzzlebox.models.calibration import CameraCalibration
+from puzzlebox.models.charuco import BOARD_BODY, DEFAULT_BOARD, CharucoBoardSpec, board_pose_flat
+from puzzlebox.models.robot import CameraImage
+from puzzlebox.models.spec import PuzzleSpec
+from puzzlebox.twin.errors import TwinError
+from puzzlebox.twin.nominal_calibration import nominal_calibration
+from puzzlebox.twin.reality import RealityProfile, load_profile
+from puzzlebox.twin.session import TwinConfig, TwinSession
 
 __all__ = ["CalibrationCell", "RigConfig", "RigError"]
 

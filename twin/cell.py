@@ -27,9 +27,9 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from models.kinds import KIND_NAMES, registered_kinds
-from twin.reality import RealityProfile
-from twin.sensors.random_vectors import random_vector
+from puzzlebox.models.kinds import KIND_NAMES, registered_kinds
+from puzzlebox.twin.reality import RealityProfile
+from puzzlebox.twin.sensors.random_vectors import random_vector
 
 
 @dataclass(frozen=True)

@@ -8,14 +8,14 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from models.cell_config import CellConfig, aruco_dictionary_name
-from models.kinds import get_kind
-from models.markers import ARUCO_DICTIONARY
-from twin.errors import TwinError
-from twin.robot_interface import GRIPPER_CTRL_MAX
+from puzzlebox.models.cell_config import CellConfig, aruco_dictionary_name
+from puzzlebox.models.kinds import get_kind
+from puzzlebox.models.markers import ARUCO_DICTIONARY
+from puzzlebox.twin.errors import TwinError
+from puzzlebox.twin.robot_interface import GRIPPER_CTRL_MAX
 
 if TYPE_CHECKING:
-    from twin.session import TwinSession
+    from puzzlebox.twin.session import TwinSession
 
 
 def twin_cell_config(session: TwinSession, *, force_limit: float, blocked_force: float) -> CellConfig:

@@ -42,12 +42,12 @@ import imageio.v3 as iio
 import mujoco
 import numpy as np
 
-from models.atomic import write_atomically
-from models.kinds import get_kind
-from models.scene import ROBOT, Scene, SceneConfig, build_scene
-from models.spec import PuzzleSpec
-from twin.rendering import RenderConfig, Renderer
-from twin.video import VideoWriter
+from puzzlebox.models.atomic import write_atomically
+from puzzlebox.models.kinds import get_kind
+from puzzlebox.models.scene import ROBOT, Scene, SceneConfig, build_scene
+from puzzlebox.models.spec import PuzzleSpec
+from puzzlebox.twin.rendering import RenderConfig, Renderer
+from puzzlebox.twin.video import VideoWriter
 
 __all__ = [
     "CAMERA",

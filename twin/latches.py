@@ -22,8 +22,8 @@ import warnings
 import mujoco
 import numpy as np
 
-from models import LockTable, PuzzleSpec
-from models.mechanism_mjcf import LockMode, mechanism_layout
+from puzzlebox.models import LockTable, PuzzleSpec
+from puzzlebox.models.mechanism_mjcf import LockMode, mechanism_layout
 
 
 class UnrealizedLockWarning(UserWarning):

@@ -14,11 +14,11 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import numpy as np
 
-from models.calibration import CameraCalibration, CellCalibration
-from twin.rendering import camera_pose_in_world, pinhole_intrinsics
+from puzzlebox.models.calibration import CameraCalibration, CellCalibration
+from puzzlebox.twin.rendering import camera_pose_in_world, pinhole_intrinsics
 
 if TYPE_CHECKING:
-    from twin.session import TwinSession
+    from puzzlebox.twin.session import TwinSession
 
 
 def camera_calibration(

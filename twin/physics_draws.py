@@ -10,7 +10,7 @@ from dataclasses import dataclass, replace
 import mujoco
 import numpy as np
 
-from twin.reality import PhysicsReality
+from puzzlebox.twin.reality import PhysicsReality
 
 
 @dataclass(frozen=True)

@@ -15,8 +15,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from models.toggle_log import ToggleLog
-from twin.toggle_signals import SignalConfig, joint_load
+from puzzlebox.models.toggle_log import ToggleLog
+from puzzlebox.twin.toggle_signals import SignalConfig, joint_load
 
 
 @dataclass(frozen=True)

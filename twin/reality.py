@@ -37,8 +37,8 @@ from typing import Any
 
 import numpy as np
 
-from models.placement import PlacementRange
-from twin.errors import ProfileError
+from puzzlebox.models.placement import PlacementRange
+from puzzlebox.twin.errors import ProfileError
 
 __all__ = [
     "PRESETS",

@@ -17,9 +17,9 @@ import dataclasses
 import math
 from typing import Any
 
-from models.placement import PlacementRange
-from twin.errors import ProfileError
-from twin.reality import HARSH, IDEAL, REALISTIC, ForceTorqueReality, RealityProfile, ScaleRange
+from puzzlebox.models.placement import PlacementRange
+from puzzlebox.twin.errors import ProfileError
+from puzzlebox.twin.reality import HARSH, IDEAL, REALISTIC, ForceTorqueReality, RealityProfile, ScaleRange
 
 FACTORS: dict[str, tuple[tuple[str, str], ...]] = {
     "camera-geometry": tuple(

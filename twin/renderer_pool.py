@@ -18,7 +18,7 @@ import threading
 
 import mujoco
 
-from twin.rendering import RenderConfig, Renderer, render_resources_key
+from puzzlebox.twin.rendering import RenderConfig, Renderer, render_resources_key
 
 MAX_IDLE = 2
 """Idle renderers kept (each holds ~10-20 MB of buffers and uploaded meshes)."""

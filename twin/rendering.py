@@ -49,7 +49,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from twin.errors import RenderingError, UnknownCamera
+from puzzlebox.twin.errors import RenderingError, UnknownCamera
 
 __all__ = [
     "GL_BACKENDS",

@@ -30,8 +30,8 @@ from typing import Any
 
 import numpy as np
 
-from models.atomic import PublishedOnExit
-from twin.errors import TwinError
+from puzzlebox.models.atomic import PublishedOnExit
+from puzzlebox.twin.errors import TwinError
 
 
 class RecordingError(TwinError, RuntimeError):

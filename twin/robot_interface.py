@@ -21,11 +21,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from models.robot import CameraImage
-from twin.errors import CommandError
+from puzzlebox.models.robot import CameraImage
+from puzzlebox.twin.errors import CommandError
 
 if TYPE_CHECKING:
-    from twin.session import TwinSession
+    from puzzlebox.twin.session import TwinSession
 
 GRIPPER_CTRL_MAX = 255.0
 """The xArm gripper's command range is 0 (open) .. 255 (closed)."""

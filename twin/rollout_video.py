@@ -42,10 +42,10 @@ import cv2
 import mujoco
 import numpy as np
 
-from models.atomic import PublishedOnExit, write_text_atomically
-from models.scene import BOX
-from twin.errors import VideoError
-from twin.video import VideoWriter
+from puzzlebox.models.atomic import PublishedOnExit, write_text_atomically
+from puzzlebox.models.scene import BOX
+from puzzlebox.twin.errors import VideoError
+from puzzlebox.twin.video import VideoWriter
 
 VIEWS = ("overview", "three-quarter", "wrist")
 """The tiled views, left to right."""

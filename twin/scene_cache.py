@@ -15,8 +15,8 @@ import threading
 
 import mujoco
 
-from models import PuzzleSpec
-from models.scene import Scene, SceneConfig, build_scene
+from puzzlebox.models import PuzzleSpec
+from puzzlebox.models.scene import Scene, SceneConfig, build_scene
 
 MAX_SCENES = 4
 """Compiled scenes kept (a paper scene's model holds ~18 MB, its meshes' collision data mostly; under a profile

@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.kinds import registered_kind
-from twin.session import TwinSession
+from puzzlebox.models.kinds import registered_kind
+from puzzlebox.twin.session import TwinSession
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from twin.reality import ArmReality
+from puzzlebox.twin.reality import ArmReality
 
 
 def _whole_steps(seconds: float, timestep: float) -> int:

@@ -30,26 +30,26 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from models import LockTable, PuzzleSpec, get_kind
-from models.calibration import CameraCalibration
-from models.placement import placed, sample_reachable_pose
-from models.scene import Scene, SceneConfig
-from models.xarm7 import HOME_QPOS
-from twin.cell import apply_cell, draw_cell
-from twin.component_states import ComponentStates, HysteresisConfig
-from twin.errors import SimulationDiverged
-from twin.jams import Jams
-from twin.latches import Latches, latched_rules
-from twin.nominal_calibration import camera_calibration
-from twin.physics_draws import apply_physics, draw_physics, subtree_bodies
-from twin.reality import RealityProfile, load_profile
-from twin.rendering import RenderConfig, pinhole_intrinsics
-from twin.robot_interface import RobotInterface
-from twin.scene_cache import compiled_scene
-from twin.sensors.cameras import Cameras, true_lens
-from twin.sensors.encoders import JointEncoders
-from twin.sensors.force_torque import ForceTorqueSensor
-from twin.servos import Servos
+from puzzlebox.models import LockTable, PuzzleSpec, get_kind
+from puzzlebox.models.calibration import CameraCalibration
+from puzzlebox.models.placement import placed, sample_reachable_pose
+from puzzlebox.models.scene import Scene, SceneConfig
+from puzzlebox.models.xarm7 import HOME_QPOS
+from puzzlebox.twin.cell import apply_cell, draw_cell
+from puzzlebox.twin.component_states import ComponentStates, HysteresisConfig
+from puzzlebox.twin.errors import SimulationDiverged
+from puzzlebox.twin.jams import Jams
+from puzzlebox.twin.latches import Latches, latched_rules
+from puzzlebox.twin.nominal_calibration import camera_calibration
+from puzzlebox.twin.physics_draws import apply_physics, draw_physics, subtree_bodies
+from puzzlebox.twin.reality import RealityProfile, load_profile
+from puzzlebox.twin.rendering import RenderConfig, pinhole_intrinsics
+from puzzlebox.twin.robot_interface import RobotInterface
+from puzzlebox.twin.scene_cache import compiled_scene
+from puzzlebox.twin.sensors.cameras import Cameras, true_lens
+from puzzlebox.twin.sensors.encoders import JointEncoders
+from puzzlebox.twin.sensors.force_torque import ForceTorqueSensor
+from puzzlebox.twin.servos import Servos
 
 # Every physics warning is a divergence (mujoco 3.17 lists: bad ctrl/qacc/qpos/qvel, full constraint
 # or contact buffers, bad inertia). Warnings outside the enum (future visual ones) are ignored.

@@ -24,8 +24,8 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
-from twin.toggle_replay import KindScales
-from twin.toggle_scoring import PreparedToggle
+from puzzlebox.twin.toggle_replay import KindScales
+from puzzlebox.twin.toggle_scoring import PreparedToggle
 
 PARAMETERS = ("damping", "friction", "latch")
 """The factors of a kind, in the order of :meth:`KindScales.as_array`."""

@@ -34,17 +34,17 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from models.kinds import get_kind
-from models.puzzle_box import MARKER_Z
-from models.scene import SceneConfig
-from models.spec import Box, Component, Goal, PuzzleSpec
-from models.toggle_log import ToggleLog
-from twin.physics_draws import subtree_bodies
-from twin.reality import ArmReality, ForceTorqueReality
-from twin.robot_interface import GRIPPER_CTRL_MAX
-from twin.scene_cache import compiled_scene
-from twin.sensors.force_torque import ForceTorqueSensor
-from twin.servos import Servos
+from puzzlebox.models.kinds import get_kind
+from puzzlebox.models.puzzle_box import MARKER_Z
+from puzzlebox.models.scene import SceneConfig
+from puzzlebox.models.spec import Box, Component, Goal, PuzzleSpec
+from puzzlebox.models.toggle_log import ToggleLog
+from puzzlebox.twin.physics_draws import subtree_bodies
+from puzzlebox.twin.reality import ArmReality, ForceTorqueReality
+from puzzlebox.twin.robot_interface import GRIPPER_CTRL_MAX
+from puzzlebox.twin.scene_cache import compiled_scene
+from puzzlebox.twin.sensors.force_torque import ForceTorqueSensor
+from puzzlebox.twin.servos import Servos
 
 _STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 

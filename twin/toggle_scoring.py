@@ -29,10 +29,10 @@ from typing import Any
 
 import numpy as np
 
-from models.toggle_log import ToggleLog
-from twin.pose_error import PoseErrorConfig, pose_basis
-from twin.toggle_replay import NOMINAL, KindScales, ReplayConfig, ReplayError, ToggleReplay
-from twin.toggle_signals import SignalConfig, compared_mask, joint_load, path_length
+from puzzlebox.models.toggle_log import ToggleLog
+from puzzlebox.twin.pose_error import PoseErrorConfig, pose_basis
+from puzzlebox.twin.toggle_replay import NOMINAL, KindScales, ReplayConfig, ReplayError, ToggleReplay
+from puzzlebox.twin.toggle_signals import SignalConfig, compared_mask, joint_load, path_length
 
 
 @dataclass

@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.toggle_log import ToggleLog
-from models.xarm7 import TCP_OFFSET
+from puzzlebox.models.toggle_log import ToggleLog
+from puzzlebox.models.xarm7 import TCP_OFFSET
 
 
 @dataclass(frozen=True)

@@ -17,8 +17,8 @@ from pathlib import Path
 import imageio_ffmpeg
 import numpy as np
 
-from models.atomic import PublishedOnExit
-from twin.errors import VideoError
+from puzzlebox.models.atomic import PublishedOnExit
+from puzzlebox.twin.errors import VideoError
 
 __all__ = ["X264_PRESETS", "VideoWriter"]
 

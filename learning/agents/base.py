@@ -6,7 +6,7 @@ from typing import Protocol
 
 import numpy as np
 
-from models import SceneObservation, TryResult
+from puzzlebox.models import SceneObservation, TryResult
 
 
 class Agent(Protocol):

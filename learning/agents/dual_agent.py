@@ -7,15 +7,15 @@ from dataclasses import replace
 
 import numpy as np
 
-from learning.belief import default_prior
-from learning.dual_controller import Decision, DualControllerConfig, decide, max_entropy_for, new_belief
-from learning.holding_pairs import holding_pairs, restrict_single_prior
-from learning.lock_belief import LockBelief
-from learning.memory.keys import se3_pose_keys
-from learning.memory.prior import MemoryConfig, episode_record, recall_memberships, recall_prior
-from learning.memory.store import MemoryStore
-from learning.multi_belief import MultiBelief
-from models import SceneObservation, TryResult
+from puzzlebox.learning.belief import default_prior
+from puzzlebox.learning.dual_controller import Decision, DualControllerConfig, decide, max_entropy_for, new_belief
+from puzzlebox.learning.holding_pairs import holding_pairs, restrict_single_prior
+from puzzlebox.learning.lock_belief import LockBelief
+from puzzlebox.learning.memory.keys import se3_pose_keys
+from puzzlebox.learning.memory.prior import MemoryConfig, episode_record, recall_memberships, recall_prior
+from puzzlebox.learning.memory.store import MemoryStore
+from puzzlebox.learning.multi_belief import MultiBelief
+from puzzlebox.models import SceneObservation, TryResult
 
 
 class DualAgent:

@@ -2,16 +2,16 @@
 
 from __future__ import annotations
 
-from learning.agent_names import AGENT_NAMES, BELIEF_AGENT_NAMES, DEEP_AGENT_NAMES, POSE_ENCODINGS
-from learning.agents.base import Agent
-from learning.agents.dual_agent import DualAgent, MemoryAgent
-from learning.agents.oracle_agent import OracleAgent
-from learning.agents.random_agent import RandomAgent
-from learning.belief import BeliefConfig
-from learning.dual_controller import DualControllerConfig
-from learning.errors import ConfigError, UnknownAgent
-from learning.memory.store import MemoryStore
-from models import PuzzleSpec
+from puzzlebox.learning.agent_names import AGENT_NAMES, BELIEF_AGENT_NAMES, DEEP_AGENT_NAMES, POSE_ENCODINGS
+from puzzlebox.learning.agents.base import Agent
+from puzzlebox.learning.agents.dual_agent import DualAgent, MemoryAgent
+from puzzlebox.learning.agents.oracle_agent import OracleAgent
+from puzzlebox.learning.agents.random_agent import RandomAgent
+from puzzlebox.learning.belief import BeliefConfig
+from puzzlebox.learning.dual_controller import DualControllerConfig
+from puzzlebox.learning.errors import ConfigError, UnknownAgent
+from puzzlebox.learning.memory.store import MemoryStore
+from puzzlebox.models import PuzzleSpec
 
 __all__ = ["AGENT_NAMES", "BELIEF_AGENT_NAMES", "DEEP_AGENT_NAMES", "POSE_ENCODINGS", "make_agent"]
 
@@ -36,7 +36,7 @@ def make_agent(
     if name in DEEP_AGENT_NAMES:
         if checkpoint is None:
             raise ConfigError(f"agent {name!r} needs a checkpoint (train one with scripts/train.py --agent {name})")
-        from learning.baselines.checkpoint import load_checkpoint  # torch only when asked
+        from puzzlebox.learning.baselines.checkpoint import load_checkpoint  # torch only when asked
 
         return load_checkpoint(checkpoint, expected_agent=name, scene=spec)
     if checkpoint is not None:

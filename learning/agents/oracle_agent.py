@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from learning.errors import LearningError
-from models import LockTable, PuzzleSpec, SceneObservation, TryResult
+from puzzlebox.learning.errors import LearningError
+from puzzlebox.models import LockTable, PuzzleSpec, SceneObservation, TryResult
 
 KIND_MISMATCH_COST = 1.0
 """Matching cost of a kind mismatch [m-equivalent]: larger than any position error we expect."""

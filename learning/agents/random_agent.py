@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from models import SceneObservation, TryResult
+from puzzlebox.models import SceneObservation, TryResult
 
 
 class RandomAgent:

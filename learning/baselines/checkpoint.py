@@ -16,13 +16,13 @@ from pathlib import Path
 
 import torch
 
-from learning.baselines.dqn import DQNAgent, DQNConfig
-from learning.baselines.graph_network import GraphNetworkConfig, SceneMismatch, family_name
-from learning.baselines.model_based import ModelBasedAgent, ModelBasedConfig
-from learning.errors import LearningError
-from models import PuzzleSpec
-from models.atomic import write_atomically, write_text_atomically
-from models.disassembly_kinds import family_kind_names
+from puzzlebox.learning.baselines.dqn import DQNAgent, DQNConfig
+from puzzlebox.learning.baselines.graph_network import GraphNetworkConfig, SceneMismatch, family_name
+from puzzlebox.learning.baselines.model_based import ModelBasedAgent, ModelBasedConfig
+from puzzlebox.learning.errors import LearningError
+from puzzlebox.models import PuzzleSpec
+from puzzlebox.models.atomic import write_atomically, write_text_atomically
+from puzzlebox.models.disassembly_kinds import family_kind_names
 
 CHECKPOINT_FORMAT = "puzzlebox-baseline/2"
 """/2: GN blocks apply the edge MLP's first layer per part (``GNBlock``); MT-OPT flags in the config."""

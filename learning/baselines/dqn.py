@@ -21,10 +21,10 @@ import numpy as np
 import torch
 from torch import nn
 
-from learning.baselines.graph_network import GraphNetwork
-from learning.baselines.learner import EpsilonGreedyLearner, LearnerConfig
-from learning.baselines.multitask import RelabelledStep, Step, progress, relabel_episode
-from models import SceneObservation
+from puzzlebox.learning.baselines.graph_network import GraphNetwork
+from puzzlebox.learning.baselines.learner import EpsilonGreedyLearner, LearnerConfig
+from puzzlebox.learning.baselines.multitask import RelabelledStep, Step, progress, relabel_episode
+from puzzlebox.models import SceneObservation
 
 
 @dataclass(frozen=True)

@@ -28,18 +28,18 @@ import numpy as np
 import torch
 from torch import nn
 
-from learning.agent_names import POSE_ENCODINGS
-from learning.errors import ConfigError, LearningError
-from learning.memory.keys import key_size, relative_pose_keys
-from models import KIND_NAMES, PuzzleSpec, SceneObservation
-from models.disassembly_kinds import (
+from puzzlebox.learning.agent_names import POSE_ENCODINGS
+from puzzlebox.learning.errors import ConfigError, LearningError
+from puzzlebox.learning.memory.keys import key_size, relative_pose_keys
+from puzzlebox.models import KIND_NAMES, PuzzleSpec, SceneObservation
+from puzzlebox.models.disassembly_kinds import (
     DISASSEMBLY_FAMILY,
     DISASSEMBLY_KIND_NAMES,
     DISASSEMBLY_POSE_SIZE,
     PUZZLE_BOX_FAMILY,
     family_kind_names,
 )
-from models.kinds import registry_family
+from puzzlebox.models.kinds import registry_family
 
 NODE_FEATURES = len(KIND_NAMES) + 2
 """Puzzle-box family: kind one-hot, state, goal flag (plus 4 pose features with ``poses="absolute"``);

@@ -13,8 +13,8 @@ from typing import Any, Self
 import numpy as np
 import torch
 
-from learning.baselines.graph_network import GraphNetworkConfig, observation_tensors
-from models import SceneObservation, TryResult
+from puzzlebox.learning.baselines.graph_network import GraphNetworkConfig, observation_tensors
+from puzzlebox.models import SceneObservation, TryResult
 
 
 @dataclass(frozen=True)

@@ -22,11 +22,11 @@ import numpy as np
 import torch
 from torch import nn
 
-from learning.baselines.graph_network import GraphNetwork
-from learning.baselines.learner import EpsilonGreedyLearner, LearnerConfig
-from learning.baselines.multitask import with_goal
-from learning.planner import bitmask, value_iteration
-from models import SceneObservation
+from puzzlebox.learning.baselines.graph_network import GraphNetwork
+from puzzlebox.learning.baselines.learner import EpsilonGreedyLearner, LearnerConfig
+from puzzlebox.learning.baselines.multitask import with_goal
+from puzzlebox.learning.planner import bitmask, value_iteration
+from puzzlebox.models import SceneObservation
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models import KIND_NAMES
+from puzzlebox.models import KIND_NAMES
 
 STATE_COLUMN = len(KIND_NAMES)
 """Node-feature column of the component state (0/1) for the puzzle-box family; in general

@@ -5,10 +5,10 @@ from __future__ import annotations
 from dataclasses import fields
 from typing import Any
 
-from learning.baselines.dqn import DQNAgent, DQNConfig
-from learning.baselines.graph_network import GraphNetworkConfig
-from learning.baselines.model_based import ModelBasedAgent, ModelBasedConfig
-from learning.errors import ConfigError, UnknownAgent
+from puzzlebox.learning.baselines.dqn import DQNAgent, DQNConfig
+from puzzlebox.learning.baselines.graph_network import GraphNetworkConfig
+from puzzlebox.learning.baselines.model_based import ModelBasedAgent, ModelBasedConfig
+from puzzlebox.learning.errors import ConfigError, UnknownAgent
 
 LEARNERS = {
     "dqn": lambda **kw: DQNAgent(DQNConfig(**kw)),

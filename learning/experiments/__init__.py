@@ -1,8 +1,8 @@
 """The paper's experiments: protocols, the paper's numbers, figures and tables."""
 
-from learning.experiments.protocol import SYMBOLIC_AGENTS, ProtocolConfig, Score, evaluate, train_memory
-from learning.experiments.report import comparison_table, plot, results_table
-from learning.experiments.symbolic_protocols import (
+from puzzlebox.learning.experiments.protocol import SYMBOLIC_AGENTS, ProtocolConfig, Score, evaluate, train_memory
+from puzzlebox.learning.experiments.report import comparison_table, plot, results_table
+from puzzlebox.learning.experiments.symbolic_protocols import (
     NOISE_CONDITIONS,
     PROTOCOLS,
     run_episodes,

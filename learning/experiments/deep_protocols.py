@@ -27,20 +27,20 @@ from typing import Any
 
 import numpy as np
 
-from learning.agent_names import DEEP_AGENT_NAMES
-from learning.errors import ConfigError
-from learning.experiments.protocol import (
+from puzzlebox.learning.agent_names import DEEP_AGENT_NAMES
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.experiments.protocol import (
     ProtocolConfig,
     Score,
     evaluate,
     summarise_scores,
     training_layout,
 )
-from learning.experiments.symbolic_protocols import CONDITIONS
-from learning.runner import RecordStore, Task, make_executor, run_tasks
-from learning.symbolic_world import SymbolicWorld
-from learning.trial import run_episode
-from models.generator import TRAIN_INDICES
+from puzzlebox.learning.experiments.symbolic_protocols import CONDITIONS
+from puzzlebox.learning.runner import RecordStore, Task, make_executor, run_tasks
+from puzzlebox.learning.symbolic_world import SymbolicWorld
+from puzzlebox.learning.trial import run_episode
+from puzzlebox.models.generator import TRAIN_INDICES
 
 DEEP_AGENTS = DEEP_AGENT_NAMES
 NONE = "none"
@@ -153,7 +153,7 @@ def run_job(job: TrainingJob, config: ProtocolConfig, out_dir: str) -> dict[str,
     """Train and evaluate one job, write its network to ``OUT/jobs/<key>.pt`` atomically; its record."""
     import torch
 
-    from learning.baselines import GraphNetworkConfig, make_learner, save_checkpoint
+    from puzzlebox.learning.baselines import GraphNetworkConfig, make_learner, save_checkpoint
 
     torch.set_num_threads(1)  # one job per core: the jobs are the parallelism
     start = time.perf_counter()

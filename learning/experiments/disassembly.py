@@ -29,17 +29,17 @@ from typing import Any
 
 import numpy as np
 
-from learning.agents.dual_agent import DualAgent, MemoryAgent
-from learning.belief import BeliefConfig
-from learning.dual_controller import DualControllerConfig
-from learning.errors import ConfigError
-from learning.experiments.scene_evaluation import TEST_SEED, evaluate_on_scenes
-from learning.memory.store import MemoryStore
-from learning.runner import RecordStore, Task, make_executor, run_tasks
-from learning.symbolic_world import SymbolicWorld
-from learning.trial import run_episode
-from models import LockTable, PuzzleSpec, load_spec, spec_from_dict
-from models.disassembly_variants import VariantConfig, disassembly_variant
+from puzzlebox.learning.agents.dual_agent import DualAgent, MemoryAgent
+from puzzlebox.learning.belief import BeliefConfig
+from puzzlebox.learning.dual_controller import DualControllerConfig
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.experiments.scene_evaluation import TEST_SEED, evaluate_on_scenes
+from puzzlebox.learning.memory.store import MemoryStore
+from puzzlebox.learning.runner import RecordStore, Task, make_executor, run_tasks
+from puzzlebox.learning.symbolic_world import SymbolicWorld
+from puzzlebox.learning.trial import run_episode
+from puzzlebox.models import LockTable, PuzzleSpec, load_spec, spec_from_dict
+from puzzlebox.models.disassembly_variants import VariantConfig, disassembly_variant
 
 DATA_DIR = Path(__file__).resolve().parents[3] / "shared" / "data" / "disassembly"
 """Where the two measured computers live (``../shared/data/disassembly`` beside the repository)."""
@@ -178,7 +178,7 @@ def symbolic_task(settings: dict[str, Any]) -> dict[str, Any]:
 
 def deep_task(settings: dict[str, Any]) -> dict[str, Any]:
     """One (deep agent, training seed): trained on the training scene, evaluated at every ``deep_episodes``."""
-    from learning.experiments.disassembly_deep import train_deep_on_scene  # torch only when asked
+    from puzzlebox.learning.experiments.disassembly_deep import train_deep_on_scene  # torch only when asked
 
     train, tests = spec_from_dict(settings["train"]), [spec_from_dict(t) for t in settings["tests"]]
     start = time.perf_counter()

@@ -19,11 +19,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from learning.errors import ConfigError
-from learning.experiments.scene_evaluation import evaluate_on_scenes
-from learning.symbolic_world import SymbolicWorld
-from learning.trial import run_episode
-from models import PuzzleSpec
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.experiments.scene_evaluation import evaluate_on_scenes
+from puzzlebox.learning.symbolic_world import SymbolicWorld
+from puzzlebox.learning.trial import run_episode
+from puzzlebox.models import PuzzleSpec
 
 DEFAULT_PROGRESS_REWARD = 1.0
 """Dense reward of the DQN agents per component removed (a goal is worth 1, a try -0.05; 0: sparse). Chosen on
@@ -62,7 +62,7 @@ def train_deep_on_scene(
     """
     import torch  # the baselines extra, only when asked
 
-    from learning.baselines import GraphNetworkConfig, make_learner
+    from puzzlebox.learning.baselines import GraphNetworkConfig, make_learner
 
     if not checkpoints or list(checkpoints) != sorted(set(checkpoints)) or checkpoints[0] < 0:
         raise ConfigError(f"checkpoints must be non-empty, increasing and >= 0, got {list(checkpoints)}")

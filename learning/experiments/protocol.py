@@ -14,20 +14,20 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from learning.agent_names import SYMBOLIC_AGENT_NAMES
-from learning.agents.base import Agent
-from learning.agents.dual_agent import DualAgent, MemoryAgent
-from learning.agents.oracle_agent import OracleAgent
-from learning.agents.random_agent import RandomAgent
-from learning.dual_controller import DualControllerConfig
-from learning.errors import ConfigError
-from learning.memory.prior import MemoryConfig
-from learning.memory.store import MemoryStore
-from learning.puzzle_env import FaultConfig, PuzzleEnvConfig
-from learning.symbolic_world import SymbolicWorld
-from learning.trial import RunResult, run_episode
-from models import PuzzleSpec
-from models.generator import TEST_INDICES, TRAIN_INDICES, paper_variant
+from puzzlebox.learning.agent_names import SYMBOLIC_AGENT_NAMES
+from puzzlebox.learning.agents.base import Agent
+from puzzlebox.learning.agents.dual_agent import DualAgent, MemoryAgent
+from puzzlebox.learning.agents.oracle_agent import OracleAgent
+from puzzlebox.learning.agents.random_agent import RandomAgent
+from puzzlebox.learning.dual_controller import DualControllerConfig
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.memory.prior import MemoryConfig
+from puzzlebox.learning.memory.store import MemoryStore
+from puzzlebox.learning.puzzle_env import FaultConfig, PuzzleEnvConfig
+from puzzlebox.learning.symbolic_world import SymbolicWorld
+from puzzlebox.learning.trial import RunResult, run_episode
+from puzzlebox.models import PuzzleSpec
+from puzzlebox.models.generator import TEST_INDICES, TRAIN_INDICES, paper_variant
 
 TRAIN_LAYOUT_BASE = 100_000
 SYMBOLIC_AGENTS = SYMBOLIC_AGENT_NAMES

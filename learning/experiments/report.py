@@ -11,7 +11,7 @@ matplotlib.use("Agg")  # headless machines
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from learning.experiments.paper_numbers import CONVERGED, PAPER, PAPER_EPISODES_TO_SOLVE  # noqa: E402
+from puzzlebox.learning.experiments.paper_numbers import CONVERGED, PAPER, PAPER_EPISODES_TO_SOLVE  # noqa: E402
 
 AGENT_STYLE = {
     "memory": "C0",

@@ -8,10 +8,10 @@ from typing import Any
 
 import numpy as np
 
-from learning.agents.base import Agent
-from learning.symbolic_world import SymbolicWorld
-from learning.trial import run_episode
-from models import PuzzleSpec
+from puzzlebox.learning.agents.base import Agent
+from puzzlebox.learning.symbolic_world import SymbolicWorld
+from puzzlebox.learning.trial import run_episode
+from puzzlebox.models import PuzzleSpec
 
 TEST_SEED = 500
 """World seed of test run 0 (run r: ``TEST_SEED + r``) on every test scene."""

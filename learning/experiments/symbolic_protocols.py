@@ -14,7 +14,7 @@ from typing import Any
 
 from tqdm import tqdm
 
-from learning.experiments.protocol import (
+from puzzlebox.learning.experiments.protocol import (
     ProtocolConfig,
     Score,
     agent_factory,
@@ -22,9 +22,9 @@ from learning.experiments.protocol import (
     summarise_scores,
     train_memory,
 )
-from learning.memory.store import MemoryStore
-from learning.puzzle_env import FaultConfig
-from models.generator import TRAIN_INDICES
+from puzzlebox.learning.memory.store import MemoryStore
+from puzzlebox.learning.puzzle_env import FaultConfig
+from puzzlebox.models.generator import TRAIN_INDICES
 
 PAPER_UNIT = 0.015
 """One abstract unit of the authors' release in metres: their door-slide neighbour distance (6 units)

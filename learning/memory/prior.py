@@ -21,10 +21,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from learning.belief import block_confidence, default_prior, hypothesis_count
-from learning.memory.keys import se3_pose_keys
-from learning.memory.store import MemoryStore
-from models.disassembly_kinds import kind_family
+from puzzlebox.learning.belief import block_confidence, default_prior, hypothesis_count
+from puzzlebox.learning.memory.keys import se3_pose_keys
+from puzzlebox.learning.memory.store import MemoryStore
+from puzzlebox.models.disassembly_kinds import kind_family
 
 KEY_DECIMALS = 9
 """Distances in key space are ranked at this resolution (key units ~ 2 cm / 1 rad)."""

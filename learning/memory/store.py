@@ -50,15 +50,15 @@ from pathlib import Path
 
 import numpy as np
 
-from learning.errors import MemoryFileError
-from learning.memory.keys import (
+from puzzlebox.learning.errors import MemoryFileError
+from puzzlebox.learning.memory.keys import (
     DEFAULT_ROTATION_WEIGHT,
     PLANAR_KEY_SIZE,
     SE3_KEY_SIZE,
     SPATIAL_KEY_SIZE,
     se3_key_from_legacy,
 )
-from models.disassembly_kinds import kind_family
+from puzzlebox.models.disassembly_kinds import kind_family
 
 MEMORY_FORMAT = "puzzlebox-memory"
 PAIR_VALUE_SIZE = 6

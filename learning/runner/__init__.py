@@ -9,11 +9,18 @@ Example::
         report = run_tasks(tasks, RecordStore(out / "runs"), executor)
 """
 
-from learning.runner.errors import RunnerError
-from learning.runner.executors import Completion, Executor, InlineExecutor, PoolExecutor, RayExecutor, make_executor
-from learning.runner.records import RecordStore
-from learning.runner.run import RunReport, run_tasks
-from learning.runner.task import Task
+from puzzlebox.learning.runner.errors import RunnerError
+from puzzlebox.learning.runner.executors import (
+    Completion,
+    Executor,
+    InlineExecutor,
+    PoolExecutor,
+    RayExecutor,
+    make_executor,
+)
+from puzzlebox.learning.runner.records import RecordStore
+from puzzlebox.learning.runner.run import RunReport, run_tasks
+from puzzlebox.learning.runner.task import Task
 
 __all__ = [
     "Completion",

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from learning.errors import LearningError
+from puzzlebox.learning.errors import LearningError
 
 
 class RunnerError(LearningError, ValueError):

@@ -7,8 +7,8 @@ import json
 from pathlib import Path
 from typing import Any
 
-from learning.runner.task import Task
-from models.atomic import write_text_atomically
+from puzzlebox.learning.runner.task import Task
+from puzzlebox.models.atomic import write_text_atomically
 
 
 class RecordStore:

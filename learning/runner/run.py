@@ -10,11 +10,11 @@ from typing import Any
 
 from tqdm import tqdm
 
-from learning.errors import LearningError
-from learning.runner.errors import RunnerError
-from learning.runner.executors import Executor
-from learning.runner.records import RecordStore
-from learning.runner.task import Task
+from puzzlebox.learning.errors import LearningError
+from puzzlebox.learning.runner.errors import RunnerError
+from puzzlebox.learning.runner.executors import Executor
+from puzzlebox.learning.runner.records import RecordStore
+from puzzlebox.learning.runner.task import Task
 
 
 @dataclass

@@ -11,7 +11,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from learning.runner.errors import RunnerError
+from puzzlebox.learning.runner.errors import RunnerError
 
 _KEY = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9._+=@-]{0,199}$")
 

@@ -4,9 +4,9 @@ Every generator is a pure function of its parameters and seed: the same call giv
 JSON.
 """
 
-from models.generator.chain import BoxConfig, check_chain_kinds, generate_chain
-from models.generator.layout import LayoutConfig
-from models.generator.paper import (
+from puzzlebox.models.generator.chain import BoxConfig, check_chain_kinds, generate_chain
+from puzzlebox.models.generator.layout import LayoutConfig
+from puzzlebox.models.generator.paper import (
     TEST_INDICES,
     TRAIN_INDICES,
     paper_family,
@@ -14,7 +14,7 @@ from models.generator.paper import (
     paper_variant,
     paper_variant_name,
 )
-from models.generator.random_graph import MAX_RANDOM_COMPONENTS, RandomGraphConfig, generate_random
+from puzzlebox.models.generator.random_graph import MAX_RANDOM_COMPONENTS, RandomGraphConfig, generate_random
 
 __all__ = [
     "MAX_RANDOM_COMPONENTS",

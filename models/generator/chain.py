@@ -12,11 +12,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from models.errors import GeneratorError
-from models.generator.layout import Layout, LayoutConfig
-from models.kinds import registered_kinds, registry_family
-from models.reach import MAX_REACH, MIN_REACH, fitting_box_pose
-from models.spec import Box, Component, Goal, LockRule, PuzzleSpec, file_precision
+from puzzlebox.models.errors import GeneratorError
+from puzzlebox.models.generator.layout import Layout, LayoutConfig
+from puzzlebox.models.kinds import registered_kinds, registry_family
+from puzzlebox.models.reach import MAX_REACH, MIN_REACH, fitting_box_pose
+from puzzlebox.models.spec import Box, Component, Goal, LockRule, PuzzleSpec, file_precision
 
 MAX_LAYOUT_ATTEMPTS = 200
 
@@ -38,8 +38,9 @@ class BoxConfig:
     and more than :data:`MAX_REACHABLE_COMPONENTS` components are refused. False: keep :attr:`pose`
     whatever it leaves out of reach (a box for the symbolic simulator only)."""
     realizable: bool = True
-    """Draw again until every lock rule is a mechanism that blocks by contact (:mod:`models.lock_mechanisms`), so
-    that the model alone behaves as the spec says; False keeps the first layout drawn (a rule no mechanism serves
+    """Draw again until every lock rule is a mechanism that blocks by contact (:mod:`models.lock_mechanisms`) and
+    no part strikes another as it moves (:mod:`models.part_clearance`), so that the model alone behaves as the
+    spec says; False keeps the first layout drawn (a rule no mechanism serves
     is then held by a latch in the twin)."""
 
 
@@ -50,12 +51,15 @@ random layouts some pose fits falls from 20/20 at 16 components to 16/20 at 20, 
 
 
 def realizable(spec: PuzzleSpec, box: BoxConfig) -> bool:
-    """Whether ``spec`` is acceptable under ``box.realizable``: every lock rule a mechanism, or not asked."""
+    """Whether ``spec`` is acceptable under ``box.realizable``: every lock rule a mechanism and no two parts that
+    strike each other as they move (:mod:`models.part_clearance`), or not asked."""
     if not box.realizable:
         return True
-    from models.lock_mechanisms import design_mechanisms  # the design search only when generating
+    # the design search and the sweep only when generating
+    from puzzlebox.models.lock_mechanisms import design_mechanisms
+    from puzzlebox.models.part_clearance import meeting_parts
 
-    return design_mechanisms(spec).complete
+    return design_mechanisms(spec).complete and not meeting_parts(spec)
 
 
 def check_reach_size(num_components: int, box: BoxConfig) -> None:

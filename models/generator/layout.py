@@ -19,9 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.errors import GeneratorError
-from models.geometry import compose, polygon_gap
-from models.kinds import get_kind
+from puzzlebox.models.errors import GeneratorError
+from puzzlebox.models.geometry import compose, polygon_gap
+from puzzlebox.models.kinds import get_kind
 
 TURNS = (-math.pi / 2.0, 0.0, math.pi / 2.0)
 """Yaw of a new component relative to its anchor [rad]."""

@@ -18,10 +18,10 @@ from typing import Literal
 
 import numpy as np
 
-from models.errors import GeneratorError
-from models.generator.chain import BoxConfig, assemble, chain_layout, chain_rules, fit_to_reach
-from models.kinds import KIND_NAMES, may_neighbour
-from models.spec import PuzzleSpec
+from puzzlebox.models.errors import GeneratorError
+from puzzlebox.models.generator.chain import BoxConfig, assemble, chain_layout, chain_rules, fit_to_reach
+from puzzlebox.models.kinds import KIND_NAMES, may_neighbour
+from puzzlebox.models.spec import PuzzleSpec
 
 PAPER_LENGTH = 5
 TRAIN_INDICES = (0, 1, 2, 4, 5, 7, 8, 10, 11)

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.errors import GeneratorError
-from models.generator.chain import (
+from puzzlebox.models.errors import GeneratorError
+from puzzlebox.models.generator.chain import (
     MAX_LAYOUT_ATTEMPTS,
     BoxConfig,
     assemble,
@@ -26,9 +26,9 @@ from models.generator.chain import (
     fit_to_reach,
     realizable,
 )
-from models.generator.layout import Layout
-from models.kinds import PAPER_FAMILY, KindFamily
-from models.spec import PuzzleSpec
+from puzzlebox.models.generator.layout import Layout
+from puzzlebox.models.kinds import PAPER_FAMILY, KindFamily
+from puzzlebox.models.spec import PuzzleSpec
 
 MAX_RANDOM_COMPONENTS = 40
 """Layouts and the validator's reachability search stay fast up to this many components."""

@@ -15,11 +15,11 @@ travels follow the motions measured on this stack in DESIGN.md (door 85 deg, sli
 
 from __future__ import annotations
 
-from models.errors import UnknownKindError
-from models.kinds.door import DOOR, DOOR_HALF
-from models.kinds.family import PAPER_FAMILY, KindFamily, UnknownFamilyError
-from models.kinds.kind import Handling, JointDynamics, Kind
-from models.kinds.registry import (
+from puzzlebox.models.errors import UnknownKindError
+from puzzlebox.models.kinds.door import DOOR, DOOR_HALF
+from puzzlebox.models.kinds.family import PAPER_FAMILY, KindFamily, UnknownFamilyError
+from puzzlebox.models.kinds.kind import Handling, JointDynamics, Kind
+from puzzlebox.models.kinds.registry import (
     DuplicateKindError,
     KindRegistry,
     family_named,
@@ -29,9 +29,16 @@ from models.kinds.registry import (
     registered_kinds,
     registry_family,
 )
-from models.kinds.slide import SLIDE, SLIDE_BACK, SLIDE_HALF
-from models.kinds.template import HANDLE_HEIGHT, HANDLE_MARGIN, HANDLE_OFFSET, HANDLE_SIZE, MARKER_SIZE, KindTemplate
-from models.kinds.wheel import WHEEL, WHEEL_RADIUS
+from puzzlebox.models.kinds.slide import SLIDE, SLIDE_BACK, SLIDE_HALF
+from puzzlebox.models.kinds.template import (
+    HANDLE_HEIGHT,
+    HANDLE_MARGIN,
+    HANDLE_OFFSET,
+    HANDLE_SIZE,
+    MARKER_SIZE,
+    KindTemplate,
+)
+from puzzlebox.models.kinds.wheel import WHEEL, WHEEL_RADIUS
 
 PUZZLE_KINDS: dict[str, KindTemplate] = {k.name: k for k in (DOOR, SLIDE, WHEEL)}
 """The paper family's kinds, by name (pinned: a newly registered kind is not a paper kind)."""

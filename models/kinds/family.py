@@ -7,7 +7,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-from models.errors import ModelsError, UnknownKindError
+from puzzlebox.models.errors import ModelsError, UnknownKindError
 
 
 class UnknownFamilyError(ModelsError, ValueError):

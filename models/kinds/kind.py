@@ -7,7 +7,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
 
-from models.kinds.template import KindTemplate
+from puzzlebox.models.kinds.template import KindTemplate
 
 if TYPE_CHECKING:  # dm_control only for the type: importing models.kinds stays free of MuJoCo
     from dm_control import mjcf

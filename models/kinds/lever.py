@@ -22,10 +22,10 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from models.geometry import rectangle
-from models.kinds.kind import Handling, JointDynamics, Kind
-from models.kinds.parts import PART_DENSITY, PLATE_THICKNESS, add_handle, add_joint, add_plate
-from models.kinds.template import HANDLE_MARGIN, HANDLE_OFFSET, MARKER_SIZE, KindTemplate
+from puzzlebox.models.geometry import rectangle
+from puzzlebox.models.kinds.kind import Handling, JointDynamics, Kind
+from puzzlebox.models.kinds.parts import PART_DENSITY, PLATE_THICKNESS, add_handle, add_joint, add_plate
+from puzzlebox.models.kinds.template import HANDLE_MARGIN, HANDLE_OFFSET, MARKER_SIZE, KindTemplate
 
 if TYPE_CHECKING:
     from dm_control import mjcf

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from models.kinds.kind import JointDynamics
-from models.kinds.template import HANDLE_HEIGHT, HANDLE_SIZE, KindTemplate
+from puzzlebox.models.kinds.kind import JointDynamics
+from puzzlebox.models.kinds.template import HANDLE_HEIGHT, HANDLE_SIZE, KindTemplate
 
 if TYPE_CHECKING:
     from dm_control import mjcf

@@ -17,11 +17,11 @@ import importlib
 import pkgutil
 from collections.abc import Iterable
 
-from models.errors import ModelsError, UnknownKindError
-from models.kinds import door, slide, wheel
-from models.kinds.family import PAPER_FAMILY, KindFamily, UnknownFamilyError
-from models.kinds.kind import Kind
-from models.kinds.template import KindTemplate
+from puzzlebox.models.errors import ModelsError, UnknownKindError
+from puzzlebox.models.kinds import door, slide, wheel
+from puzzlebox.models.kinds.family import PAPER_FAMILY, KindFamily, UnknownFamilyError
+from puzzlebox.models.kinds.kind import Kind
+from puzzlebox.models.kinds.template import KindTemplate
 
 _NOT_KINDS = frozenset({"family", "kind", "parts", "registry", "template"})
 """Modules of this package that hold no kind."""
@@ -81,7 +81,7 @@ PAPER_KINDS: tuple[Kind, ...] = (door.KIND, slide.KIND, wheel.KIND)
 
 def _kind_modules() -> list[str]:
     """Names of this package's modules that may define a kind, sorted (the paper's excluded)."""
-    package = importlib.import_module("models.kinds")
+    package = importlib.import_module("puzzlebox.models.kinds")
     paper = {k.name for k in PAPER_KINDS}
     return sorted(m.name for m in pkgutil.iter_modules(package.__path__) if m.name not in _NOT_KINDS | paper)
 
@@ -89,7 +89,7 @@ def _kind_modules() -> list[str]:
 def _discover() -> tuple[Kind, ...]:
     found = []
     for module_name in _kind_modules():
-        module = importlib.import_module(f"models.kinds.{module_name}")
+        module = importlib.import_module(f"puzzlebox.models.kinds.{module_name}")
         kind = getattr(module, "KIND", None)
         if isinstance(kind, Kind):
             found.append(kind)

@@ -20,7 +20,7 @@ from typing import Literal
 
 import numpy as np
 
-from models.geometry import clip_below_x, transform_points
+from puzzlebox.models.geometry import clip_below_x, transform_points
 
 MARKER_SIZE = 0.036
 """Side of every component's ArUco marker (black square) [m]: ~38 px from the overview camera."""

@@ -10,10 +10,10 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from models.geometry import circle_polygon
-from models.kinds.kind import JointDynamics, Kind
-from models.kinds.parts import PART_DENSITY, PLATE_THICKNESS, add_handle, add_joint
-from models.kinds.template import HANDLE_OFFSET, MARKER_SIZE, KindTemplate
+from puzzlebox.models.geometry import circle_polygon
+from puzzlebox.models.kinds.kind import JointDynamics, Kind
+from puzzlebox.models.kinds.parts import PART_DENSITY, PLATE_THICKNESS, add_handle, add_joint
+from puzzlebox.models.kinds.template import HANDLE_OFFSET, MARKER_SIZE, KindTemplate
 
 if TYPE_CHECKING:
     from dm_control import mjcf

@@ -25,7 +25,6 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scripts"))
 
 
 def python(*args, timeout=900):
@@ -60,7 +59,7 @@ def test_the_quick_fault_suite_detects_survives_and_keeps_every_case(tmp_path):
 
 
 def test_a_killed_pool_worker_is_replaced_and_no_run_is_lost(specs, tmp_path):
-    from _faults import _pool_workers
+    from puzzlebox.lab.faults import _pool_workers
 
     def trial(out, *flags):
         return [sys.executable, ROOT / "scripts/trial.py", "--specs", *sorted(specs.glob("*.json")), "--sim",
@@ -89,11 +88,10 @@ def test_a_killed_pool_worker_is_replaced_and_no_run_is_lost(specs, tmp_path):
 def test_physics_that_diverges_ends_the_run_with_its_name_and_keeps_the_record(specs):
     """Velocities made infinite mid-survey: MuJoCo flags it at the next step, the session raises
     SimulationDiverged, and the trial records the run as ended for that reason (no traceback)."""
-    from _twin_trial import run_twin_trial
-
-    from models import load_spec
-    from twin.errors import SimulationDiverged
-    from twin.session import TwinSession
+    from puzzlebox.lab.twin_trial import run_twin_trial
+    from puzzlebox.models import load_spec
+    from puzzlebox.twin.errors import SimulationDiverged
+    from puzzlebox.twin.session import TwinSession
 
     spec = load_spec(specs / "paper-test-0.json")
     with TwinSession(spec, seed=0) as session:
@@ -124,7 +122,7 @@ def test_a_video_killed_in_mid_write_never_appears_under_its_final_name(specs, t
     the orphaned drawing process discards its partial file and exits, and the resume publishes a whole video."""
     import imageio_ffmpeg
 
-    from twin.rollout_video import RolloutConfig
+    from puzzlebox.twin.rollout_video import RolloutConfig
 
     out = tmp_path / "out"
     command = [sys.executable, ROOT / "scripts/trial.py", "--specs", specs / "paper-test-0.json", "--sim", "twin",

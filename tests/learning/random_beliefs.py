@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from learning.belief import Belief, BeliefConfig, hypothesis_count
+from puzzlebox.learning.belief import Belief, BeliefConfig, hypothesis_count
 
 EXACT = BeliefConfig(jam_probability=0.0, false_move_probability=0.0)
 NOISY = BeliefConfig(jam_probability=0.05, false_move_probability=0.02)

@@ -8,11 +8,11 @@ import sys
 
 import pytest
 
-from learning.agent_names import AGENT_NAMES, DEEP_AGENT_NAMES, SYMBOLIC_AGENT_NAMES
-from learning.errors import ConfigError, UnknownAgent
-from learning.experiments.protocol import ProtocolConfig, agent_factory
-from learning.memory.store import MemoryStore
-from models.generator import generate_chain
+from puzzlebox.learning.agent_names import AGENT_NAMES, DEEP_AGENT_NAMES, SYMBOLIC_AGENT_NAMES
+from puzzlebox.learning.errors import ConfigError, UnknownAgent
+from puzzlebox.learning.experiments.protocol import ProtocolConfig, agent_factory
+from puzzlebox.learning.memory.store import MemoryStore
+from puzzlebox.models.generator import generate_chain
 
 
 def test_the_names_are_read_without_torch():
@@ -23,8 +23,8 @@ def test_the_names_are_read_without_torch():
 
 def test_the_deep_registry_and_the_checkpoints_know_exactly_the_deep_names():
     pytest.importorskip("torch")
-    from learning.baselines.checkpoint import AGENTS
-    from learning.baselines.registry import LEARNERS
+    from puzzlebox.learning.baselines.checkpoint import AGENTS
+    from puzzlebox.learning.baselines.registry import LEARNERS
 
     assert set(LEARNERS) == set(AGENTS) == set(DEEP_AGENT_NAMES)
 
@@ -38,7 +38,7 @@ def test_the_protocols_build_every_symbolic_agent_and_refuse_the_others():
 
 
 def test_an_unknown_agent_lists_every_name():
-    from learning import make_agent
+    from puzzlebox.learning import make_agent
 
     with pytest.raises(UnknownAgent) as raised:
         make_agent("genius", generate_chain(["door", "slide"], seed=0))

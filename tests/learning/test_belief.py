@@ -7,8 +7,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from learning.belief import Belief, BeliefConfig, block_entropy, default_prior, hypothesis_count
-from learning.errors import ConfigError
+from puzzlebox.learning.belief import Belief, BeliefConfig, block_entropy, default_prior, hypothesis_count
+from puzzlebox.learning.errors import ConfigError
 
 EXACT = BeliefConfig(jam_probability=0.0, false_move_probability=0.0)
 """The paper's exact elimination (the library default adds a 0.001 noise floor)."""

@@ -10,12 +10,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from random_beliefs import EXACT, NOISY, random_belief, random_problem
 
-import learning.planner as planner
-from learning.belief import Belief, hypothesis_count, state_bits
-from learning.best_first import BestFirstPlanner
-from learning.dual_controller import DualControllerConfig, decide
-from learning.exploration import expected_information_gain, information_values
-from learning.planner import PlannerConfig, exploit_values, free_table, state_values, value_iteration
+import puzzlebox.learning.planner as planner
+from puzzlebox.learning.belief import Belief, hypothesis_count, state_bits
+from puzzlebox.learning.best_first import BestFirstPlanner
+from puzzlebox.learning.dual_controller import DualControllerConfig, decide
+from puzzlebox.learning.exploration import expected_information_gain, information_values
+from puzzlebox.learning.planner import PlannerConfig, exploit_values, free_table, state_values, value_iteration
 
 
 def brute_force_cost(belief: Belief, source: int, goal: int, goal_state: int, gamma: float) -> float:

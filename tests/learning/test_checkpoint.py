@@ -10,8 +10,8 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from learning import SymbolicWorld, make_agent, run_episode  # noqa: E402
-from learning.baselines import (  # noqa: E402
+from puzzlebox.learning import SymbolicWorld, make_agent, run_episode  # noqa: E402
+from puzzlebox.learning.baselines import (  # noqa: E402
     CheckpointError,
     DQNAgent,
     DQNConfig,
@@ -21,8 +21,8 @@ from learning.baselines import (  # noqa: E402
     load_checkpoint,
     save_checkpoint,
 )
-from learning.errors import ConfigError  # noqa: E402
-from models.generator import generate_chain  # noqa: E402
+from puzzlebox.learning.errors import ConfigError  # noqa: E402
+from puzzlebox.models.generator import generate_chain  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 SMALL = GraphNetworkConfig(blocks=1, hidden=16)

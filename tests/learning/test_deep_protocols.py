@@ -5,15 +5,15 @@ import json
 
 import pytest
 
-from learning.errors import ConfigError
-from learning.experiments import ProtocolConfig
-from learning.experiments.deep_protocols import (
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.experiments import ProtocolConfig
+from puzzlebox.learning.experiments.deep_protocols import (
     DeepSchedule,
     cached_record,
     jobs_for,
     merge_deep_points,
 )
-from learning.experiments.report import episodes_to_solve
+from puzzlebox.learning.experiments.report import episodes_to_solve
 
 CONFIG = ProtocolConfig(runs_per_variant=2, training_seeds=2)
 SCHEDULE = DeepSchedule(checkpoints=(0, 5, 10), converged_episodes=10, variant_counts=(0, 1, 9))
@@ -41,14 +41,14 @@ def _record(job, config, success):
     if job.conditions_at is not None:
         evaluations += [{"episodes": job.conditions_at, "condition": c, "success_rate": 0.5, "mean_actions": 9.0,
                          "runs": 6} for c in ("wrong kind", "pose noise", "both", "moved box")]  # fmt: skip
-    from learning.experiments.deep_protocols import _settings
+    from puzzlebox.learning.experiments.deep_protocols import _settings
 
     return {"settings": json.loads(json.dumps(_settings(job, config))), "evaluations": evaluations}
 
 
 def test_a_cached_job_is_reused_only_with_identical_settings(tmp_path):
-    from learning.experiments.deep_protocols import job_task
-    from learning.runner import RecordStore
+    from puzzlebox.learning.experiments.deep_protocols import job_task
+    from puzzlebox.learning.runner import RecordStore
 
     job = jobs_for("episodes", ["dqn"], CONFIG, SCHEDULE)[0]
     RecordStore(tmp_path / "jobs").put(job_task(job, CONFIG, tmp_path), _record(job, CONFIG, lambda x: 1.0))

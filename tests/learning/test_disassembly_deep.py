@@ -11,8 +11,8 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from learning.agents.factory import make_agent  # noqa: E402
-from learning.baselines import (  # noqa: E402
+from puzzlebox.learning.agents.factory import make_agent  # noqa: E402
+from puzzlebox.learning.baselines import (  # noqa: E402
     CheckpointError,
     GraphNetworkConfig,
     load_checkpoint,
@@ -20,14 +20,14 @@ from learning.baselines import (  # noqa: E402
     observation_tensors,
     save_checkpoint,
 )
-from learning.baselines.graph_network import NODE_FEATURES, SceneMismatch  # noqa: E402
-from learning.baselines.multitask import progress  # noqa: E402
-from learning.errors import ConfigError, LearningError  # noqa: E402
-from learning.experiments.disassembly_deep import train_deep_on_scene  # noqa: E402
-from learning.symbolic_world import SymbolicWorld  # noqa: E402
-from learning.trial import run_episode  # noqa: E402
-from models import KIND_NAMES, load_spec, spec_from_dict  # noqa: E402
-from models.disassembly_kinds import DISASSEMBLY_KIND_NAMES  # noqa: E402
+from puzzlebox.learning.baselines.graph_network import NODE_FEATURES, SceneMismatch  # noqa: E402
+from puzzlebox.learning.baselines.multitask import progress  # noqa: E402
+from puzzlebox.learning.errors import ConfigError, LearningError  # noqa: E402
+from puzzlebox.learning.experiments.disassembly_deep import train_deep_on_scene  # noqa: E402
+from puzzlebox.learning.symbolic_world import SymbolicWorld  # noqa: E402
+from puzzlebox.learning.trial import run_episode  # noqa: E402
+from puzzlebox.models import KIND_NAMES, load_spec, spec_from_dict  # noqa: E402
+from puzzlebox.models.disassembly_kinds import DISASSEMBLY_KIND_NAMES  # noqa: E402
 
 DATA = Path(__file__).resolve().parents[3] / "shared" / "data" / "disassembly"
 pytestmark = pytest.mark.skipif(not DATA.is_dir(), reason=f"{DATA} (the shared disassembly data) is absent")

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from learning.errors import ConfigError
-from learning.experiments.disassembly import DATA_DIR, DisassemblyConfig, run_disassembly, scenes, tasks_for
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.experiments.disassembly import DATA_DIR, DisassemblyConfig, run_disassembly, scenes, tasks_for
 
 ROOT = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.skipif(not DATA_DIR.is_dir(), reason=f"{DATA_DIR} (the shared disassembly data) is absent")

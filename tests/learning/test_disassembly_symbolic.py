@@ -7,14 +7,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from learning.agents.dual_agent import MemoryAgent
-from learning.agents.factory import make_agent
-from learning.memory.store import MemoryStore
-from learning.puzzle_env import PuzzleEnv
-from learning.symbolic_world import SymbolicWorld
-from learning.trial import run_episode
-from models import LockTable, load_spec, spec_from_dict
-from models.disassembly_kinds import DISASSEMBLY_KIND_NAMES
+from puzzlebox.learning.agents.dual_agent import MemoryAgent
+from puzzlebox.learning.agents.factory import make_agent
+from puzzlebox.learning.memory.store import MemoryStore
+from puzzlebox.learning.puzzle_env import PuzzleEnv
+from puzzlebox.learning.symbolic_world import SymbolicWorld
+from puzzlebox.learning.trial import run_episode
+from puzzlebox.models import LockTable, load_spec, spec_from_dict
+from puzzlebox.models.disassembly_kinds import DISASSEMBLY_KIND_NAMES
 
 DATA = Path(__file__).resolve().parents[3] / "shared" / "data" / "disassembly"
 pytestmark = pytest.mark.skipif(not DATA.is_dir(), reason=f"{DATA} (the shared disassembly data) is absent")
@@ -65,7 +65,7 @@ def test_one_memory_holds_puzzle_boxes_and_disassembly_scenes_and_recalls_each_a
 
 
 def test_misreported_kinds_stay_in_the_scenes_family(lab_b):
-    from learning.puzzle_env import FaultConfig, PuzzleEnvConfig
+    from puzzlebox.learning.puzzle_env import FaultConfig, PuzzleEnvConfig
 
     env = PuzzleEnv(lab_b, PuzzleEnvConfig(faults=FaultConfig(misreported_kinds=3)))
     obs, _ = env.reset(seed=0)

@@ -5,9 +5,9 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from learning import RandomAgent, SymbolicWorld, run_episode  # noqa: E402
-from learning.baselines import DQNAgent, DQNConfig, GraphNetworkConfig  # noqa: E402
-from models.generator import generate_chain  # noqa: E402
+from puzzlebox.learning import RandomAgent, SymbolicWorld, run_episode  # noqa: E402
+from puzzlebox.learning.baselines import DQNAgent, DQNConfig, GraphNetworkConfig  # noqa: E402
+from puzzlebox.models.generator import generate_chain  # noqa: E402
 
 
 def test_dqn_learns_a_two_component_box_within_two_hundred_episodes():

@@ -5,14 +5,21 @@ import itertools
 import numpy as np
 import pytest
 
-from learning import DualAgent, MemoryAgent, SymbolicWorld, run_episode, summarise
-from learning.belief import Belief, BeliefConfig, hypothesis_count
-from learning.dual_controller import DualControllerConfig, decide, max_entropy_for
-from learning.exploration import information_values
-from learning.memory import MemoryStore
-from learning.planner import exploit_values
-from models import LockTable
-from models.generator import TEST_INDICES, TRAIN_INDICES, BoxConfig, RandomGraphConfig, generate_random, paper_variant
+from puzzlebox.learning import DualAgent, MemoryAgent, SymbolicWorld, run_episode, summarise
+from puzzlebox.learning.belief import Belief, BeliefConfig, hypothesis_count
+from puzzlebox.learning.dual_controller import DualControllerConfig, decide, max_entropy_for
+from puzzlebox.learning.exploration import information_values
+from puzzlebox.learning.memory import MemoryStore
+from puzzlebox.learning.planner import exploit_values
+from puzzlebox.models import LockTable
+from puzzlebox.models.generator import (
+    TEST_INDICES,
+    TRAIN_INDICES,
+    BoxConfig,
+    RandomGraphConfig,
+    generate_random,
+    paper_variant,
+)
 
 SYMBOLIC_BOX = BoxConfig(realizable=False)
 """Random boxes as drawn before lock mechanisms existed: these symbolic tests chose their seeds for their graphs."""

@@ -6,9 +6,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from random_beliefs import NOISY, random_belief, random_problem
 
-import learning.planner as planner
-from learning.belief import Belief
-from learning.planner import exploit_values, free_table, open_free_rows, open_index, value_iteration
+import puzzlebox.learning.planner as planner
+from puzzlebox.learning.belief import Belief
+from puzzlebox.learning.planner import exploit_values, free_table, open_free_rows, open_index, value_iteration
 
 
 def jacobi_values(table: np.ndarray, goal: int, goal_state: int, gamma: float) -> np.ndarray:

@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from learning.belief import Belief, BeliefConfig, default_prior, hypothesis_count
-from learning.exploration import expected_information_gain, information_values, kl_divergence
+from puzzlebox.learning.belief import Belief, BeliefConfig, default_prior, hypothesis_count
+from puzzlebox.learning.exploration import expected_information_gain, information_values, kl_divergence
 
 EXACT = BeliefConfig(jam_probability=0.0, false_move_probability=0.0)
 """The paper's exact elimination (the library default adds a 0.001 noise floor)."""

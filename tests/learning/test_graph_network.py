@@ -5,10 +5,10 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from learning import SymbolicWorld  # noqa: E402
-from learning.baselines import GraphNetwork, GraphNetworkConfig, observation_tensors  # noqa: E402
-from learning.errors import ConfigError  # noqa: E402
-from models.generator import paper_family  # noqa: E402
+from puzzlebox.learning import SymbolicWorld  # noqa: E402
+from puzzlebox.learning.baselines import GraphNetwork, GraphNetworkConfig, observation_tensors  # noqa: E402
+from puzzlebox.learning.errors import ConfigError  # noqa: E402
+from puzzlebox.models.generator import paper_family  # noqa: E402
 
 
 @pytest.mark.parametrize("poses", ["relative", "absolute"])
@@ -51,9 +51,9 @@ def test_absolute_poses_go_into_the_nodes_and_unknown_encodings_are_config_error
 
 
 def test_features_are_sized_from_the_registry_for_boxes_with_new_kinds_and_a_paper_network_refuses_them():
-    from learning.baselines.graph_network import SceneMismatch
-    from models.generator import generate_chain
-    from models.kinds import registry_family
+    from puzzlebox.learning.baselines.graph_network import SceneMismatch
+    from puzzlebox.models.generator import generate_chain
+    from puzzlebox.models.kinds import registry_family
 
     spec = generate_chain(["slide", "lever", "drawer", "wheel"], seed=0)
     config = GraphNetworkConfig.for_spec(spec)

@@ -7,17 +7,17 @@ from collections import defaultdict
 import numpy as np
 import pytest
 
-from learning.agents.dual_agent import DualAgent, MemoryAgent
-from learning.belief import BeliefConfig
-from learning.dual_controller import DualControllerConfig
-from learning.errors import ConfigError
-from learning.holding_pairs import holding_pairs, restrict_single_prior
-from learning.locker_sets import locker_sets
-from learning.memory.store import MemoryStore
-from learning.symbolic_world import SymbolicWorld
-from learning.trial import run_episode
-from models import spec_from_dict
-from models.errors import UnknownKindError
+from puzzlebox.learning.agents.dual_agent import DualAgent, MemoryAgent
+from puzzlebox.learning.belief import BeliefConfig
+from puzzlebox.learning.dual_controller import DualControllerConfig
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.holding_pairs import holding_pairs, restrict_single_prior
+from puzzlebox.learning.locker_sets import locker_sets
+from puzzlebox.learning.memory.store import MemoryStore
+from puzzlebox.learning.symbolic_world import SymbolicWorld
+from puzzlebox.learning.trial import run_episode
+from puzzlebox.models import spec_from_dict
+from puzzlebox.models.errors import UnknownKindError
 
 
 @pytest.fixture

@@ -6,14 +6,14 @@ import json
 import numpy as np
 import pytest
 
-from learning import DualAgent, MemoryAgent, SymbolicWorld, make_agent, run_episode
-from learning.belief import Belief, BeliefConfig
-from learning.dual_controller import DualControllerConfig
-from learning.errors import ConfigError
-from learning.memory import MemoryStore
-from learning.multi_belief import MultiBelief
-from models.generator import TEST_INDICES, TRAIN_INDICES, RandomGraphConfig, generate_random, paper_variant
-from models.generator.chain import BoxConfig
+from puzzlebox.learning import DualAgent, MemoryAgent, SymbolicWorld, make_agent, run_episode
+from puzzlebox.learning.belief import Belief, BeliefConfig
+from puzzlebox.learning.dual_controller import DualControllerConfig
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.memory import MemoryStore
+from puzzlebox.learning.multi_belief import MultiBelief
+from puzzlebox.models.generator import TEST_INDICES, TRAIN_INDICES, RandomGraphConfig, generate_random, paper_variant
+from puzzlebox.models.generator.chain import BoxConfig
 
 SYMBOLIC_BOX = BoxConfig(realizable=False)
 """Random boxes as drawn before lock mechanisms existed: these symbolic tests chose their seeds for their graphs."""

@@ -6,17 +6,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from learning.agents.dual_agent import MemoryAgent
-from learning.belief import Belief, block_confidence, hypothesis_count
-from learning.dual_controller import DualControllerConfig
-from learning.errors import ConfigError
-from learning.locker_sets import locker_sets
-from learning.memory.keys import se3_pose_keys
-from learning.memory.prior import episode_record
-from learning.memory.store import MemoryStore
-from learning.multi_belief import MultiBelief
-from learning.set_prior import membership_set_prior
-from models.observation import ComponentObservation, SceneObservation
+from puzzlebox.learning.agents.dual_agent import MemoryAgent
+from puzzlebox.learning.belief import Belief, block_confidence, hypothesis_count
+from puzzlebox.learning.dual_controller import DualControllerConfig
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.locker_sets import locker_sets
+from puzzlebox.learning.memory.keys import se3_pose_keys
+from puzzlebox.learning.memory.prior import episode_record
+from puzzlebox.learning.memory.store import MemoryStore
+from puzzlebox.learning.multi_belief import MultiBelief
+from puzzlebox.learning.set_prior import membership_set_prior
+from puzzlebox.models.observation import ComponentObservation, SceneObservation
 
 N = 3  # screw-1 (0), screw-2 (1), panel (2)
 KINDS = ("screw", "screw", "panel")

@@ -10,10 +10,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from learning import MemoryAgent, SymbolicWorld, run_episode
-from learning.belief import Belief, default_prior, hypothesis_count
-from learning.errors import LearningError, MemoryFileError
-from learning.memory import (
+from puzzlebox.learning import MemoryAgent, SymbolicWorld, run_episode
+from puzzlebox.learning.belief import Belief, default_prior, hypothesis_count
+from puzzlebox.learning.errors import LearningError, MemoryFileError
+from puzzlebox.learning.memory import (
     MEMORY_FORMAT,
     SCHEMA_VERSION,
     MemoryConfig,
@@ -23,8 +23,8 @@ from learning.memory import (
     relative_pose_keys,
     se3_pose_keys,
 )
-from learning.memory.keys import se3_key_from_legacy
-from models.generator import TEST_INDICES, TRAIN_INDICES, paper_variant
+from puzzlebox.learning.memory.keys import se3_key_from_legacy
+from puzzlebox.models.generator import TEST_INDICES, TRAIN_INDICES, paper_variant
 
 KINDS = ("door", "slide", "wheel")
 PAPER_CONFIG = MemoryConfig(bandwidth=None, weight_by_confidence=False)

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 from legacy_memory import make_legacy
 
-from learning.errors import MemoryFileError
-from learning.memory import SCHEMA_VERSION, MemoryStore, se3_pose_keys
+from puzzlebox.learning.errors import MemoryFileError
+from puzzlebox.learning.memory import SCHEMA_VERSION, MemoryStore, se3_pose_keys
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -14,11 +14,11 @@ import pytest
 from legacy_memory import make_legacy
 from scipy.spatial.transform import Rotation
 
-from learning import MemoryAgent, SymbolicWorld, run_episode
-from learning.errors import MemoryFileError
-from learning.memory import MemoryConfig, MemoryStore, recall_prior, relative_pose_keys, se3_pose_keys
-from learning.memory.keys import SE3_KEY_SIZE, se3_key_from_legacy
-from models.generator import TEST_INDICES, TRAIN_INDICES, paper_variant
+from puzzlebox.learning import MemoryAgent, SymbolicWorld, run_episode
+from puzzlebox.learning.errors import MemoryFileError
+from puzzlebox.learning.memory import MemoryConfig, MemoryStore, recall_prior, relative_pose_keys, se3_pose_keys
+from puzzlebox.learning.memory.keys import SE3_KEY_SIZE, se3_key_from_legacy
+from puzzlebox.models.generator import TEST_INDICES, TRAIN_INDICES, paper_variant
 
 ROOT = Path(__file__).resolve().parents[2]
 

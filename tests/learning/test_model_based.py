@@ -5,10 +5,10 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from learning import SymbolicWorld, run_episode  # noqa: E402
-from learning.baselines import GraphNetworkConfig, ModelBasedAgent, ModelBasedConfig  # noqa: E402
-from models import LockTable  # noqa: E402
-from models.generator import generate_chain  # noqa: E402
+from puzzlebox.learning import SymbolicWorld, run_episode  # noqa: E402
+from puzzlebox.learning.baselines import GraphNetworkConfig, ModelBasedAgent, ModelBasedConfig  # noqa: E402
+from puzzlebox.models import LockTable  # noqa: E402
+from puzzlebox.models.generator import generate_chain  # noqa: E402
 
 
 def test_learned_preconditions_plan_a_three_component_chain_optimally():

@@ -5,14 +5,14 @@ import itertools
 import numpy as np
 import pytest
 
-import learning.planner as planner
-from learning.belief import BeliefConfig, default_prior
-from learning.errors import ConfigError
-from learning.exploration import expected_information_gain, information_values
-from learning.locker_sets import locker_set_count, locker_sets
-from learning.multi_belief import MultiBelief
-from learning.planner import exploit_values, free_table, value_iteration
-from learning.set_prior import set_prior
+import puzzlebox.learning.planner as planner
+from puzzlebox.learning.belief import BeliefConfig, default_prior
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.exploration import expected_information_gain, information_values
+from puzzlebox.learning.locker_sets import locker_set_count, locker_sets
+from puzzlebox.learning.multi_belief import MultiBelief
+from puzzlebox.learning.planner import exploit_values, free_table, value_iteration
+from puzzlebox.learning.set_prior import set_prior
 
 EXACT = BeliefConfig(jam_probability=0.0, false_move_probability=0.0)
 NOISY = BeliefConfig(jam_probability=0.05, false_move_probability=0.02)
@@ -308,7 +308,7 @@ def test_the_generic_heuristic_is_admissible_for_the_one_locker_belief_too():
     finds the values of value iteration as well."""
     from random_beliefs import random_problem
 
-    from learning.set_best_first import SetBestFirstPlanner
+    from puzzlebox.learning.set_best_first import SetBestFirstPlanner
 
     for seed in range(3):
         rng, belief, goal, goal_state = random_problem(seed, 6)

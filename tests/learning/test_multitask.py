@@ -6,8 +6,8 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from learning import SymbolicWorld, run_episode  # noqa: E402
-from learning.baselines import (  # noqa: E402
+from puzzlebox.learning import SymbolicWorld, run_episode  # noqa: E402
+from puzzlebox.learning.baselines import (  # noqa: E402
     DQNAgent,
     DQNConfig,
     GraphNetworkConfig,
@@ -15,9 +15,9 @@ from learning.baselines import (  # noqa: E402
     ModelBasedConfig,
     make_learner,
 )
-from learning.baselines.multitask import GOAL_COLUMN, STATE_COLUMN, Step, relabel_episode  # noqa: E402
-from learning.errors import UnknownAgent  # noqa: E402
-from models.generator import generate_chain  # noqa: E402
+from puzzlebox.learning.baselines.multitask import GOAL_COLUMN, STATE_COLUMN, Step, relabel_episode  # noqa: E402
+from puzzlebox.learning.errors import UnknownAgent  # noqa: E402
+from puzzlebox.models.generator import generate_chain  # noqa: E402
 
 SMALL = GraphNetworkConfig(blocks=1, hidden=16)
 

@@ -8,11 +8,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import learning.planner as planner
-from learning.belief import Belief, BeliefConfig, hypothesis_count
-from learning.planner import PlannerConfig, exploit_values, free_table, state_values
-from models import LockTable
-from models.generator import BoxConfig, RandomGraphConfig, generate_random, paper_family
+import puzzlebox.learning.planner as planner
+from puzzlebox.learning.belief import Belief, BeliefConfig, hypothesis_count
+from puzzlebox.learning.planner import PlannerConfig, exploit_values, free_table, state_values
+from puzzlebox.models import LockTable
+from puzzlebox.models.generator import BoxConfig, RandomGraphConfig, generate_random, paper_family
 
 SYMBOLIC_BOX = BoxConfig(realizable=False)
 """Random boxes as drawn before lock mechanisms existed: these symbolic tests chose their seeds for their graphs."""

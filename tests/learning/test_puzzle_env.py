@@ -2,9 +2,9 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from learning import ConfigError, FaultConfig, InvalidAction, PuzzleEnv, PuzzleEnvConfig
-from models import KIND_NAMES, Box, Component, Goal, LockRule, PuzzleSpec, kind_code
-from models.generator import BoxConfig, RandomGraphConfig, generate_random, paper_family
+from puzzlebox.learning import ConfigError, FaultConfig, InvalidAction, PuzzleEnv, PuzzleEnvConfig
+from puzzlebox.models import KIND_NAMES, Box, Component, Goal, LockRule, PuzzleSpec, kind_code
+from puzzlebox.models.generator import BoxConfig, RandomGraphConfig, generate_random, paper_family
 
 SYMBOLIC_BOX = BoxConfig(realizable=False)
 """Random boxes as drawn before lock mechanisms existed: these symbolic tests chose their seeds for their graphs."""
@@ -187,8 +187,8 @@ def test_a_turned_box_turns_the_observed_poses(paper_spec):
 
 
 def test_boxes_with_new_kinds_code_kinds_in_the_registry_family_and_pass_check_env():
-    from models.generator import generate_chain
-    from models.kinds import registry_family
+    from puzzlebox.models.generator import generate_chain
+    from puzzlebox.models.kinds import registry_family
 
     spec = generate_chain(["door", "drawer", "lever", "wheel"], seed=1)
     env = PuzzleEnv(spec)

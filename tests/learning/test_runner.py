@@ -9,8 +9,8 @@ import threading
 import pytest
 import runner_tasks
 
-from learning.errors import LearningError
-from learning.runner import (
+from puzzlebox.learning.errors import LearningError
+from puzzlebox.learning.runner import (
     InlineExecutor,
     PoolExecutor,
     RayExecutor,

@@ -1,9 +1,9 @@
 import numpy as np
 
-from learning import OracleAgent, PuzzleEnvConfig, RandomAgent, SymbolicWorld, run_episode, summarise
-from learning.puzzle_env import FaultConfig
-from models import LockTable, World
-from models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random, paper_family
+from puzzlebox.learning import OracleAgent, PuzzleEnvConfig, RandomAgent, SymbolicWorld, run_episode, summarise
+from puzzlebox.learning.puzzle_env import FaultConfig
+from puzzlebox.models import LockTable, World
+from puzzlebox.models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random, paper_family
 
 SYMBOLIC_BOX = BoxConfig(realizable=False)
 """Random boxes as drawn before lock mechanisms existed: these symbolic tests chose their seeds for their graphs."""

@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from learning import DualAgent, SymbolicWorld, run_episode
-from learning.trial import MAX_FAILURES_IN_A_ROW
-from models import TryResult
-from models.generator import paper_family
+from puzzlebox.learning import DualAgent, SymbolicWorld, run_episode
+from puzzlebox.learning.trial import MAX_FAILURES_IN_A_ROW
+from puzzlebox.models import TryResult
+from puzzlebox.models.generator import paper_family
 
 
 def _spec():

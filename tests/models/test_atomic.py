@@ -6,7 +6,7 @@ import threading
 
 import pytest
 
-from models.atomic import write_atomically, write_text_atomically
+from puzzlebox.models.atomic import write_atomically, write_text_atomically
 
 
 def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path):

@@ -3,10 +3,10 @@
 import mujoco
 import pytest
 
-from models import spec_from_dict
-from models.box_export import NotAPuzzleBox, build_box_model, compile_box, export_box
-from models.generator import paper_family
-from models.lock_check import check_locks
+from puzzlebox.models import spec_from_dict
+from puzzlebox.models.box_export import NotAPuzzleBox, build_box_model, compile_box, export_box
+from puzzlebox.models.generator import paper_family
+from puzzlebox.models.lock_check import check_locks
 
 
 def test_the_exported_box_is_the_compiled_box_and_holds_its_rules_by_contact(tmp_path):

@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from models.cell_config import EXAMPLE, CellConfig, CellConfigError, load_cell_config, save_cell_config
+from puzzlebox.models.cell_config import EXAMPLE, CellConfig, CellConfigError, load_cell_config, save_cell_config
 
 GOOD = EXAMPLE
 
@@ -55,14 +55,14 @@ def test_a_camera_device_for_no_camera_is_refused():
 
 
 def test_twin_config_matches_the_constants_twin_and_skills_use(tmp_path):
-    from models.generator.paper import paper_family
-    from models.kinds import MARKER_SIZE
-    from models.markers import ARUCO_DICTIONARY
-    from models.xarm7 import HOME_QPOS
-    from skills.primitives import PrimitiveConfig
-    from twin.cell_config import twin_cell_config
-    from twin.robot_interface import GRIPPER_CTRL_MAX
-    from twin.session import TwinSession
+    from puzzlebox.models.generator.paper import paper_family
+    from puzzlebox.models.kinds import MARKER_SIZE
+    from puzzlebox.models.markers import ARUCO_DICTIONARY
+    from puzzlebox.models.xarm7 import HOME_QPOS
+    from puzzlebox.skills.primitives import PrimitiveConfig
+    from puzzlebox.twin.cell_config import twin_cell_config
+    from puzzlebox.twin.robot_interface import GRIPPER_CTRL_MAX
+    from puzzlebox.twin.session import TwinSession
 
     skills = PrimitiveConfig()
     with TwinSession(paper_family("test")[0], seed=0, reality="realistic") as session:
@@ -72,7 +72,7 @@ def test_twin_config_matches_the_constants_twin_and_skills_use(tmp_path):
         assert {config.overview_camera, config.wrist_camera} == set(robot.camera_names)
         assert all(robot.capture(name) is not None for name in config.camera_names)
         assert config.ft_rate_hz == session.ft.config.rate_hz == 100.0
-    assert load_cell_config(save_cell_config(config, tmp_path / "twin.json")) == config
+    assert load_cell_config(save_cell_config(config, tmp_path / "puzzlebox.twin.json")) == config
     assert config.rest_posture == HOME_QPOS
     assert (config.force_limit, config.blocked_force) == (60.0, 20.0)  # the skills' values, unchanged
     assert (config.gripper_open, config.gripper_closed) == (0.0, GRIPPER_CTRL_MAX)

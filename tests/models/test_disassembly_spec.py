@@ -11,8 +11,8 @@ from typing import Any
 import pytest
 from conftest import SCENE_EXAMPLE, SPEC_EXAMPLE
 
-from models import LockTable, SpecError, load_spec, spec_from_dict, validate_data
-from models.disassembly_kinds import (
+from puzzlebox.models import LockTable, SpecError, load_spec, spec_from_dict, validate_data
+from puzzlebox.models.disassembly_kinds import (
     ALLOWED_LOCKS,
     DISASSEMBLY_KIND_NAMES,
     DISASSEMBLY_KINDS,
@@ -20,7 +20,7 @@ from models.disassembly_kinds import (
     kind_family,
     may_lock,
 )
-from models.kinds import KIND_NAMES
+from puzzlebox.models.kinds import KIND_NAMES
 
 DATA = Path(__file__).resolve().parents[3] / "shared" / "data" / "disassembly"
 LAB_COMPUTERS = ("lab-computer-a.json", "lab-computer-b.json")
@@ -181,7 +181,7 @@ def test_every_problem_is_listed_at_once():
 
 def test_a_scene_round_trips_through_its_json():
     spec = spec_from_dict(_scene())
-    from models import spec_from_json
+    from puzzlebox.models import spec_from_json
 
     again = spec_from_json(spec.to_json())
     assert again == spec and again.family == "disassembly"

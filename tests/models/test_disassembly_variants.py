@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from models import LockTable, load_spec
-from models.disassembly_variants import VariantConfig, disassembly_variant
+from puzzlebox.models import LockTable, load_spec
+from puzzlebox.models.disassembly_variants import VariantConfig, disassembly_variant
 
 DATA = Path(__file__).resolve().parents[3] / "shared" / "data" / "disassembly"
 pytestmark = pytest.mark.skipif(not DATA.is_dir(), reason=f"{DATA} (the shared disassembly data) is absent")
@@ -80,7 +80,7 @@ def test_every_pose_is_jittered_by_about_its_sigma(lab_b):
 
 
 def test_bad_ranges_and_a_puzzle_box_are_refused(lab_b, spec_dict):
-    from models import spec_from_dict
+    from puzzlebox.models import spec_from_dict
 
     with pytest.raises(ValueError, match="at least one RAM stick"):
         VariantConfig(ram_sticks=(0, 2))

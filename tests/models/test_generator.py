@@ -6,8 +6,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from models import GeneratorError, LockTable, get_kind, validate_data
-from models.generator import (
+from puzzlebox.models import GeneratorError, LockTable, get_kind, validate_data
+from puzzlebox.models.generator import (
     TEST_INDICES,
     TRAIN_INDICES,
     BoxConfig,
@@ -18,10 +18,10 @@ from models.generator import (
     paper_family,
     paper_sequences,
 )
-from models.generator.chain import MAX_REACHABLE_COMPONENTS
-from models.geometry import polygon_gap
-from models.kinds import may_neighbour
-from models.reach import unreachable_handles
+from puzzlebox.models.generator.chain import MAX_REACHABLE_COMPONENTS
+from puzzlebox.models.geometry import polygon_gap
+from puzzlebox.models.kinds import may_neighbour
+from puzzlebox.models.reach import unreachable_handles
 
 NEIGHBOUR_GAP = LayoutConfig().neighbour_gap
 

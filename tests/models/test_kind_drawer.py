@@ -7,14 +7,21 @@ import mujoco
 import numpy as np
 import pytest
 
-from models import Box, Component, Goal, LockRule, PuzzleSpec
-from models.generator import RandomGraphConfig, generate_chain, generate_random, paper_family
-from models.generator.layout import Layout, LayoutConfig
-from models.kinds import KIND_NAMES, PAPER_FAMILY, family_named, registered_kind, registered_kinds, registry_family
-from models.kinds.drawer import DRAWER, DRAWER_BACK, HOUSING_DEPTH, RAIL_OUTER, TRAVEL
-from models.puzzle_box import lid_to_world
-from models.scene import DEFAULT_BOX_POSE, build_scene
-from models.validation import validate_data
+from puzzlebox.models import Box, Component, Goal, LockRule, PuzzleSpec
+from puzzlebox.models.generator import RandomGraphConfig, generate_chain, generate_random, paper_family
+from puzzlebox.models.generator.layout import Layout, LayoutConfig
+from puzzlebox.models.kinds import (
+    KIND_NAMES,
+    PAPER_FAMILY,
+    family_named,
+    registered_kind,
+    registered_kinds,
+    registry_family,
+)
+from puzzlebox.models.kinds.drawer import DRAWER, DRAWER_BACK, HOUSING_DEPTH, RAIL_OUTER, TRAVEL
+from puzzlebox.models.puzzle_box import lid_to_world
+from puzzlebox.models.scene import DEFAULT_BOX_POSE, build_scene
+from puzzlebox.models.validation import validate_data
 
 LID = (0.3, 0.3, 0.08)
 """The hand-made test box: lid length, width and height [m]."""

@@ -6,10 +6,10 @@ import json
 
 import pytest
 
-from models import LockTable, validate_data
-from models.disassembly_kinds import DISASSEMBLY_KIND_NAMES, family_kind_names
-from models.generator import RandomGraphConfig, generate_chain, generate_random, paper_family
-from models.kinds import (
+from puzzlebox.models import LockTable, validate_data
+from puzzlebox.models.disassembly_kinds import DISASSEMBLY_KIND_NAMES, family_kind_names
+from puzzlebox.models.generator import RandomGraphConfig, generate_chain, generate_random, paper_family
+from puzzlebox.models.kinds import (
     KIND_NAMES,
     PAPER_FAMILY,
     UnknownFamilyError,
@@ -68,7 +68,7 @@ def test_kind_codes_are_the_papers_for_paper_boxes_and_the_registrys_otherwise()
 
 
 def test_a_chain_of_kinds_that_may_not_lock_each_other_is_refused_naming_the_allowed_pairs():
-    from models.errors import GeneratorError
+    from puzzlebox.models.errors import GeneratorError
 
     with pytest.raises(GeneratorError, match="door-slide"):
         generate_chain(["door", "wheel"], seed=0)

@@ -8,13 +8,20 @@ import mujoco
 import numpy as np
 import pytest
 
-from models import Box, Component, Goal, LockRule, PuzzleSpec
-from models.generator import RandomGraphConfig, generate_chain, generate_random, paper_family
-from models.kinds import KIND_NAMES, PAPER_FAMILY, family_named, registered_kind, registered_kinds, registry_family
-from models.kinds.lever import LEVER, LEVER_LIFT
-from models.kinds.parts import PLATE_THICKNESS
-from models.scene import build_scene
-from skills.joint_model import joint_model
+from puzzlebox.models import Box, Component, Goal, LockRule, PuzzleSpec
+from puzzlebox.models.generator import RandomGraphConfig, generate_chain, generate_random, paper_family
+from puzzlebox.models.kinds import (
+    KIND_NAMES,
+    PAPER_FAMILY,
+    family_named,
+    registered_kind,
+    registered_kinds,
+    registry_family,
+)
+from puzzlebox.models.kinds.lever import LEVER, LEVER_LIFT
+from puzzlebox.models.kinds.parts import PLATE_THICKNESS
+from puzzlebox.models.scene import build_scene
+from puzzlebox.skills.joint_model import joint_model
 
 
 def lever_and_slide(locked: bool) -> PuzzleSpec:

@@ -8,10 +8,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from models import Box, Component, Goal, PuzzleSpec, UnknownKindError
-from models.generator import paper_family
-from models.geometry import rectangle, transform_points
-from models.kinds import (
+from puzzlebox.models import Box, Component, Goal, PuzzleSpec, UnknownKindError
+from puzzlebox.models.generator import paper_family
+from puzzlebox.models.geometry import rectangle, transform_points
+from puzzlebox.models.kinds import (
     ALLOWED_NEIGHBOURS,
     KIND_NAMES,
     PAPER_FAMILY,
@@ -27,9 +27,9 @@ from models.kinds import (
     registered_kinds,
     registry,
 )
-from models.kinds.parts import PLATE_THICKNESS, add_handle, add_joint, add_plate
-from models.kinds.template import HANDLE_HEIGHT
-from models.puzzle_box import build_puzzle_box
+from puzzlebox.models.kinds.parts import PLATE_THICKNESS, add_handle, add_joint, add_plate
+from puzzlebox.models.kinds.template import HANDLE_HEIGHT
+from puzzlebox.models.puzzle_box import build_puzzle_box
 
 LEVER = replace(  # a slide along y with its own travel, handle and footprint
     SLIDE,
@@ -185,7 +185,7 @@ def test_template_mjcf_and_handle_agree(name, with_lever):
     assert np.allclose(data.xanchor[joint.id][:2], anchor, atol=1e-9)
     assert math.isclose(data.xanchor[joint.id][2], lift + PLATE_THICKNESS / 2, abs_tol=1e-9)
     # the handle the primitives grasp is where the MJCF put it: the skills' joint model from the marker pose
-    from skills.joint_model import GRASP_DEPTH, joint_model
+    from puzzlebox.skills.joint_model import GRASP_DEPTH, joint_model
 
     T = np.eye(4)
     T[:3, :3] = data.geom(f"{name}-0:marker").xmat.reshape(3, 3)

@@ -12,14 +12,14 @@ import numpy as np
 import pytest
 import trimesh
 
-from models.generator import RandomGraphConfig, generate_random, paper_family
-from models.geometry import polygon_gap, rectangle, transform_points
-from models.kinds import MARKER_SIZE, get_kind
-from models.kinds.parts import PLATE_THICKNESS
-from models.lock_features import FEATURE_RGBA, layout_lock_features, lock_features
-from models.mesh_export import BOX_PART, component_meshes, export_meshes
-from models.puzzle_box import build_puzzle_box, component_prefixes
-from models.spec import Box, Component, Goal, LockRule, PuzzleSpec
+from puzzlebox.models.generator import RandomGraphConfig, generate_random, paper_family
+from puzzlebox.models.geometry import polygon_gap, rectangle, transform_points
+from puzzlebox.models.kinds import MARKER_SIZE, get_kind
+from puzzlebox.models.kinds.parts import PLATE_THICKNESS
+from puzzlebox.models.lock_features import FEATURE_RGBA, layout_lock_features, lock_features
+from puzzlebox.models.mesh_export import BOX_PART, component_meshes, export_meshes
+from puzzlebox.models.puzzle_box import build_puzzle_box, component_prefixes
+from puzzlebox.models.spec import Box, Component, Goal, LockRule, PuzzleSpec
 
 SPECS = {s.name: s for s in paper_family("all")} | {
     s.name: s for s in (generate_random(RandomGraphConfig(num_components=6), seed) for seed in range(10))
@@ -267,7 +267,7 @@ def test_exports_carry_the_features_on_their_lockers(name, tmp_path):
 def test_a_raised_or_sliding_lockers_features_ride_on_its_moving_body(kinds):
     """A lever's and a drawer's moving parts are a child body above their fixed parts: their features go there,
     at the part's height, and keep their place on it as its joint turns or slides."""
-    from models.generator import generate_chain
+    from puzzlebox.models.generator import generate_chain
 
     spec = generate_chain(kinds, seed=1)
     locker = spec.components[0]

@@ -10,12 +10,12 @@ import mujoco
 import numpy as np
 import pytest
 
-from models.box_export import compile_box
-from models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random, paper_family
-from models.lock_check import HELD_FRACTION, check_locks
-from models.lock_mechanisms import design_mechanisms, paired_rules
-from models.scene import SceneConfig, build_scene
-from models.spec import Component, Goal, LockRule, PuzzleSpec
+from puzzlebox.models.box_export import compile_box
+from puzzlebox.models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random, paper_family
+from puzzlebox.models.lock_check import HELD_FRACTION, check_locks
+from puzzlebox.models.lock_mechanisms import design_mechanisms, paired_rules
+from puzzlebox.models.scene import SceneConfig, build_scene
+from puzzlebox.models.spec import Component, Goal, LockRule, PuzzleSpec
 
 PAPER = {s.name: s for s in paper_family("test")}
 
@@ -100,7 +100,7 @@ def test_a_chain_of_all_five_kinds_behaves_as_its_spec_says():
 
 
 def _all_kinds():
-    from models.kinds import family_named
+    from puzzlebox.models.kinds import family_named
 
     return family_named("all")
 

@@ -4,7 +4,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from models import Box, Component, Goal, LockRule, LockTable, PuzzleSpec
+from puzzlebox.models import Box, Component, Goal, LockRule, LockTable, PuzzleSpec
 
 
 def make_spec(n, rules, goal, goal_state=1):

@@ -15,8 +15,8 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 from dm_control import mjcf  # noqa: E402
 
-from models.errors import ModelsError  # noqa: E402
-from models.markers import (  # noqa: E402
+from puzzlebox.models.errors import ModelsError  # noqa: E402
+from puzzlebox.models.markers import (  # noqa: E402
     MARKER_BITS,
     MAX_MARKER_ID,
     MarkerError,
@@ -26,7 +26,7 @@ from models.markers import (  # noqa: E402
     marker_geom_size,
     marker_image,
 )
-from twin.rendering import RenderConfig, Renderer  # noqa: E402
+from puzzlebox.twin.rendering import RenderConfig, Renderer  # noqa: E402
 
 MARKER_SIZE = 0.04
 """Black square side of the markers in the rendered scene [m]."""

@@ -18,13 +18,13 @@ import pytest
 import scipy.spatial
 import trimesh
 
-from models.generator import RandomGraphConfig, generate_random, paper_family
-from models.mechanism_mjcf import mechanism_layout
-from models.mesh_export import BOX_PART, SAGITTA, MeshExportError, component_meshes, export_meshes
-from models.puzzle_box import component_prefixes
-from models.scene import SceneConfig, build_scene
-from models.spec import Component, Goal, LockRule
-from models.spec_loading import spec_from_dict
+from puzzlebox.models.generator import RandomGraphConfig, generate_random, paper_family
+from puzzlebox.models.mechanism_mjcf import mechanism_layout
+from puzzlebox.models.mesh_export import BOX_PART, SAGITTA, MeshExportError, component_meshes, export_meshes
+from puzzlebox.models.puzzle_box import component_prefixes
+from puzzlebox.models.scene import SceneConfig, build_scene
+from puzzlebox.models.spec import Component, Goal, LockRule
+from puzzlebox.models.spec_loading import spec_from_dict
 
 TOLERANCE = 1e-4  # 0.1 mm, the target
 RANDOM = [(6, False, 0), (9, True, 1), (12, True, 2)] + [(3 + i % 18, i % 2 == 1, 1000 + i) for i in range(18)]

@@ -8,9 +8,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from models import Box, Component, Goal, PuzzleSpec, UnknownKindError
-from models.generator import RandomGraphConfig, generate_random, paper_family
-from models.scene import UnreachableBoxPose, build_scene
+from puzzlebox.models import Box, Component, Goal, PuzzleSpec, UnknownKindError
+from puzzlebox.models.generator import RandomGraphConfig, generate_random, paper_family
+from puzzlebox.models.scene import UnreachableBoxPose, build_scene
 
 SIM_SECONDS = 1.0
 
@@ -51,7 +51,7 @@ def test_two_hundred_random_specs_compile_and_step_without_warnings():
 
 
 def replace_markers_off():
-    from models.scene import SceneConfig
+    from puzzlebox.models.scene import SceneConfig
 
     return SceneConfig(with_markers=False)
 

@@ -2,8 +2,8 @@ import json
 
 import pytest
 
-from models import SPEC_FORMAT, SpecError, load_spec, save_spec, spec_from_dict, spec_from_json
-from models.generator import RandomGraphConfig, generate_random, paper_family
+from puzzlebox.models import SPEC_FORMAT, SpecError, load_spec, save_spec, spec_from_dict, spec_from_json
+from puzzlebox.models.generator import RandomGraphConfig, generate_random, paper_family
 
 
 def test_spec_example_loads_with_its_fields(spec_dict):
@@ -51,7 +51,7 @@ def test_unknown_extra_fields_are_tolerated(spec_dict):
 
 
 def test_shuffled_lists_and_renamed_components_describe_the_same_puzzle(spec_dict):
-    from models import LockTable
+    from puzzlebox.models import LockTable
 
     renamed = json.loads(json.dumps(spec_dict).replace("door-1", "A").replace("slide-1", "B"))
     renamed["components"].reverse()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from models.toggle_log import ARRAYS, PHASES, ToggleLog, load_toggles, save_toggles
+from puzzlebox.models.toggle_log import ARRAYS, PHASES, ToggleLog, load_toggles, save_toggles
 
 
 def a_log(n: int = 7, seed: int = 0) -> ToggleLog:

@@ -7,7 +7,7 @@ from conftest import SPEC_EXAMPLE
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from models import SpecError, spec_from_dict, spec_from_json, validate_data
+from puzzlebox.models import SpecError, spec_from_dict, spec_from_json, validate_data
 
 
 def problems_of(data):

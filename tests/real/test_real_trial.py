@@ -1,12 +1,11 @@
 """Trials on a real xArm-7 through the same pipeline, proven against the twin standing in for the arm: the driver
 (``real.XArmRobot``) runs on :class:`twin_sdk.TwinSDK`, a double of the SDK backed by a twin session, on
-simulated time. The pipeline (``scripts/_real_trial.py``) sees only what the driver gives; these tests read the
+simulated time. The pipeline (``puzzlebox/lab/real_trial.py``) sees only what the driver gives; these tests read the
 session's truth beside it."""
 
 from __future__ import annotations
 
 import json
-import sys
 import time
 from pathlib import Path
 
@@ -14,21 +13,18 @@ import numpy as np
 import pytest
 from twin_sdk import TwinSDK, rpy_of, twin_xarm_cell
 
-from models.cell_config import EXAMPLE, CellConfig, save_cell_config
-from models.generator import paper_family
-from models.spec import save_spec
-from real import XArmRobot
-from real.xarm_driver import XARM7_JOINT_LIMITS, _rpy_matrix
-from skills.errors import MarkersNotFound
-from skills.perception import MarkerDetector, PerceptionConfig
-from skills.twin_world import TwinWorld
-from twin.nominal_calibration import nominal_calibration
-from twin.session import TwinSession
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
-
-import trial  # noqa: E402  (scripts/ is not a package)
-from _real_trial import cell_configs, run_real_trial  # noqa: E402
+from puzzlebox.lab.real_trial import cell_configs, run_real_trial  # noqa: E402
+from puzzlebox.models.cell_config import EXAMPLE, CellConfig, save_cell_config
+from puzzlebox.models.generator import paper_family
+from puzzlebox.models.spec import save_spec
+from puzzlebox.real import XArmRobot
+from puzzlebox.real.xarm_driver import XARM7_JOINT_LIMITS, _rpy_matrix
+from puzzlebox.scripts import trial
+from puzzlebox.skills.errors import MarkersNotFound
+from puzzlebox.skills.perception import MarkerDetector, PerceptionConfig
+from puzzlebox.skills.twin_world import TwinWorld
+from puzzlebox.twin.nominal_calibration import nominal_calibration
+from puzzlebox.twin.session import TwinSession
 
 SPEC = paper_family("test")[0]
 

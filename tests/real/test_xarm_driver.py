@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from models.cell_config import EXAMPLE, CellConfig, save_cell_config
-from models.robot import Robot
-from real import (
+from puzzlebox.models.cell_config import EXAMPLE, CellConfig, save_cell_config
+from puzzlebox.models.robot import Robot
+from puzzlebox.real import (
     ArmStopped,
     ArmUnreachable,
     CommandRefused,

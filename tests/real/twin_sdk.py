@@ -27,10 +27,10 @@ from typing import Any
 
 import numpy as np
 
-from models.cell_config import CellConfig
-from skills.primitives import PrimitiveConfig
-from twin.cell_config import twin_cell_config
-from twin.session import TwinSession
+from puzzlebox.models.cell_config import CellConfig
+from puzzlebox.skills.primitives import PrimitiveConfig
+from puzzlebox.twin.cell_config import twin_cell_config
+from puzzlebox.twin.session import TwinSession
 
 STOPPED_CODE = 1
 """What a motion command returns once the arm was stopped (a controller in the stop state refuses it)."""

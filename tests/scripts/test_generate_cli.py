@@ -8,9 +8,9 @@ from pathlib import Path
 import pytest
 import trimesh
 
-from models import save_spec
-from models.generator import paper_family
-from models.lock_features import layout_lock_features
+from puzzlebox.models import save_spec
+from puzzlebox.models.generator import paper_family
+from puzzlebox.models.lock_features import layout_lock_features
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -140,7 +140,7 @@ def test_a_dataset_is_byte_identical_across_runs_and_worker_counts(tmp_path):
     assert _tree(tmp_path / "a") == _tree(tmp_path / "b") == _tree(tmp_path / "c")
     manifest = json.loads((tmp_path / "a" / "manifest.json").read_text())
     assert manifest["count"] == 10 and [e["seed"] for e in manifest["specs"]] == list(range(40, 50))
-    from models import LockTable, load_spec
+    from puzzlebox.models import LockTable, load_spec
 
     for entry in manifest["specs"]:
         path = tmp_path / "a" / entry["file"]

@@ -6,12 +6,10 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scripts"))
 
-from _kinds_experiment import KindsConfig, five_kind_chains, make_specs  # noqa: E402
-
-from models import LockTable, load_spec  # noqa: E402
-from models.kinds import registry_family  # noqa: E402
+from puzzlebox.lab.kinds_experiment import KindsConfig, five_kind_chains, make_specs  # noqa: E402
+from puzzlebox.models import LockTable, load_spec  # noqa: E402
+from puzzlebox.models.kinds import registry_family  # noqa: E402
 
 
 def experiment(*args):

@@ -11,9 +11,8 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scripts"))
 
-from _trial_task import without_timing  # noqa: E402
+from puzzlebox.lab.trial_task import without_timing  # noqa: E402
 
 
 def sweep(*args, timeout=600):

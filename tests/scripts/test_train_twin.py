@@ -14,15 +14,13 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scripts"))
 
-from _twin_training import TwinTraining  # noqa: E402  (scripts/ is not a package)
-
-from learning import MemoryAgent  # noqa: E402
-from learning.memory import MemoryStore  # noqa: E402
-from learning.memory.keys import se3_pose_keys  # noqa: E402
-from models import load_spec  # noqa: E402
-from twin.reality import load_profile  # noqa: E402
+from puzzlebox.lab.twin_training import TwinTraining  # noqa: E402  (scripts/ is not a package)
+from puzzlebox.learning import MemoryAgent  # noqa: E402
+from puzzlebox.learning.memory import MemoryStore  # noqa: E402
+from puzzlebox.learning.memory.keys import se3_pose_keys  # noqa: E402
+from puzzlebox.models import load_spec  # noqa: E402
+from puzzlebox.twin.reality import load_profile  # noqa: E402
 
 
 def run(*args, **kwargs):

@@ -6,9 +6,8 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scripts"))
 
-from _trial_task import without_timing  # noqa: E402  (a results object less its wall-clock fields)
+from puzzlebox.lab.trial_task import without_timing  # noqa: E402  (a results object less its wall-clock fields)
 
 
 def run(*args):
@@ -143,7 +142,7 @@ def test_memory_trial_refuses_a_missing_or_foreign_memory(tmp_path):
 def test_twin_trial_refuses_a_calibration_made_for_another_cell(tmp_path):
     import numpy as np
 
-    from models.calibration import CameraCalibration, CellCalibration
+    from puzzlebox.models.calibration import CameraCalibration, CellCalibration
 
     specs = tmp_path / "specs"
     run(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", specs)
@@ -305,9 +304,8 @@ def test_executor_mistakes_are_one_line(tmp_path):
 
 
 def test_a_misreported_kind_is_drawn_from_the_seed_and_is_never_the_true_kind():
-    from _twin_trial import wrong_kind
-
-    from models.generator import paper_family
+    from puzzlebox.lab.twin_trial import wrong_kind
+    from puzzlebox.models.generator import paper_family
 
     spec = paper_family("test")[0]
     kinds = {c.name: c.kind for c in spec.components}
@@ -320,7 +318,7 @@ def test_a_misreported_kind_is_drawn_from_the_seed_and_is_never_the_true_kind():
 def test_a_twin_trial_told_a_wrong_kind_stays_under_the_force_limit(tmp_path):
     """The oracle toggles every part on the solution; one of them is told as another kind: its pull follows
     the wrong path, and the arm must stop, not force it (the true wrist force stays under the 60 N limit)."""
-    from skills.primitives import PrimitiveConfig
+    from puzzlebox.skills.primitives import PrimitiveConfig
 
     specs = tmp_path / "specs"
     assert run(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", specs).returncode == 0

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from models.calibration import CALIBRATION_FORMAT, CalibrationError, CameraCalibration, CellCalibration
-from models.charuco import DEFAULT_BOARD
-from skills.calibration import (
+from puzzlebox.models.calibration import CALIBRATION_FORMAT, CalibrationError, CameraCalibration, CellCalibration
+from puzzlebox.models.charuco import DEFAULT_BOARD
+from puzzlebox.skills.calibration import (
     BoardView,
     calibrate_intrinsics,
     detect_board,
@@ -21,7 +21,7 @@ from skills.calibration import (
     pose_error,
     solve_hand_eye_closed_form,
 )
-from skills.errors import BoardNotFound, CalibrationFailed, InconsistentViews, TooFewViews
+from puzzlebox.skills.errors import BoardNotFound, CalibrationFailed, InconsistentViews, TooFewViews
 
 SIZE = (640, 480)
 # A D435-like camera with a visible lens distortion (REALITY_NOTES.md §3, pessimistic k1).

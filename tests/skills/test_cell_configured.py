@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import pytest
 
-from models.cell_config import CellConfig
-from models.generator import paper_family
-from skills.primitives import PrimitiveConfig
-from skills.scene_survey import SceneSurvey, SurveyConfig
-from twin.cell_config import twin_cell_config
-from twin.session import TwinSession
+from puzzlebox.models.cell_config import CellConfig
+from puzzlebox.models.generator import paper_family
+from puzzlebox.skills.primitives import PrimitiveConfig
+from puzzlebox.skills.scene_survey import SceneSurvey, SurveyConfig
+from puzzlebox.twin.cell_config import twin_cell_config
+from puzzlebox.twin.session import TwinSession
 
 
 @pytest.fixture(scope="module")

@@ -9,12 +9,12 @@ import mujoco
 import numpy as np
 import pytest
 
-from models.kinds import DOOR_HALF
-from models.puzzle_box import build_puzzle_box
-from models.spec_loading import spec_from_dict
-from skills.door_clearance import door_overhang, lean_away, near_open_door
-from skills.door_push import DoorPush
-from skills.joint_model import joint_model
+from puzzlebox.models.kinds import DOOR_HALF
+from puzzlebox.models.puzzle_box import build_puzzle_box
+from puzzlebox.models.spec_loading import spec_from_dict
+from puzzlebox.skills.door_clearance import door_overhang, lean_away, near_open_door
+from puzzlebox.skills.door_push import DoorPush
+from puzzlebox.skills.joint_model import joint_model
 
 
 @pytest.fixture(scope="module")

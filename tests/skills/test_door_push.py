@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from models.kinds import HANDLE_SIZE
-from skills.door_push import DoorPush
-from skills.joint_model import joint_model
+from puzzlebox.models.kinds import HANDLE_SIZE
+from puzzlebox.skills.door_push import DoorPush
+from puzzlebox.skills.joint_model import joint_model
 
 
 def _door(yaw: float = 0.7, at=(0.45, -0.1, 0.08)) -> DoorPush:

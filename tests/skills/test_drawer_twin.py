@@ -3,9 +3,9 @@ held by its latch through the F/T sensor, and read moved from its marker leaving
 
 from world_fixtures import twin_world
 
-from learning import DualAgent, run_episode
-from models.generator import generate_chain
-from twin.session import TwinSession
+from puzzlebox.learning import DualAgent, run_episode
+from puzzlebox.models.generator import generate_chain
+from puzzlebox.twin.session import TwinSession
 
 
 def test_a_box_where_a_wheel_locks_a_drawer_is_solved_with_sensed_outcomes_matching_the_truth():

@@ -6,8 +6,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from models.generator import paper_family
-from skills import (
+from puzzlebox.models.generator import paper_family
+from puzzlebox.skills import (
     MarkerDetector,
     MarkersNotFound,
     UnknownMarker,
@@ -17,8 +17,8 @@ from skills import (
     select_markers,
     upright_pose,
 )
-from twin.nominal_calibration import nominal_calibration
-from twin.session import TwinSession
+from puzzlebox.twin.nominal_calibration import nominal_calibration
+from puzzlebox.twin.session import TwinSession
 
 
 def overview_calibration(session: TwinSession):

@@ -5,13 +5,13 @@ import numpy as np
 import pytest
 from world_fixtures import TrueForceWatch
 
-from models.generator import generate_chain
-from skills import MarkerDetector, joint_model, lid_height, select_markers, upright_pose
-from skills.errors import IKFailure
-from skills.kinematics import ArmKinematics, top_down
-from skills.primitives import PrimitiveConfig, Toggler
-from twin.nominal_calibration import nominal_calibration
-from twin.session import TwinSession
+from puzzlebox.models.generator import generate_chain
+from puzzlebox.skills import MarkerDetector, joint_model, lid_height, select_markers, upright_pose
+from puzzlebox.skills.errors import IKFailure
+from puzzlebox.skills.kinematics import ArmKinematics, top_down
+from puzzlebox.skills.primitives import PrimitiveConfig, Toggler
+from puzzlebox.twin.nominal_calibration import nominal_calibration
+from puzzlebox.twin.session import TwinSession
 
 
 def perceived_joint_models(session: TwinSession) -> dict:

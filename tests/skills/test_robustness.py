@@ -10,18 +10,18 @@ import numpy as np
 import pytest
 from world_fixtures import TrueForceWatch, twin_world
 
-from learning import OracleAgent, run_episode
-from models import Goal, Robot
-from models.calibration import CellCalibration
-from models.generator import generate_chain, paper_family
-from models.placement import placed
-from models.scene import SceneConfig
-from skills import MarkerDetector, joint_model, lid_height, select_markers, upright_pose
-from skills.primitives import PrimitiveConfig, Toggler
-from skills.twin_world import TwinWorld
-from twin.nominal_calibration import nominal_calibration
-from twin.reality import ArmReality, ForceTorqueReality, PhysicsReality, RealityProfile
-from twin.session import TwinConfig, TwinSession
+from puzzlebox.learning import OracleAgent, run_episode
+from puzzlebox.models import Goal, Robot
+from puzzlebox.models.calibration import CellCalibration
+from puzzlebox.models.generator import generate_chain, paper_family
+from puzzlebox.models.placement import placed
+from puzzlebox.models.scene import SceneConfig
+from puzzlebox.skills import MarkerDetector, joint_model, lid_height, select_markers, upright_pose
+from puzzlebox.skills.primitives import PrimitiveConfig, Toggler
+from puzzlebox.skills.twin_world import TwinWorld
+from puzzlebox.twin.nominal_calibration import nominal_calibration
+from puzzlebox.twin.reality import ArmReality, ForceTorqueReality, PhysicsReality, RealityProfile
+from puzzlebox.twin.session import TwinConfig, TwinSession
 
 
 def _joint_models(session: TwinSession, kinds: dict[int, str] | None = None) -> dict:

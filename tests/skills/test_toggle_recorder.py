@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 from world_fixtures import evaluation_world
 
-from models.generator import paper_family
-from models.toggle_log import PHASES, ToggleLog
-from skills.toggle_recorder import ToggleRecorder
-from twin.session import TwinSession
+from puzzlebox.models.generator import paper_family
+from puzzlebox.models.toggle_log import PHASES, ToggleLog
+from puzzlebox.skills.toggle_recorder import ToggleRecorder
+from puzzlebox.twin.session import TwinSession
 
 SPEC = paper_family("train")[0]  # door-0 is free at the start
 

@@ -13,10 +13,10 @@ from pathlib import Path
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 import world_fixtures  # noqa: E402, F401  (puts scripts/ on the path)
-from _trial_task import without_timing  # noqa: E402
-from _twin_trial import run_twin_trial  # noqa: E402
 
-from models.generator import paper_family  # noqa: E402
+from puzzlebox.lab.trial_task import without_timing  # noqa: E402
+from puzzlebox.lab.twin_trial import run_twin_trial  # noqa: E402
+from puzzlebox.models.generator import paper_family  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
 MAX_ACTIONS = 1
@@ -34,8 +34,11 @@ def test_a_trial_after_others_in_the_process_gives_the_record_of_a_fresh_process
     again = _record(0, 1, "realistic")
     assert again == first
     code = (
-        "import json, sys; sys.path.insert(0, 'tests/skills'); import test_trial_caches as t; "
-        "print(json.dumps(t._record(0, 1, 'realistic')))"
+        "import json; from puzzlebox.models.generator import paper_family; "
+        "from puzzlebox.lab.twin_trial import run_twin_trial; from puzzlebox.lab.trial_task import without_timing; "
+        f"record = run_twin_trial(paper_family('test')[0], 1, 'oracle', None, {MAX_ACTIONS}, None, "
+        "reality='realistic'); "
+        "print(json.dumps(without_timing(record)))"
     )
     out = subprocess.run(
         [sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, check=True, timeout=600,

@@ -8,13 +8,13 @@ from pathlib import Path
 import numpy as np
 from world_fixtures import twin_world
 
-from learning import DualAgent, OracleAgent, run_episode
-from models import TryResult, World
-from models.generator import generate_chain
-from skills.primitives import ToggleResult
-from skills.twin_world import DOOR_STAYED, HELD_UNDER_PINCH_AND_PUSH, TwinWorld
-from twin.nominal_calibration import nominal_calibration
-from twin.session import TwinSession
+from puzzlebox.learning import DualAgent, OracleAgent, run_episode
+from puzzlebox.models import TryResult, World
+from puzzlebox.models.generator import generate_chain
+from puzzlebox.skills.primitives import ToggleResult
+from puzzlebox.skills.twin_world import DOOR_STAYED, HELD_UNDER_PINCH_AND_PUSH, TwinWorld
+from puzzlebox.twin.nominal_calibration import nominal_calibration
+from puzzlebox.twin.session import TwinSession
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -71,7 +71,7 @@ def test_trial_cli_runs_the_twin_and_writes_a_timeline(tmp_path):
 def test_markers_the_overview_camera_misses_are_found_from_the_wrist_camera():
     from dataclasses import replace
 
-    from skills import MarkerDetector
+    from puzzlebox.skills import MarkerDetector
 
     spec = generate_chain(["door", "slide", "wheel"], seed=4)
     spec = replace(spec, box=replace(spec.box, pose=(0.25, 0.36, 0.0)))  # beyond the overview's view
@@ -90,7 +90,7 @@ def test_markers_the_overview_camera_misses_are_found_from_the_wrist_camera():
 def test_a_marker_nobody_can_see_is_reported_missing():
     import pytest
 
-    from skills import MarkersNotFound
+    from puzzlebox.skills import MarkersNotFound
 
     spec = generate_chain(["door", "slide"], seed=1)
     with TwinSession(spec, seed=0) as session, pytest.raises(MarkersNotFound, match=r"missing marker ids \[9\]"):

@@ -13,12 +13,12 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from models.generator import generate_chain, paper_family  # noqa: E402
-from twin import renderer_pool, scene_cache  # noqa: E402
-from twin import rendering as rendering_module  # noqa: E402
-from twin.errors import RenderingError  # noqa: E402
-from twin.rendering import RenderConfig, Renderer  # noqa: E402
-from twin.session import TwinSession  # noqa: E402
+from puzzlebox.models.generator import generate_chain, paper_family  # noqa: E402
+from puzzlebox.twin import renderer_pool, scene_cache  # noqa: E402
+from puzzlebox.twin import rendering as rendering_module  # noqa: E402
+from puzzlebox.twin.errors import RenderingError  # noqa: E402
+from puzzlebox.twin.rendering import RenderConfig, Renderer  # noqa: E402
+from puzzlebox.twin.session import TwinSession  # noqa: E402
 
 CAMERAS = ("overview", "xarm7/gripper/wrist_camera")
 

@@ -13,11 +13,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from models.calibration import CameraCalibration
-from models.charuco import BOARD_BODY, DEFAULT_BOARD
-from models.generator import paper_family
-from models.scene import SceneConfig, build_scene
-from skills.calibration import (
+from puzzlebox.models.calibration import CameraCalibration
+from puzzlebox.models.charuco import BOARD_BODY, DEFAULT_BOARD
+from puzzlebox.models.generator import paper_family
+from puzzlebox.models.scene import SceneConfig, build_scene
+from puzzlebox.skills.calibration import (
     CalibrationConfig,
     board_pose_in_camera,
     calibrate_intrinsics,
@@ -26,9 +26,9 @@ from skills.calibration import (
     hand_eye,
     pose_error,
 )
-from skills.errors import IKFailure
-from skills.primitives import Toggler
-from twin.calibration_rig import CalibrationCell
+from puzzlebox.skills.errors import IKFailure
+from puzzlebox.skills.primitives import Toggler
+from puzzlebox.twin.calibration_rig import CalibrationCell
 
 ROOT = Path(__file__).resolve().parents[2]
 

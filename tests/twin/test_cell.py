@@ -9,11 +9,11 @@ import dataclasses
 import numpy as np
 import pytest
 
-from models.generator import paper_family
-from models.kinds import KIND_NAMES, registered_kinds
-from twin.cell import draw_cell
-from twin.reality import IDENTITY, PRESETS, PhysicsReality, RealityProfile, ScaleRange
-from twin.session import TwinSession
+from puzzlebox.models.generator import paper_family
+from puzzlebox.models.kinds import KIND_NAMES, registered_kinds
+from puzzlebox.twin.cell import draw_cell
+from puzzlebox.twin.reality import IDENTITY, PRESETS, PhysicsReality, RealityProfile, ScaleRange
+from puzzlebox.twin.session import TwinSession
 
 SPEC = paper_family("test")[0]  # a door, two slides and two wheels
 CAMERAS = ("overview", "xarm7/gripper/wrist_camera")

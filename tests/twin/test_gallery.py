@@ -1,4 +1,4 @@
-"""twin.gallery: standard views of a box, checked on what they show (MuJoCo segmentation: geom id per pixel)."""
+"""puzzlebox.twin.gallery: standard views of a box, checked on what they show (segmentation: geom id per pixel)."""
 
 from __future__ import annotations
 
@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 from conftest import SCENE_EXAMPLE
 
-from models import spec_from_dict
-from models.generator import generate_chain, paper_family
-from models.scene import SceneConfig, SceneError, build_scene
-from twin.gallery import CAMERA, Gallery, component_view_name, frame_view
-from twin.rendering import RenderConfig
+from puzzlebox.models import spec_from_dict
+from puzzlebox.models.generator import generate_chain, paper_family
+from puzzlebox.models.scene import SceneConfig, SceneError, build_scene
+from puzzlebox.twin.gallery import CAMERA, Gallery, component_view_name, frame_view
+from puzzlebox.twin.rendering import RenderConfig
 
 WIDTH, HEIGHT = 400, 300
 FIVE_KINDS = ["lever", "slide", "door", "drawer", "wheel"]

@@ -7,10 +7,10 @@ import cv2
 import numpy as np
 import pytest
 
-from models.generator import paper_family
-from models.markers import aruco_dictionary
-from twin.nominal_calibration import nominal_calibration
-from twin.session import TwinSession
+from puzzlebox.models.generator import paper_family
+from puzzlebox.models.markers import aruco_dictionary
+from puzzlebox.twin.nominal_calibration import nominal_calibration
+from puzzlebox.twin.session import TwinSession
 
 
 def detect(rgb: np.ndarray) -> dict[int, np.ndarray]:

@@ -13,14 +13,14 @@ import mujoco
 import numpy as np
 import pytest
 
-from models.generator import paper_family
-from models.robot import Robot
-from skills import MarkerDetector
-from twin.errors import ProfileError
-from twin.jams import Jams
-from twin.nominal_calibration import nominal_calibration
-from twin.physics_draws import subtree_bodies
-from twin.reality import (
+from puzzlebox.models.generator import paper_family
+from puzzlebox.models.robot import Robot
+from puzzlebox.skills import MarkerDetector
+from puzzlebox.twin.errors import ProfileError
+from puzzlebox.twin.jams import Jams
+from puzzlebox.twin.nominal_calibration import nominal_calibration
+from puzzlebox.twin.physics_draws import subtree_bodies
+from puzzlebox.twin.reality import (
     PRESETS,
     ArmReality,
     CameraReality,
@@ -30,10 +30,10 @@ from twin.reality import (
     ScaleRange,
     load_profile,
 )
-from twin.rendering import RenderConfig, Renderer
-from twin.sensors import cameras
-from twin.servos import Servos
-from twin.session import TwinConfig, TwinSession
+from puzzlebox.twin.rendering import RenderConfig, Renderer
+from puzzlebox.twin.sensors import cameras
+from puzzlebox.twin.servos import Servos
+from puzzlebox.twin.session import TwinConfig, TwinSession
 
 SPEC = paper_family("test")[0]  # door-0 is free, the other four are latched
 WRIST = "xarm7/gripper/wrist_camera"

@@ -4,9 +4,9 @@ import dataclasses
 
 import pytest
 
-from twin.errors import ProfileError
-from twin.reality import HARSH, IDEAL, REALISTIC, RealityProfile
-from twin.reality_levels import ALL, FACTORS, force_noise_profile, profile_at
+from puzzlebox.twin.errors import ProfileError
+from puzzlebox.twin.reality import HARSH, IDEAL, REALISTIC, RealityProfile
+from puzzlebox.twin.reality_levels import ALL, FACTORS, force_noise_profile, profile_at
 
 
 def _without_name(profile: RealityProfile) -> RealityProfile:

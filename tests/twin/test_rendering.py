@@ -17,9 +17,9 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from twin.errors import RenderingError, TwinError, UnknownCamera, VideoError  # noqa: E402
-from twin.rendering import RenderConfig, Renderer, gl_backend  # noqa: E402
-from twin.video import VideoWriter  # noqa: E402
+from puzzlebox.twin.errors import RenderingError, TwinError, UnknownCamera, VideoError  # noqa: E402
+from puzzlebox.twin.rendering import RenderConfig, Renderer, gl_backend  # noqa: E402
+from puzzlebox.twin.video import VideoWriter  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -85,7 +85,7 @@ def run_python(code: str, **env: str) -> subprocess.CompletedProcess[str]:
 
 TINY_SCENE = """
     import mujoco, numpy as np
-    from twin.rendering import Renderer, RenderConfig
+    from puzzlebox.twin.rendering import Renderer, RenderConfig
     model = mujoco.MjModel.from_xml_string('''<mujoco><worldbody>
         <light pos="0 0 2"/><geom type="plane" size="1 1 .1" rgba=".1 .6 .1 1"/>
         <geom type="box" size=".05 .05 .05" pos="0 0 .05" rgba="1 0 0 1"/><camera name="top" pos="0 0 .6"/>
@@ -135,7 +135,7 @@ def test_egl_failure_raises_rendering_error_that_points_to_osmesa():
     result = run_python(
         TINY_SCENE
         + """
-    from twin.errors import RenderingError
+    from puzzlebox.twin.errors import RenderingError
     try:
         Renderer(model)
     except RenderingError as error:

@@ -9,7 +9,7 @@ import pytest
 
 pytest.importorskip("rerun")
 
-from twin.rerun_log import RecordingError, TrialRecording, read_counts  # noqa: E402
+from puzzlebox.twin.rerun_log import RecordingError, TrialRecording, read_counts  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -11,13 +11,11 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scripts"))
 
-from _twin_trial import run_twin_trial, scene_cameras  # noqa: E402
-
-from models.generator import generate_chain, paper_family  # noqa: E402
-from twin.errors import VideoError  # noqa: E402
-from twin.rollout_video import (  # noqa: E402
+from puzzlebox.lab.twin_trial import run_twin_trial, scene_cameras  # noqa: E402
+from puzzlebox.models.generator import generate_chain, paper_family  # noqa: E402
+from puzzlebox.twin.errors import VideoError  # noqa: E402
+from puzzlebox.twin.rollout_video import (  # noqa: E402
     BackgroundRollout,
     Caption,
     FrameCollector,
@@ -26,7 +24,7 @@ from twin.rollout_video import (  # noqa: E402
     RolloutFrame,
     frames_path,
 )
-from twin.session import TwinSession  # noqa: E402
+from puzzlebox.twin.session import TwinSession  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -96,7 +94,7 @@ def test_the_video_trial_is_the_same_trial_and_a_trial_without_video_writes_no_f
 def test_every_sampled_frame_shows_the_box_unoccluded_in_at_least_one_view(monkeypatch):
     """The target: in every frame at least one view shows >= 90 % of the box's pixels it shows with the arm
     hidden (MuJoCo's segmentation rendering), on a five-kind box, every fourth frame."""
-    import _twin_trial
+    from puzzlebox.lab import twin_trial as _twin_trial
 
     monkeypatch.setattr(_twin_trial, "BackgroundRollout", FrameCollector)
     spec = generate_chain(["lever", "slide", "door", "drawer", "wheel"], seed=0)

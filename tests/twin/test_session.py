@@ -7,9 +7,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from models.generator import generate_chain, paper_family
-from twin.errors import CommandError, SimulationDiverged
-from twin.session import TwinSession
+from puzzlebox.models.generator import generate_chain, paper_family
+from puzzlebox.twin.errors import CommandError, SimulationDiverged
+from puzzlebox.twin.session import TwinSession
 
 PUSH_N = 20.0
 
@@ -203,9 +203,9 @@ def test_robot_interface_offers_no_ground_truth():
 
 
 def test_a_rule_no_mechanism_serves_is_named_in_a_warning_and_held_by_a_latch():
-    from models.generator import BoxConfig, RandomGraphConfig, generate_random
-    from models.kinds import family_named
-    from twin.latches import UnrealizedLockWarning
+    from puzzlebox.models.generator import BoxConfig, RandomGraphConfig, generate_random
+    from puzzlebox.models.kinds import family_named
+    from puzzlebox.twin.latches import UnrealizedLockWarning
 
     # a lever whose pivot stands 33 mm above the lid cannot latch a slide that moves along its length one way:
     # the generator, told not to redraw, keeps that box; the twin runs it with a latch for exactly that rule
@@ -226,8 +226,8 @@ def test_a_rule_no_mechanism_serves_is_named_in_a_warning_and_held_by_a_latch():
     # the ablation: every rule on the latches, no warning
     import warnings
 
-    from models.scene import SceneConfig
-    from twin.session import TwinConfig
+    from puzzlebox.models.scene import SceneConfig
+    from puzzlebox.twin.session import TwinConfig
 
     with warnings.catch_warnings():
         warnings.simplefilter("error", UnrealizedLockWarning)

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 from toggle_logs import known_hardware, record
 
-from models.generator import paper_family
-from twin.system_id import FitConfig, fit_kind
-from twin.toggle_replay import NOMINAL, KindScales
-from twin.toggle_scoring import prepare, toggle_errors
-from twin.toggle_signals import joint_load
+from puzzlebox.models.generator import paper_family
+from puzzlebox.twin.system_id import FitConfig, fit_kind
+from puzzlebox.twin.toggle_replay import NOMINAL, KindScales
+from puzzlebox.twin.toggle_scoring import prepare, toggle_errors
+from puzzlebox.twin.toggle_signals import joint_load
 
 PARTS = ("door-0", "slide-1", "door-2", "slide-3", "door-4")
 FIT = FitConfig(max_nfev=12)

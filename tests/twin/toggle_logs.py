@@ -1,23 +1,18 @@
-"""Logged toggles of a twin session, made the way ``experiment.py sysid`` makes them (``scripts/_sysid.py``): the
+"""Logged toggles of a twin session, made the way ``experiment.py sysid`` makes them (``puzzlebox/lab/sysid.py``): the
 pipeline's world on a recorder, and — for evaluation only — the world's truth beside each log."""
 
 from __future__ import annotations
 
 import dataclasses
-import sys
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
-
-from _sysid import TruthTrace  # noqa: E402  (scripts/ is not a package)
-from _twin_trial import evaluation_world  # noqa: E402
-
-from models import PuzzleSpec  # noqa: E402
-from models.generator import paper_family  # noqa: E402
-from models.toggle_log import ToggleLog  # noqa: E402
-from skills.toggle_recorder import ToggleRecorder  # noqa: E402
-from twin.reality import PRESETS, RealityProfile, ScaleRange  # noqa: E402
-from twin.session import TwinSession  # noqa: E402
+from puzzlebox.lab.sysid import TruthTrace  # noqa: E402  (scripts/ is not a package)
+from puzzlebox.lab.twin_trial import evaluation_world  # noqa: E402
+from puzzlebox.models import PuzzleSpec  # noqa: E402
+from puzzlebox.models.generator import paper_family  # noqa: E402
+from puzzlebox.models.toggle_log import ToggleLog  # noqa: E402
+from puzzlebox.skills.toggle_recorder import ToggleRecorder  # noqa: E402
+from puzzlebox.twin.reality import PRESETS, RealityProfile, ScaleRange  # noqa: E402
+from puzzlebox.twin.session import TwinSession  # noqa: E402
 
 SPEC = paper_family("train")[0]
 """Doors and slides in a chain: door-0 is free at the start, each part frees the next (door-0, slide-1, door-2, ...)."""

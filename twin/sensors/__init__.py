@@ -2,8 +2,8 @@
 reports from them) and the cameras, each applying the reality profile's imperfections. The session
 owns them; the robot interface only asks them."""
 
-from twin.sensors.cameras import Cameras, TrueLens
-from twin.sensors.encoders import JointEncoders
-from twin.sensors.force_torque import ForceTorqueSensor
+from puzzlebox.twin.sensors.cameras import Cameras, TrueLens
+from puzzlebox.twin.sensors.encoders import JointEncoders
+from puzzlebox.twin.sensors.force_torque import ForceTorqueSensor
 
 __all__ = ["Cameras", "ForceTorqueSensor", "JointEncoders", "TrueLens"]

@@ -21,11 +21,11 @@ import cv2
 import mujoco
 import numpy as np
 
-from models.robot import CameraImage
-from twin import renderer_pool
-from twin.errors import UnknownCamera
-from twin.reality import CameraReality
-from twin.rendering import MUJOCO_TO_OPENCV, RenderConfig, Renderer, pinhole_intrinsics
+from puzzlebox.models.robot import CameraImage
+from puzzlebox.twin import renderer_pool
+from puzzlebox.twin.errors import UnknownCamera
+from puzzlebox.twin.reality import CameraReality
+from puzzlebox.twin.rendering import MUJOCO_TO_OPENCV, RenderConfig, Renderer, pinhole_intrinsics
 
 
 @dataclass(frozen=True)

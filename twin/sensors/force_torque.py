@@ -16,8 +16,8 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from twin.reality import ForceTorqueReality
-from twin.sensors.random_vectors import random_vector
+from puzzlebox.twin.reality import ForceTorqueReality
+from puzzlebox.twin.sensors.random_vectors import random_vector
 
 
 class ForceTorqueSensor:

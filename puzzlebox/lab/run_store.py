@@ -21,9 +21,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from _cli import fail, versions, write_json
-
-from learning.runner import RecordStore
+from puzzlebox.lab.cli import fail, versions, write_json
+from puzzlebox.learning.runner import RecordStore
 
 RECORDS = "runs"
 

@@ -34,13 +34,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from _cli import write_json
-from _trial_task import without_timing
 
-from learning.memory import MemoryStore
+import puzzlebox.scripts
+from puzzlebox.lab.cli import write_json
+from puzzlebox.lab.trial_task import without_timing
+from puzzlebox.learning.memory import MemoryStore
 
-ROOT = Path(__file__).resolve().parents[1]
-SCRIPTS = ROOT / "scripts"
+SCRIPTS = Path(puzzlebox.scripts.__file__).resolve().parent
+"""The command-line scripts, run in real processes as a user runs them."""
 
 
 @dataclass(frozen=True)
@@ -205,9 +206,8 @@ DIVERGE_AT_S = 3.0
 
 _DIVERGING_TRIAL = f"""
 import sys
-sys.path.insert(0, {str(SCRIPTS)!r})
 import numpy as np
-from twin.session import TwinSession
+from puzzlebox.twin.session import TwinSession
 after_steps = TwinSession._after_steps
 def diverging(self):
     if self.data.time > {DIVERGE_AT_S} and not getattr(self, "_diverged", False):
@@ -215,7 +215,7 @@ def diverging(self):
         self.data.qvel[:] = np.inf  # MuJoCo flags it (BADQVEL) at the next step
     after_steps(self)
 TwinSession._after_steps = diverging
-import trial
+from puzzlebox.scripts import trial
 sys.exit(trial.main(sys.argv[1:]))
 """
 
@@ -360,7 +360,7 @@ QUICK_TWIN_FAULTS = ("camera: every frame dropped", "every free part jams on eve
 def twin_faults(out: Path, config: FaultsConfig) -> list[FaultRow]:
     """One twin trial per fault of :data:`TWIN_FAULTS` (the quick suite: :data:`QUICK_TWIN_FAULTS`): did the
     run end with its reason named (or solve anyway), without a traceback, with its record kept?"""
-    from twin.reality import IDEAL
+    from puzzlebox.twin.reality import IDEAL
 
     spec = _specs(out) / "paper-test-0.json"
     names = QUICK_TWIN_FAULTS if config.sim == "symbolic" else tuple(TWIN_FAULTS)

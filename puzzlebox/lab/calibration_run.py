@@ -8,12 +8,12 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from _cli import one_line
 
-from models import ModelsError
-from models.calibration import CameraCalibration, CellCalibration
-from models.spec import PuzzleSpec
-from skills.calibration import (
+from puzzlebox.lab.cli import one_line
+from puzzlebox.models import ModelsError
+from puzzlebox.models.calibration import CameraCalibration, CellCalibration
+from puzzlebox.models.spec import PuzzleSpec
+from puzzlebox.skills.calibration import (
     CalibrationConfig,
     calibrate_intrinsics,
     detect_board,
@@ -21,12 +21,12 @@ from skills.calibration import (
     hand_eye,
     pose_error,
 )
-from skills.errors import IKFailure, SkillError
-from skills.kinematics import ArmKinematics
-from skills.primitives import Toggler
-from twin.calibration_rig import CalibrationCell, RigConfig, RigError
-from twin.errors import TwinError
-from twin.reality import RealityProfile
+from puzzlebox.skills.errors import IKFailure, SkillError
+from puzzlebox.skills.kinematics import ArmKinematics
+from puzzlebox.skills.primitives import Toggler
+from puzzlebox.twin.calibration_rig import CalibrationCell, RigConfig, RigError
+from puzzlebox.twin.errors import TwinError
+from puzzlebox.twin.reality import RealityProfile
 
 
 class CellCalibrationError(Exception):

@@ -32,17 +32,17 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from _trial_task import trial_task
 
-from learning import AGENT_NAMES
-from learning.agents.factory import BELIEF_AGENT_NAMES
-from learning.dual_controller import DualControllerConfig
-from learning.errors import ConfigError
-from learning.runner import Task
-from models import PuzzleSpec, load_spec
-from models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random
-from models.kinds import KindFamily, UnknownFamilyError, family_named
-from models.spec import file_precision
+from puzzlebox.lab.trial_task import trial_task
+from puzzlebox.learning import AGENT_NAMES
+from puzzlebox.learning.agents.factory import BELIEF_AGENT_NAMES
+from puzzlebox.learning.dual_controller import DualControllerConfig
+from puzzlebox.learning.errors import ConfigError
+from puzzlebox.learning.runner import Task
+from puzzlebox.models import PuzzleSpec, load_spec
+from puzzlebox.models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random
+from puzzlebox.models.kinds import KindFamily, UnknownFamilyError, family_named
+from puzzlebox.models.spec import file_precision
 
 KEYS = {"sim", "specs", "generate", "placements", "placement_seed", "seeds", "agents", "profiles", "calibrations",
         "max_actions", "name"}  # fmt: skip
@@ -171,7 +171,7 @@ def _placements(sweep: dict[str, Any], spec: PuzzleSpec) -> list[tuple[float, fl
     chosen = sweep.get("placements")
     if chosen is None:
         return [None]
-    from models.placement import sample_reachable_pose
+    from puzzlebox.models.placement import sample_reachable_pose
 
     if isinstance(chosen, int):
         rng = np.random.default_rng([int(sweep.get("placement_seed", 0)), len(spec.components)])
@@ -181,15 +181,15 @@ def _placements(sweep: dict[str, Any], spec: PuzzleSpec) -> list[tuple[float, fl
 
 def grid(sweep: dict[str, Any], base: Path) -> tuple[list[Task], dict[str, Cell]]:
     """Every task of the sweep and the cell each belongs to (by task key)."""
-    from models.placement import placed
+    from puzzlebox.models.placement import placed
 
     specs, seeds, agents = _specs(sweep, base), _seeds(sweep), _agents(sweep, base)
     twin = sweep["sim"] == "twin"
     profiles = sweep.get("profiles", ["ideal"]) if twin else ["-"]
     realities, calibrations = {}, {}
     if twin:
-        from models.calibration import CellCalibration
-        from twin.reality import PRESETS, load_profile
+        from puzzlebox.models.calibration import CellCalibration
+        from puzzlebox.twin.reality import PRESETS, load_profile
 
         for name in profiles:
             realities[name] = load_profile(name if name in PRESETS else base / name)

@@ -12,17 +12,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from _twin_trial import evaluation_world
-
-from learning import MemoryAgent, RunResult, run_episode
-from learning.belief import CELL_BELIEF
-from learning.dual_controller import DualControllerConfig
-from models import PuzzleSpec
-from models.calibration import CellCalibration
-from skills import SkillError
-from twin.errors import SimulationDiverged
-from twin.reality import RealityProfile
-from twin.session import TwinSession
+from puzzlebox.lab.twin_trial import evaluation_world
+from puzzlebox.learning import MemoryAgent, RunResult, run_episode
+from puzzlebox.learning.belief import CELL_BELIEF
+from puzzlebox.learning.dual_controller import DualControllerConfig
+from puzzlebox.models import PuzzleSpec
+from puzzlebox.models.calibration import CellCalibration
+from puzzlebox.skills import SkillError
+from puzzlebox.twin.errors import SimulationDiverged
+from puzzlebox.twin.reality import RealityProfile
+from puzzlebox.twin.session import TwinSession
 
 
 @dataclass(frozen=True)

@@ -9,9 +9,8 @@ import time
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from _trial_task import trial_task
-
-from learning.runner import Executor, InlineExecutor, PoolExecutor, RayExecutor, Task
+from puzzlebox.lab.trial_task import trial_task
+from puzzlebox.learning.runner import Executor, InlineExecutor, PoolExecutor, RayExecutor, Task
 
 
 def noop(settings: Mapping[str, Any]) -> dict[str, Any]:
@@ -52,7 +51,7 @@ def twin_throughput(trials: int = 40, workers: int | None = None) -> dict[str, A
     two ways: ``trials_per_hour`` start-up included (a worker's first trial pays its imports and scene build,
     as a user's run does; Ray's start-up is seconds) and ``warm_trials_per_hour``, the ``trials`` timed after
     one warm-up trial per worker (what a long sweep sees: start-up spread over thousands of trials)."""
-    from models.generator import paper_family
+    from puzzlebox.models.generator import paper_family
 
     workers = workers or os.cpu_count() or 1
     specs = paper_family("test")

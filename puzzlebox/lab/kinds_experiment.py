@@ -37,14 +37,15 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from _cli import write_json
 
-from models import LockTable, PuzzleSpec, load_spec, save_spec
-from models.atomic import write_atomically, write_text_atomically
-from models.generator import RandomGraphConfig, generate_chain, generate_random
-from models.kinds import registry_family
+import puzzlebox.scripts
+from puzzlebox.lab.cli import write_json
+from puzzlebox.models import LockTable, PuzzleSpec, load_spec, save_spec
+from puzzlebox.models.atomic import write_atomically, write_text_atomically
+from puzzlebox.models.generator import RandomGraphConfig, generate_chain, generate_random
+from puzzlebox.models.kinds import registry_family
 
-SCRIPTS = Path(__file__).resolve().parent
+SCRIPTS = Path(puzzlebox.scripts.__file__).resolve().parent
 
 
 @dataclass(frozen=True)

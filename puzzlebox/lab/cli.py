@@ -9,8 +9,8 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-from models.atomic import write_text_atomically
-from models.spec import dumps_compact
+from puzzlebox.models.atomic import write_text_atomically
+from puzzlebox.models.spec import dumps_compact
 
 
 def versions() -> dict[str, str]:

@@ -24,20 +24,19 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from _calibration_run import calibrate_cell
-from _cli import write_json
-from _run_store import Periodic
-from _trial_task import trial_task
-from trial import twin_figures
-
-from learning import MemoryAgent, SymbolicWorld, run_episode, summarise
-from learning.memory import MemoryStore
-from learning.runner import RecordStore, RunReport, Task, make_executor, run_tasks
-from models.calibration import CellCalibration
-from models.generator import paper_family
-from models.spec_loading import spec_from_dict
-from twin.reality import RealityProfile
-from twin.reality_levels import ALL, FACTORS, force_noise_profile, profile_at
+from puzzlebox.lab.calibration_run import calibrate_cell
+from puzzlebox.lab.cli import write_json
+from puzzlebox.lab.run_store import Periodic
+from puzzlebox.lab.trial_figures import twin_figures
+from puzzlebox.lab.trial_task import trial_task
+from puzzlebox.learning import MemoryAgent, SymbolicWorld, run_episode, summarise
+from puzzlebox.learning.memory import MemoryStore
+from puzzlebox.learning.runner import RecordStore, RunReport, Task, make_executor, run_tasks
+from puzzlebox.models.calibration import CellCalibration
+from puzzlebox.models.generator import paper_family
+from puzzlebox.models.spec_loading import spec_from_dict
+from puzzlebox.twin.reality import RealityProfile
+from puzzlebox.twin.reality_levels import ALL, FACTORS, force_noise_profile, profile_at
 
 AGREEMENT_BOUND = 0.99
 """Outcome agreement below which the F/T noise sweep reports its level."""

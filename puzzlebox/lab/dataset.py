@@ -11,12 +11,12 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from learning.runner import Task
-from models import LockTable
-from models.atomic import write_text_atomically
-from models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random
-from models.kinds import family_named
-from models.lock_table import ReachabilityUndecided
+from puzzlebox.learning.runner import Task
+from puzzlebox.models import LockTable
+from puzzlebox.models.atomic import write_text_atomically
+from puzzlebox.models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random
+from puzzlebox.models.kinds import family_named
+from puzzlebox.models.lock_table import ReachabilityUndecided
 
 MANIFEST = "manifest.json"
 

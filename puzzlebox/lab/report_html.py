@@ -25,8 +25,8 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import quote
 
-from _cell_bars import cell_bars
-from _cli import one_line
+from puzzlebox.lab.cell_bars import cell_bars
+from puzzlebox.lab.cli import one_line
 
 OUTCOME_COLOURS = {"moved": "#2e9d4a", "blocked": "#9aa3ad", "failed": "#d1495b"}
 OTHER_COLOUR = "#8e6bbf"
@@ -177,7 +177,7 @@ def summary_table(data: ResultsDir) -> str:
 
 def cell_runs(data: ResultsDir) -> list[list[str]]:
     """The run keys of each of the sweep's cells (in ``results.json``'s order): a sweep's run key is
-    ``{spec index:03d}-{spec}-p{placement}-{agent}-{profile}-seed{seed}`` (``scripts/_sweep_grid.py``)."""
+    ``{spec index:03d}-{spec}-p{placement}-{agent}-{profile}-seed{seed}`` (``puzzlebox/lab/sweep_grid.py``)."""
     cells = data.cells
     spec_index: dict[str, int] = {}
     for c in cells:

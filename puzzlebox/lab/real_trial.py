@@ -18,20 +18,20 @@ from typing import Any
 
 import numpy as np
 
-from learning import RunResult, make_agent, run_episode
-from learning.belief import CELL_BELIEF
-from learning.memory import MemoryStore
-from learning.trial import ActionRecord
-from models import PuzzleSpec
-from models.calibration import CellCalibration
-from models.cell_config import CellConfig
-from models.robot import Robot
-from real.errors import ArmStopped
-from skills import SkillError
-from skills.perception import MarkerDetector, PerceptionConfig
-from skills.primitives import PrimitiveConfig, Toggler
-from skills.scene_survey import SurveyConfig
-from skills.twin_world import TwinWorld, WorldConfig
+from puzzlebox.learning import RunResult, make_agent, run_episode
+from puzzlebox.learning.belief import CELL_BELIEF
+from puzzlebox.learning.memory import MemoryStore
+from puzzlebox.learning.trial import ActionRecord
+from puzzlebox.models import PuzzleSpec
+from puzzlebox.models.calibration import CellCalibration
+from puzzlebox.models.cell_config import CellConfig
+from puzzlebox.models.robot import Robot
+from puzzlebox.real.errors import ArmStopped
+from puzzlebox.skills import SkillError
+from puzzlebox.skills.perception import MarkerDetector, PerceptionConfig
+from puzzlebox.skills.primitives import PrimitiveConfig, Toggler
+from puzzlebox.skills.scene_survey import SurveyConfig
+from puzzlebox.skills.twin_world import TwinWorld, WorldConfig
 
 REST_TOLERANCE = 0.01
 """A handed-over arm farther than this from the cell's rest posture on any joint is moved there first [rad]."""

@@ -15,21 +15,21 @@ from typing import Any
 
 import numpy as np
 
-from learning import RunResult, make_agent, run_episode
-from learning.belief import CELL_BELIEF
-from learning.memory import MemoryStore
-from models import PuzzleSpec
-from models.calibration import CellCalibration
-from models.kinds import PUZZLE_KINDS
-from models.scene import SceneConfig
-from skills import MarkerDetector, SkillError
-from skills.twin_world import TwinWorld
-from twin.errors import SimulationDiverged
-from twin.nominal_calibration import nominal_calibration
-from twin.reality import RealityProfile
-from twin.rerun_log import TrialRecording
-from twin.rollout_video import BackgroundRollout, Caption, RolloutFrame, SceneCameras
-from twin.session import TwinConfig, TwinSession
+from puzzlebox.learning import RunResult, make_agent, run_episode
+from puzzlebox.learning.belief import CELL_BELIEF
+from puzzlebox.learning.memory import MemoryStore
+from puzzlebox.models import PuzzleSpec
+from puzzlebox.models.calibration import CellCalibration
+from puzzlebox.models.kinds import PUZZLE_KINDS
+from puzzlebox.models.scene import SceneConfig
+from puzzlebox.skills import MarkerDetector, SkillError
+from puzzlebox.skills.twin_world import TwinWorld
+from puzzlebox.twin.errors import SimulationDiverged
+from puzzlebox.twin.nominal_calibration import nominal_calibration
+from puzzlebox.twin.reality import RealityProfile
+from puzzlebox.twin.rerun_log import TrialRecording
+from puzzlebox.twin.rollout_video import BackgroundRollout, Caption, RolloutFrame, SceneCameras
+from puzzlebox.twin.session import TwinConfig, TwinSession
 
 
 class RolloutRecorder:

@@ -34,22 +34,22 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from _cli import write_json
-from _reality_sweep import _raise_failures, calibration_task
 
-from learning import make_agent, run_episode
-from learning.runner import RecordStore, Task, make_executor, run_tasks
-from models.calibration import CellCalibration
-from models.generator import paper_family
-from models.kinds import KIND_NAMES
-from models.spec_loading import spec_from_dict
-from models.toggle_log import load_toggles, save_toggles
-from twin.pose_error import PoseErrorConfig
-from twin.reality import RealityProfile, load_profile
-from twin.system_id import FitConfig
-from twin.toggle_replay import KindScales, ReplayConfig
-from twin.toggle_scoring import pooled_rms, prepare, toggle_errors
-from twin.toggle_signals import SignalConfig
+from puzzlebox.lab.cli import write_json
+from puzzlebox.lab.reality_sweep import _raise_failures, calibration_task
+from puzzlebox.learning import make_agent, run_episode
+from puzzlebox.learning.runner import RecordStore, Task, make_executor, run_tasks
+from puzzlebox.models.calibration import CellCalibration
+from puzzlebox.models.generator import paper_family
+from puzzlebox.models.kinds import KIND_NAMES
+from puzzlebox.models.spec_loading import spec_from_dict
+from puzzlebox.models.toggle_log import load_toggles, save_toggles
+from puzzlebox.twin.pose_error import PoseErrorConfig
+from puzzlebox.twin.reality import RealityProfile, load_profile
+from puzzlebox.twin.system_id import FitConfig
+from puzzlebox.twin.toggle_replay import KindScales, ReplayConfig
+from puzzlebox.twin.toggle_scoring import pooled_rms, prepare, toggle_errors
+from puzzlebox.twin.toggle_signals import SignalConfig
 
 TARGET_RATIO = 0.5
 """The issue's target: the held-out joint-load error at most half the nominal twin's."""
@@ -129,13 +129,12 @@ class TruthTrace:
 
 def record_task(settings: dict[str, Any], context: dict[str, Any]) -> dict[str, Any]:
     """Solve one box in the twin with every toggle logged (a runner task); the log goes to ``context["log"]``."""
-    from _twin_trial import evaluation_world  # MuJoCo and rendering only in the task
-
-    from learning.belief import CELL_BELIEF
-    from skills import SkillError
-    from skills.toggle_recorder import ToggleRecorder
-    from twin.errors import SimulationDiverged
-    from twin.session import TwinSession
+    from puzzlebox.lab.twin_trial import evaluation_world  # MuJoCo and rendering only in the task
+    from puzzlebox.learning.belief import CELL_BELIEF
+    from puzzlebox.skills import SkillError
+    from puzzlebox.skills.toggle_recorder import ToggleRecorder
+    from puzzlebox.twin.errors import SimulationDiverged
+    from puzzlebox.twin.session import TwinSession
 
     start = time.perf_counter()
     spec, seed = spec_from_dict(settings["spec"]), settings["seed"]
@@ -187,7 +186,7 @@ def _configs(settings: dict[str, Any]) -> tuple[ReplayConfig, SignalConfig, Pose
 
 def fit_task(settings: dict[str, Any], context: dict[str, Any]) -> dict[str, Any]:
     """Fit one kind of one cell on its training logs (a runner task)."""
-    from twin.system_id import fit_kind
+    from puzzlebox.twin.system_id import fit_kind
 
     replay, signals, pose, fit = _configs(settings)
     ready, skipped = prepare(_logs(context["dir"], settings["logs"]), replay, signals, pose)
@@ -318,7 +317,7 @@ class _Errors:
     rows: list[dict[str, Any]]
 
     def figures(self) -> dict[str, Any]:
-        from twin.toggle_scoring import ToggleErrors
+        from puzzlebox.twin.toggle_scoring import ToggleErrors
 
         def pooled(which: str, attribute: str) -> float | None:
             return pooled_rms([ToggleErrors(**r[which]) for r in self.rows], attribute)
@@ -374,7 +373,7 @@ def summarise(
 
 def write_report(summary: dict[str, Any], out: Path) -> None:
     """``sysid.json``, ``sysid.md`` and ``sysid.png``, each written atomically."""
-    from models.atomic import write_atomically, write_text_atomically
+    from puzzlebox.models.atomic import write_atomically, write_text_atomically
 
     write_json(out / "sysid.json", summary)
     write_text_atomically(out / "sysid.md", markdown(summary))

@@ -11,8 +11,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.patches import FancyArrowPatch, Polygon, Rectangle  # noqa: E402
 
-from models import PuzzleSpec, get_kind  # noqa: E402
-from models.kinds import registered_kind  # noqa: E402
+from puzzlebox.models import PuzzleSpec, get_kind  # noqa: E402
+from puzzlebox.models.kinds import registered_kind  # noqa: E402
 
 
 def plot_spec(spec: PuzzleSpec, path: Path) -> Path:

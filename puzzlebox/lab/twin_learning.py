@@ -36,19 +36,18 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from _cli import write_json
-from _reality_sweep import _raise_failures, calibration_task
-from _trial_task import trial_task
-from _twin_training import TwinTraining
-
-from learning import MemoryAgent, SymbolicWorld, run_episode, summarise
-from learning.experiments.deep_protocols import TrainingJob, job_key, job_task
-from learning.experiments.protocol import ProtocolConfig
-from learning.memory import MemoryStore
-from learning.runner import RecordStore, Task, make_executor, run_tasks
-from models.calibration import CellCalibration
-from models.generator import TRAIN_INDICES, paper_family
-from twin.reality import RealityProfile, load_profile
+from puzzlebox.lab.cli import write_json
+from puzzlebox.lab.reality_sweep import _raise_failures, calibration_task
+from puzzlebox.lab.trial_task import trial_task
+from puzzlebox.lab.twin_training import TwinTraining
+from puzzlebox.learning import MemoryAgent, SymbolicWorld, run_episode, summarise
+from puzzlebox.learning.experiments.deep_protocols import TrainingJob, job_key, job_task
+from puzzlebox.learning.experiments.protocol import ProtocolConfig
+from puzzlebox.learning.memory import MemoryStore
+from puzzlebox.learning.runner import RecordStore, Task, make_executor, run_tasks
+from puzzlebox.models.calibration import CellCalibration
+from puzzlebox.models.generator import TRAIN_INDICES, paper_family
+from puzzlebox.twin.reality import RealityProfile, load_profile
 
 STARTS = ("empty", "symbolic", "symbolic+twin")
 """Where a learning curve starts (see the module docstring)."""

@@ -13,11 +13,11 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any, Protocol
 
-from learning import SymbolicWorld, make_agent, run_episode
-from learning.memory import MemoryStore
-from learning.runner import Task
-from models import PuzzleSpec
-from models.spec_loading import spec_from_dict
+from puzzlebox.learning import SymbolicWorld, make_agent, run_episode
+from puzzlebox.learning.memory import MemoryStore
+from puzzlebox.learning.runner import Task
+from puzzlebox.models import PuzzleSpec
+from puzzlebox.models.spec_loading import spec_from_dict
 
 TIMING_KEYS = ("wall_time", "wall_time_s", "wall_time_per_trial_s_max", "wall_time_per_trial_s_mean", "sim_over_wall")
 """Record and summary fields that measure this machine's speed, not the trial: the only ones that differ
@@ -95,10 +95,9 @@ def run_trial(settings: Mapping[str, Any], context: Mapping[str, Any] | None = N
 def _run(spec: PuzzleSpec, settings: Mapping[str, Any], video: str | None, record: str | None = None) -> dict[str, Any]:
     memory = _memory(settings["memory"], settings["memory_sha256"]) if settings["memory"] else None
     if settings["sim"] == "twin":
-        from _twin_trial import run_twin_trial  # MuJoCo and rendering only when asked
-
-        from models.calibration import CellCalibration
-        from twin.reality import RealityProfile
+        from puzzlebox.lab.twin_trial import run_twin_trial  # MuJoCo and rendering only when asked
+        from puzzlebox.models.calibration import CellCalibration
+        from puzzlebox.twin.reality import RealityProfile
 
         reality = RealityProfile.from_dict(settings["reality"]) if settings["reality"] else None
         calibration = CellCalibration.from_dict(settings["calibration"]) if settings["calibration"] else None
