@@ -82,7 +82,7 @@ ROBOTS = ("twin", "xarm")
 
 
 def _real_main(args, arm: Callable[[str, Any], Any] | None = None) -> int:
-    """``--robot xarm``: one trial on the real arm (``puzzlebox/lab/real_trial.py``), refusing clearly, in one line, what
+    """``--robot xarm``: one trial on the real arm (``puzzlebox.lab.real_trial``), refusing clearly, in one line, what
     cannot run; an address where no arm answers is refused first, in about a second. ``arm(ip, cell)`` connects
     to the arm (default ``real.XArmRobot``, after probing the address; a test passes one over a test double)."""
     if args.ip is None or args.cell is None:
