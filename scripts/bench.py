@@ -185,14 +185,14 @@ def twin_trial_figures(quick: bool) -> dict[str, float]:
     """Simulated over wall time of oracle twin trials on the first paper test box, ideal cell: a first trial
     in this process and, unless ``quick``, a second one with what the process kept from the first. Quick: one
     try after the survey instead of the whole box."""
-    from puzzlebox.lab.twin_trial import run_twin_trial
+    from puzzlebox.lab import TrialConfig, run_trial
     from puzzlebox.models.generator import paper_family
 
     spec = paper_family("test")[0]
     out: dict[str, float] = {}
     for label in ("first", "second")[: 1 if quick else 2]:
         start = time.perf_counter()
-        record = run_twin_trial(spec, 0, "oracle", None, 1 if quick else 30, None)
+        record = run_trial(spec, TrialConfig(agent="oracle", seed=0, max_actions=1 if quick else 30)).to_dict()
         wall = time.perf_counter() - start
         out[f"{label}_sim_s"], out[f"{label}_wall_s"] = record["sim_time_s"], wall
         out[f"{label}_sim_over_wall"] = record["sim_time_s"] / wall
@@ -206,20 +206,24 @@ def rollout_figures(quick: bool) -> dict[str, float]:
     warm-up trial, ``repeats`` times each: medians and the ratios to plain (targets x1.5 and x1.3)."""
     import tempfile
 
-    from puzzlebox.lab.twin_trial import run_twin_trial
+    from puzzlebox.lab import TrialConfig, run_trial
     from puzzlebox.models.generator import paper_family
 
     spec = paper_family("test")[0]
     repeats = 1 if quick else 3
     walls: dict[str, list[float]] = {"plain": [], "video": [], "record": []}
     with tempfile.TemporaryDirectory() as tmp:
-        run_twin_trial(spec, 0, "oracle", None, 30, None)  # warm-up: renderer, scene, IK model built
+        run_trial(
+            spec, TrialConfig(agent="oracle", seed=0, max_actions=30)
+        ).to_dict()  # warm-up: renderer, scene, IK model built
         for k in range(repeats):
             for label in walls:
                 video = Path(tmp, f"v{k}.mp4") if label == "video" else None
                 record = Path(tmp, f"r{k}.rrd") if label == "record" else None
                 start = time.perf_counter()
-                run_twin_trial(spec, 0, "oracle", None, 30, video, record=record)
+                run_trial(
+                    spec, TrialConfig(agent="oracle", seed=0, max_actions=30), video=video, recording=record
+                ).to_dict()
                 walls[label].append(time.perf_counter() - start)
     out = {f"{label}_wall_s": float(np.median(times)) for label, times in walls.items()}
     out["video_over_plain"] = out["video_wall_s"] / out["plain_wall_s"]
@@ -233,6 +237,7 @@ def box_visibility_figures(quick: bool) -> dict[str, float]:
     trials (the 3 paper test boxes and two five-kind chains; quick: one), every frame's state kept, and per frame
     the best view's share of the box's pixels seen with the arm against the same view without it (MuJoCo's
     segmentation rendering, :meth:`twin.rollout_video.RolloutDrawer.box_visibility`)."""
+    from puzzlebox.lab import TrialConfig, run_trial
     from puzzlebox.lab import twin_trial as _twin_trial
     from puzzlebox.models.generator import generate_chain, paper_family
     from puzzlebox.twin.rollout_video import FrameCollector, RolloutDrawer
@@ -244,7 +249,7 @@ def box_visibility_figures(quick: bool) -> dict[str, float]:
     best: list[float] = []
     try:
         for spec in specs:
-            _twin_trial.run_twin_trial(spec, 0, "oracle", None, 12, Path("unused.mp4"))
+            run_trial(spec, TrialConfig(agent="oracle", seed=0, max_actions=12), video=Path("unused.mp4")).to_dict()
             kept = FrameCollector.last
             drawer = RolloutDrawer(kept.model, kept.cameras, kept.config)
             best += [max(drawer.box_visibility(f.qpos).values()) for f in kept.frames]

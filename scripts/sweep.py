@@ -18,7 +18,8 @@ from pathlib import Path
 from typing import Any
 
 from puzzlebox.lab.cell_bars import cell_bars
-from puzzlebox.lab.cli import fail
+from puzzlebox.lab.cli import fail, one_line
+from puzzlebox.lab.errors import RunStoreError
 from puzzlebox.lab.interrupt import StopRequests
 from puzzlebox.lab.run_store import Periodic, RunStore
 from puzzlebox.lab.sweep_grid import Cell, SweepError, grid, load_sweep
@@ -95,7 +96,10 @@ def main(argv: list[str] | None = None) -> int:
     except (SweepError, ModelsError, LearningError, TwinError, OSError) as err:  # a calibration's is a ModelsError
         fail(f"{path}: {err}" if not str(err).startswith(("sweep", "cannot read")) else str(err))
     out = Path(args.out)
-    store = RunStore(out, {"command": "sweep", "sweep": sweep, "sweep_file": str(path)}, args.resume, args.force)
+    try:
+        store = RunStore(out, {"command": "sweep", "sweep": sweep, "sweep_file": str(path)}, args.resume, args.force)
+    except RunStoreError as err:
+        fail(one_line(err))
     keys = [t.key for t in tasks]
     found: dict[str, dict] = {}
 

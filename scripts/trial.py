@@ -66,6 +66,7 @@ from tqdm import tqdm
 
 from puzzlebox.lab import trial_task as _trial_task
 from puzzlebox.lab.cli import fail, one_line, write_json
+from puzzlebox.lab.errors import RunStoreError
 from puzzlebox.lab.interrupt import StopRequests
 from puzzlebox.lab.run_store import Periodic, RunStore
 from puzzlebox.lab.trial_figures import twin_figures
@@ -139,7 +140,10 @@ def _real_main(args, arm: Callable[[str, Any], Any] | None = None) -> int:
                   "calibration": str(Path(args.calibration).resolve()), "spec": spec.to_dict(), "agent": args.agent,
                   "memory": args.memory, "checkpoint": args.checkpoint, "seed": args.seed,
                   "max_actions": args.max_actions, "max_lockers": args.max_lockers}  # fmt: skip
-    store = RunStore(out, experiment, force=args.force)
+    try:
+        store = RunStore(out, experiment, force=args.force)
+    except RunStoreError as err:
+        fail(one_line(err))
     key = f"000-{spec.name}-seed{args.seed}"
 
     def write(record: dict) -> None:  # the record as it grows: a stop or a crash keeps every action done
@@ -359,7 +363,10 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
         executor = make_executor(workers, args.ray)
     except RunnerError as err:
         fail(str(err))
-    store = RunStore(out, experiment, resume=args.resume, force=args.force)
+    try:
+        store = RunStore(out, experiment, resume=args.resume, force=args.force)
+    except RunStoreError as err:
+        fail(one_line(err))
     tasks = _tasks(args, specs, reality, calibration, out)
     found: dict[str, dict] = {}
     keys = [t.key for t in tasks]

@@ -6,9 +6,10 @@ Layout of ``DIR``: ``config.json`` (the experiment's resolved arguments, written
 ``runs_planned``).
 A crash, a kill or Ctrl-C keeps every finished run; ``--resume`` continues a directory of the same
 configuration, skipping what is there; ``--force`` empties one that holds anything else. Without either,
-a directory holding results is refused, so no directory ever describes one experiment and holds
-another's numbers. Half-written files a SIGKILL left (hidden temporaries of records and videos) are
-removed when the directory is taken up again.
+a directory holding results is refused (:class:`~puzzlebox.lab.errors.OutputHoldsResults`), so no directory
+ever describes one experiment and holds another's numbers. Every refusal is a
+:class:`~puzzlebox.lab.errors.RunStoreError`, its message naming the command line's flags. Half-written files
+a SIGKILL left (hidden temporaries of records and videos) are removed when the directory is taken up again.
 """
 
 from __future__ import annotations
@@ -21,7 +22,14 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from puzzlebox.lab.cli import fail, versions, write_json
+from puzzlebox.lab.cli import versions, write_json
+from puzzlebox.lab.errors import (
+    OutputHoldsAnotherConfig,
+    OutputHoldsResults,
+    OutputNotADirectory,
+    OutputNotWritable,
+    ResumeAndForce,
+)
 from puzzlebox.learning.runner import RecordStore
 
 RECORDS = "runs"
@@ -33,9 +41,9 @@ class RunStore:
 
     def __init__(self, out: Path, experiment: dict[str, Any], resume: bool = False, force: bool = False) -> None:
         if resume and force:
-            fail("--resume continues a directory, --force empties it: give one")
+            raise ResumeAndForce("--resume continues a directory, --force empties it: give one")
         if out.exists() and not out.is_dir():
-            fail(f"--out {out} is a file, not a directory")
+            raise OutputNotADirectory(f"--out {out} is a file, not a directory")
         self.out, self.experiment = out, experiment
         self.records_dir = out / RECORDS
         self.records = RecordStore(self.records_dir)
@@ -45,13 +53,15 @@ class RunStore:
         if holds and not force:
             old = self._read_config(config_path)
             if not resume:
-                fail(
+                raise OutputHoldsResults(
                     f"--out {out} already holds results ({len(self._record_paths())} run(s)): add --resume to "
                     "continue them (same configuration) or --force to delete them and start over"
                 )
             if old != experiment:
                 changed = sorted(k for k in set(old) | set(experiment) if old.get(k) != experiment.get(k))
-                fail(f"--resume: {out} holds another configuration (differs in {', '.join(changed)}); use --force")
+                raise OutputHoldsAnotherConfig(
+                    f"--resume: {out} holds another configuration (differs in {', '.join(changed)}); use --force"
+                )
         if force:
             shutil.rmtree(self.records_dir, ignore_errors=True)
             (out / "results.json").unlink(missing_ok=True)
@@ -64,7 +74,7 @@ class RunStore:
         try:
             write_json(config_path, {**experiment, "versions": versions()})
         except OSError as err:
-            fail(f"--out {out}: cannot write there ({err.strerror})")
+            raise OutputNotWritable(f"--out {out}: cannot write there ({err.strerror})") from err
 
     def _record_paths(self) -> list[Path]:
         return sorted(self.records_dir.glob("*.json")) if self.records_dir.is_dir() else []

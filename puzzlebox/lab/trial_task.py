@@ -13,7 +13,9 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any, Protocol
 
-from puzzlebox.learning import SymbolicWorld, make_agent, run_episode
+from puzzlebox.lab.agent_class import is_agent_class_name, make_agent_object
+from puzzlebox.lab.trial_config import TrialConfig
+from puzzlebox.lab.trials import run_trial as run_trial_of
 from puzzlebox.learning.memory import MemoryStore
 from puzzlebox.learning.runner import Task
 from puzzlebox.models import PuzzleSpec
@@ -94,25 +96,24 @@ def run_trial(settings: Mapping[str, Any], context: Mapping[str, Any] | None = N
 
 def _run(spec: PuzzleSpec, settings: Mapping[str, Any], video: str | None, record: str | None = None) -> dict[str, Any]:
     memory = _memory(settings["memory"], settings["memory_sha256"]) if settings["memory"] else None
+    name = settings["agent"]
+    agent = make_agent_object(name) if is_agent_class_name(name) else None
     if settings["sim"] == "twin":
-        from puzzlebox.lab.twin_trial import run_twin_trial  # MuJoCo and rendering only when asked
-        from puzzlebox.models.calibration import CellCalibration
-        from puzzlebox.twin.reality import RealityProfile
+        from puzzlebox.models.calibration import CellCalibration  # MuJoCo and rendering only when asked
+        from puzzlebox.twin.reality import IDEAL, RealityProfile
 
-        reality = RealityProfile.from_dict(settings["reality"]) if settings["reality"] else None
-        calibration = CellCalibration.from_dict(settings["calibration"]) if settings["calibration"] else None
-        return run_twin_trial(spec, settings["seed"], settings["agent"], memory, settings["max_actions"],
-                              Path(video) if video else None,
-                              settings["checkpoint"], reality, calibration, on_action=_on_action,
-                              misreport_kind=settings.get("misreport_kind", False),
-                              max_lockers=settings.get("max_lockers", 1),
-                              record=Path(record) if record else None,
-                              locks=settings.get("locks", "latch"))  # fmt: skip
-    agent = make_agent(
-        settings["agent"], spec, memory, settings["checkpoint"], max_lockers=settings.get("max_lockers", 1)
-    )
-    world = SymbolicWorld(spec, settings["seed"])
-    return run_episode(agent, world, spec.name, settings["seed"], settings["max_actions"], _on_action).to_dict()
+        config = TrialConfig(
+            sim="twin", agent=name, seed=settings["seed"], max_actions=settings["max_actions"],
+            reality=RealityProfile.from_dict(settings["reality"]) if settings["reality"] else IDEAL,
+            calibration=CellCalibration.from_dict(settings["calibration"]) if settings["calibration"] else None,
+            checkpoint=settings["checkpoint"], misreport_kind=settings.get("misreport_kind", False),
+            max_lockers=settings.get("max_lockers", 1), locks=settings.get("locks", "latch"),
+        )  # fmt: skip
+        return run_trial_of(spec, config, agent=agent, memory=memory, video=video, recording=record,
+                         on_action=_on_action).to_dict()  # fmt: skip
+    config = TrialConfig(sim="symbolic", agent=name, seed=settings["seed"], max_actions=settings["max_actions"],
+                         checkpoint=settings["checkpoint"], max_lockers=settings.get("max_lockers", 1))  # fmt: skip
+    return run_trial_of(spec, config, agent=agent, memory=memory, on_action=_on_action).to_dict()
 
 
 class ActionHook(Protocol):

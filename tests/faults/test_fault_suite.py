@@ -88,7 +88,7 @@ def test_a_killed_pool_worker_is_replaced_and_no_run_is_lost(specs, tmp_path):
 def test_physics_that_diverges_ends_the_run_with_its_name_and_keeps_the_record(specs):
     """Velocities made infinite mid-survey: MuJoCo flags it at the next step, the session raises
     SimulationDiverged, and the trial records the run as ended for that reason (no traceback)."""
-    from puzzlebox.lab.twin_trial import run_twin_trial
+    from puzzlebox.lab import TrialConfig, run_trial
     from puzzlebox.models import load_spec
     from puzzlebox.twin.errors import SimulationDiverged
     from puzzlebox.twin.session import TwinSession
@@ -110,7 +110,7 @@ def test_physics_that_diverges_ends_the_run_with_its_name_and_keeps_the_record(s
 
     TwinSession._after_steps = diverging
     try:
-        record = run_twin_trial(spec, 0, "oracle", None, 6, None)
+        record = run_trial(spec, TrialConfig(agent="oracle", seed=0, max_actions=6)).to_dict()
     finally:
         TwinSession._after_steps = after_steps
     assert record["ended"].startswith("SimulationDiverged: MuJoCo warning") and not record["solved"]

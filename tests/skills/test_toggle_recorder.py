@@ -7,8 +7,8 @@ import dataclasses
 
 import numpy as np
 import pytest
-from world_fixtures import evaluation_world
 
+from puzzlebox.lab.twin_trial import evaluation_world
 from puzzlebox.models.generator import paper_family
 from puzzlebox.models.toggle_log import PHASES, ToggleLog
 from puzzlebox.skills.toggle_recorder import ToggleRecorder

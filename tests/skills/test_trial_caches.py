@@ -12,10 +12,9 @@ from pathlib import Path
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
-import world_fixtures  # noqa: E402, F401  (puts scripts/ on the path)
 
+from puzzlebox.lab import TrialConfig, run_trial  # noqa: E402
 from puzzlebox.lab.trial_task import without_timing  # noqa: E402
-from puzzlebox.lab.twin_trial import run_twin_trial  # noqa: E402
 from puzzlebox.models.generator import paper_family  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
@@ -25,7 +24,8 @@ MAX_ACTIONS = 1
 
 def _record(spec_index: int, seed: int, reality: str) -> dict:
     spec = paper_family("test")[spec_index]
-    return without_timing(run_twin_trial(spec, seed, "oracle", None, MAX_ACTIONS, None, reality=reality))
+    config = TrialConfig(agent="oracle", seed=seed, max_actions=MAX_ACTIONS, reality=reality)
+    return without_timing(run_trial(spec, config).to_dict())
 
 
 def test_a_trial_after_others_in_the_process_gives_the_record_of_a_fresh_process():
@@ -35,10 +35,9 @@ def test_a_trial_after_others_in_the_process_gives_the_record_of_a_fresh_process
     assert again == first
     code = (
         "import json; from puzzlebox.models.generator import paper_family; "
-        "from puzzlebox.lab.twin_trial import run_twin_trial; from puzzlebox.lab.trial_task import without_timing; "
-        f"record = run_twin_trial(paper_family('test')[0], 1, 'oracle', None, {MAX_ACTIONS}, None, "
-        "reality='realistic'); "
-        "print(json.dumps(without_timing(record)))"
+        "from puzzlebox.lab import TrialConfig, run_trial; from puzzlebox.lab.trial_task import without_timing; "
+        f"config = TrialConfig(agent='oracle', seed=1, max_actions={MAX_ACTIONS}, reality='realistic'); "
+        "print(json.dumps(without_timing(run_trial(paper_family('test')[0], config).to_dict())))"
     )
     out = subprocess.run(
         [sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, check=True, timeout=600,

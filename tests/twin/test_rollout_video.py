@@ -12,7 +12,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 
-from puzzlebox.lab.twin_trial import run_twin_trial, scene_cameras  # noqa: E402
+from puzzlebox.lab import TrialConfig, run_trial  # noqa: E402
+from puzzlebox.lab.rollout_observers import scene_cameras  # noqa: E402
 from puzzlebox.models.generator import generate_chain, paper_family  # noqa: E402
 from puzzlebox.twin.errors import VideoError  # noqa: E402
 from puzzlebox.twin.rollout_video import (  # noqa: E402
@@ -98,7 +99,7 @@ def test_every_sampled_frame_shows_the_box_unoccluded_in_at_least_one_view(monke
 
     monkeypatch.setattr(_twin_trial, "BackgroundRollout", FrameCollector)
     spec = generate_chain(["lever", "slide", "door", "drawer", "wheel"], seed=0)
-    entry = run_twin_trial(spec, 1, "oracle", None, 8, Path("unused.mp4"))
+    entry = run_trial(spec, TrialConfig(agent="oracle", seed=1, max_actions=8), video=Path("unused.mp4")).to_dict()
     assert entry["solved"]
     kept = FrameCollector.last
     drawer = RolloutDrawer(kept.model, kept.cameras, kept.config)

@@ -1,0 +1,168 @@
+"""Observers that show a trial: a rollout video (:class:`RolloutVideo`) and a Rerun recording
+(:class:`RerunRecording`), fed by the trial's events (:mod:`puzzlebox.lab.observers`) and by the pipeline's own
+marker detections (:class:`RecordingDetector`). Neither senses anything: the trial is the same with or without.
+"""
+
+from __future__ import annotations
+
+import collections
+import math
+from collections.abc import Callable
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from puzzlebox.lab.observers import TrialContext, TrialObserver
+from puzzlebox.skills import MarkerDetector
+from puzzlebox.twin.rerun_log import TrialRecording
+from puzzlebox.twin.rollout_video import BackgroundRollout, Caption, RolloutFrame, SceneCameras
+from puzzlebox.twin.session import TwinSession
+
+__all__ = ["RecordingDetector", "RerunRecording", "RolloutVideo", "agent_belief", "scene_cameras"]
+
+
+class RecordingDetector(MarkerDetector):
+    """The pipeline's marker detector, keeping its latest detections per camera for the rollout video (the
+    video shows what the pipeline detected, never detecting again)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.latest: dict[str, tuple[float, list[tuple[int, np.ndarray]]]] = {}
+        """Camera name -> capture time [s] and detections (marker id, corners [px]) of its latest look."""
+        self.listeners: list[Callable[[str, float, list[tuple[int, np.ndarray]]], None]] = []
+        """Called with (camera, capture time, detections) after every look (a Rerun recording's)."""
+
+    def detect(self, image, camera, T_base_tcp=None):
+        found = super().detect(image, camera, T_base_tcp)
+        if image is not None:
+            seen = [(d.marker_id, d.corners_px.copy()) for d in found]
+            self.latest[image.camera] = (image.time, seen)
+            for listener in self.listeners:
+                listener(image.camera, image.time, seen)
+        return found
+
+
+def scene_cameras(session: TwinSession) -> SceneCameras:
+    """What the rollout video's views look at in ``session``: its cameras, and its lid for the perspective view."""
+    length, width, _ = session.spec.box.size
+    names, render = session.scene.names, session.config.render
+    return SceneCameras(
+        overview=names.overview_camera,
+        wrist=names.wrist_camera,
+        lid_centre=tuple(float(v) for v in session.scene.T_world_lid[:3, 3]),
+        lid_diagonal=float(np.hypot(length, width)),
+        capture_size=(render.width, render.height),
+    )
+
+
+def agent_belief(agent: Any) -> np.ndarray | None:
+    """The agent's belief as one-locker categoricals ``(N, 2, 1 + 2N)``, or None for an agent without one."""
+    belief = getattr(agent, "belief", None)
+    return None if belief is None else np.array(belief.single_locker_probs(), dtype=float)
+
+
+class RolloutVideo(TrialObserver):
+    """Hands a :class:`~puzzlebox.twin.rollout_video.RolloutFrame` to the background drawer every
+    ``RolloutConfig.period`` of simulated time: the joint positions, the caption of the action under way, the
+    pipeline's latest detections (``detector``) and the recent wrist force the primitives sensed. Drawing happens
+    in the other process."""
+
+    def __init__(self, session: TwinSession, rollout: BackgroundRollout, detector: RecordingDetector) -> None:
+        self._session, self._rollout, self._detector = session, rollout, detector
+        self._period = rollout.config.period
+        self._window = rollout.config.plot_window
+        self._next = 0.0
+        self._caption = Caption()
+        self._world: Any = None
+        self._forces: collections.deque[tuple[float, float]] = collections.deque()
+
+    def attach(self, trial: TrialContext) -> None:
+        self._world = trial.world
+
+    def waited(self, now: float) -> None:
+        if self._world is not None:
+            force_in_base = self._world.toggler.force_in_base
+            self._forces.append((now, math.sqrt(force_in_base @ force_in_base)))
+            while self._forces and self._forces[0][0] < now - self._window:
+                self._forces.popleft()
+        while self._next <= now:  # a frame per grid time 0, period, 2 period, ... this wait passed: the state
+            self._frame(self._next)  # at its end (a 10 ms control tick; a look or a settle waits up to ~1 s)
+            self._next += self._period
+
+    def action_begins(self, caption: Caption) -> None:
+        self._caption = caption
+
+    action_ended = action_begins
+
+    def finish(self) -> None:
+        self._frame(self._session.time)  # the last frame, whatever the time: how the last action ended
+
+    def _frame(self, now: float) -> None:
+        phase = "surveying" if self._world is None else self._world.toggler.phase
+        self._rollout.add(
+            RolloutFrame(
+                time=now, qpos=self._session.data.qpos.copy(), caption=replace(self._caption, phase=phase),
+                detections=dict(self._detector.latest), forces=np.array(self._forces, dtype=float).reshape(-1, 2),
+            )
+        )  # fmt: skip
+
+
+class RerunRecording(TrialObserver):
+    """Logs the trial into a :class:`~puzzlebox.twin.rerun_log.TrialRecording`: every image the pipeline captured
+    (as captured), the markers it detected, and every ``RecordConfig.period`` of simulated time the arm's and the
+    components' poses, the TCP and the wrist force the primitives sensed; every decision, outcome and the agent's
+    belief after it."""
+
+    def __init__(self, session: TwinSession, recording: TrialRecording, detector: RecordingDetector) -> None:
+        self._session, self.recording = session, recording
+        m = session.model
+        names = session.scene.names
+        self._arm = [b for b in range(m.nbody) if m.body(b).name.startswith("xarm7/")]
+        self._arm_names = [m.body(b).name.removeprefix("xarm7/") for b in self._arm]
+        self._components = [m.body(c.body).id for c in names.components.values()]
+        self._component_names = list(names.components)
+        self._tcp = m.site(names.tcp_site).id
+        self._next = 0.0
+        self._world: Any = None
+        self._agent: Any = None
+        detector.listeners.append(self._markers)
+
+    def attach(self, trial: TrialContext) -> None:
+        self._world, self._agent = trial.world, trial.agent
+
+    def sensed(self, what: str, value: Any) -> None:
+        if what.startswith("capture:") and value is not None:
+            self.recording.at(value.time)
+            self.recording.image(value.camera, value.rgb)
+
+    def _markers(self, camera: str, time: float, detections: list) -> None:
+        self.recording.at(time)
+        self.recording.markers(camera, detections)
+
+    def waited(self, now: float) -> None:
+        if now < self._next:
+            return
+        while self._next <= now:  # on the grid 0, period, 2 period, ... (a long wait skips points)
+            self._next += self.recording.config.period
+        d = self._session.data
+        bodies = {
+            "world/arm": (self._arm_names, d.xpos[self._arm], d.xquat[self._arm]),
+            "world/components": (self._component_names, d.xpos[self._components], d.xquat[self._components]),
+        }
+        force = None if self._world is None else np.array(self._world.toggler.force_in_base, dtype=float)
+        self.recording.sample(now, bodies, d.site_xpos[self._tcp], force)
+
+    def action_begins(self, caption: Caption) -> None:
+        self.recording.at(self._session.time)
+        values = "" if caption.q_info is None else f": w {caption.weight_info:.3f}, Q_info {caption.q_info:.4f}, "
+        values += "" if caption.q_exploit is None else f"Q_exploit {caption.q_exploit:.4f}"
+        self.recording.decision(f"action {caption.action}: try {caption.component}{values}", caption.weight_info)
+
+    def action_ended(self, caption: Caption) -> None:
+        self.recording.at(self._session.time)
+        truth = f" (truth: {caption.truth})" if caption.truth else ""
+        self.recording.decision(f"action {caption.action} {caption.component}: {caption.sensed}{truth}")
+        belief = agent_belief(self._agent)
+        if belief is not None:
+            self.recording.belief(belief)

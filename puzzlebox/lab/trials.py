@@ -1,0 +1,80 @@
+"""Run a trial from Python: :func:`run_trial` (the agent acts until solved or out of actions; a record comes back)
+and :func:`open_world` (the world, for one's own loop)."""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Callable, Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+from puzzlebox.lab.observers import TrialContext, TrialObserver
+from puzzlebox.lab.trial_config import TrialConfig
+from puzzlebox.lab.trial_record import TrialRecord
+from puzzlebox.learning import Agent, SymbolicWorld, make_agent, run_episode
+from puzzlebox.learning.memory import MemoryStore
+from puzzlebox.models import PuzzleSpec, World
+
+__all__ = ["open_world", "run_trial"]
+
+
+def run_trial(
+    spec: PuzzleSpec,
+    config: TrialConfig | None = None,
+    *,
+    agent: Agent | None = None,
+    observers: Sequence[TrialObserver] = (),
+    memory: MemoryStore | None = None,
+    video: str | Path | None = None,
+    recording: str | Path | None = None,
+    on_action: Callable[[Any], None] | None = None,
+) -> TrialRecord:
+    """One trial of ``agent`` on ``spec`` under ``config`` (default :class:`TrialConfig`: the twin, ``ideal``).
+
+    ``agent``: any object with the ``puzzlebox.learning.Agent`` methods (default: the registered agent
+    ``config.agent``, made for this spec; the memory agent reads ``memory``, or the file ``config.memory``).
+    ``observers`` see every reading, wait and action of a twin trial (:mod:`puzzlebox.lab.observers`) without
+    changing it. ``video`` (MP4) and ``recording`` (Rerun ``.rrd``) are written there, twin only.
+    ``on_action`` is called after every try with its :class:`~puzzlebox.learning.ActionRecord`.
+    Raises :class:`~puzzlebox.lab.errors.TrialConfigError` for outputs a symbolic trial cannot make."""
+    config = config or TrialConfig()
+    if memory is None and agent is None and config.memory is not None:
+        memory = MemoryStore.open_existing(config.memory)
+    if config.sim == "twin":
+        from puzzlebox.lab.twin_trial import run_twin_trial  # MuJoCo and rendering only when asked
+
+        return run_twin_trial(
+            spec, config, agent, memory, observers, None if video is None else Path(video),
+            None if recording is None else Path(recording), on_action,
+        )  # fmt: skip
+    if video is not None or recording is not None:
+        from puzzlebox.lab.errors import TrialConfigError
+
+        raise TrialConfigError("a video or a recording is of a twin trial (sim='twin')")
+    if agent is None:
+        checkpoint = None if config.checkpoint is None else str(config.checkpoint)
+        agent = make_agent(config.agent, spec, memory, checkpoint, max_lockers=config.max_lockers)
+    for observer in observers:
+        observer.attach(TrialContext(spec, config.seed, None, None, agent))
+    result = run_episode(agent, SymbolicWorld(spec, config.seed), spec.name, config.seed, config.max_actions, on_action)
+    for observer in observers:
+        observer.finish()
+    return TrialRecord.of_run(result)
+
+
+@contextlib.contextmanager
+def open_world(
+    spec: PuzzleSpec, config: TrialConfig | None = None, observers: Sequence[TrialObserver] = ()
+) -> Iterator[World]:
+    """The world of a trial for one's own loop (a context manager): ``observe()`` gives the scene as the
+    pipeline perceives it, ``try_toggle(i)`` tries component ``i`` and says what happened. In the twin
+    (``config.sim``, default) the robot moves through perception and the motion primitives, under
+    ``config``'s reality profile and calibration; the session closes when the block ends."""
+    config = config or TrialConfig()
+    if config.sim == "symbolic":
+        yield SymbolicWorld(spec, config.seed)
+        return
+    from puzzlebox.lab.twin_trial import open_twin_world
+
+    with open_twin_world(spec, config, observers) as world:
+        yield world
