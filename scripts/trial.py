@@ -65,8 +65,9 @@ from typing import Any
 from tqdm import tqdm
 
 from puzzlebox.lab import trial_task as _trial_task
+from puzzlebox.lab.agent_class import is_agent_class_name, load_agent_class
 from puzzlebox.lab.cli import fail, one_line, write_json
-from puzzlebox.lab.errors import RunStoreError
+from puzzlebox.lab.errors import AgentClassError, RunStoreError
 from puzzlebox.lab.interrupt import StopRequests
 from puzzlebox.lab.run_store import Periodic, RunStore
 from puzzlebox.lab.trial_figures import twin_figures
@@ -237,7 +238,11 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
     parser.add_argument("--seed", type=int, required=True, help="seed of run 0; run r uses seed + r")
     parser.add_argument("--max-actions", type=int, required=True, help="action budget per run")
     parser.add_argument("--out", required=True, help="output directory")
-    parser.add_argument("--agent", default="memory", help=f"one of {list(AGENT_NAMES)} (default: memory)")
+    parser.add_argument(
+        "--agent", default="memory",
+        help=f"one of {list(AGENT_NAMES)} (default: memory), or an agent class of one's own as package.module:Class "
+        "(the puzzlebox.learning.Agent methods, constructed with no argument; importable where trial.py runs)",
+    )  # fmt: skip
     parser.add_argument("--checkpoint", default=None, help="checkpoint from train.py (deep agents)")
     parser.add_argument(
         "--max-lockers", type=int, default=1, metavar="K",
@@ -290,8 +295,18 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
         fail(f"--seed must be >= 0, got {args.seed}")
     if args.workers is not None and (args.workers < 1 or args.ray is not None):
         fail("--workers must be >= 1, and goes without --ray" if args.workers < 1 else "give --workers or --ray")
-    if args.agent not in AGENT_NAMES:
-        fail(f"unknown agent {args.agent!r}. Available agents: {sorted(AGENT_NAMES)}")
+    own_agent = is_agent_class_name(args.agent)
+    if own_agent:
+        if os.getcwd() not in sys.path:  # as `python -m` would: an agent module beside the user imports (workers
+            sys.path.insert(0, os.getcwd())  # inherit the path)
+        try:
+            load_agent_class(args.agent)
+        except AgentClassError as err:
+            fail(one_line(err))
+        if args.memory or args.checkpoint or args.max_lockers != 1:
+            fail(f"--memory, --checkpoint and --max-lockers are for the project's agents, not {args.agent!r}")
+    elif args.agent not in AGENT_NAMES:
+        fail(f"unknown agent {args.agent!r}. Available agents: {sorted(AGENT_NAMES)}, or package.module:Class")
     if (args.agent == "memory") != (args.memory is not None):
         fail("--memory goes with --agent memory (and only with it): train one with scripts/train.py")
     if args.max_lockers != 1:
@@ -343,7 +358,8 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
 
     try:  # what every run needs is checked once here: a bad memory or checkpoint is one line, not N errors
         memory = MemoryStore.open_existing(args.memory) if args.memory else None
-        make_agent(args.agent, specs[0], memory, args.checkpoint)
+        if not own_agent:
+            make_agent(args.agent, specs[0], memory, args.checkpoint)
     except LearningError as err:
         fail(str(err))
     if memory is not None:
