@@ -40,6 +40,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from puzzlebox.lab.cells import profile_of_calibration
 from puzzlebox.lab.cli import fail, versions, write_json
 from puzzlebox.lab.interrupt import StopRequests
 from puzzlebox.learning import DEEP_AGENT_NAMES, MemoryAgent, SymbolicWorld, run_episode
@@ -167,6 +168,7 @@ def _twin_setup(args: argparse.Namespace, specs: list):
     try:
         reality = load_profile(args.reality or "ideal")
         calibration = CellCalibration.load(args.calibration) if args.calibration else None
+        reality = profile_of_calibration(reality, calibration)  # the cell the calibration was made in
     except (TwinError, CalibrationError) as err:
         fail(str(err))
     for path, spec in zip(args.specs, specs, strict=True):

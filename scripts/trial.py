@@ -66,6 +66,7 @@ from tqdm import tqdm
 
 from puzzlebox.lab import trial_task as _trial_task
 from puzzlebox.lab.agent_class import is_agent_class_name, load_agent_class
+from puzzlebox.lab.cells import profile_of_calibration
 from puzzlebox.lab.cli import fail, one_line, write_json
 from puzzlebox.lab.errors import AgentClassError, RunStoreError
 from puzzlebox.lab.interrupt import StopRequests
@@ -341,6 +342,7 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
         try:
             reality = load_profile(args.reality)
             calibration = CellCalibration.load(args.calibration) if args.calibration else None
+            reality = profile_of_calibration(reality, calibration)  # the cell the calibration was made in
         except (TwinError, CalibrationError) as err:
             fail(str(err))
     try:
