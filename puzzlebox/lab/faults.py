@@ -17,7 +17,7 @@ Classes so far:
 - the twin's faults (:data:`TWIN_FAULTS`): frames dropped, occluded, noised; F/T noise; parts that jam;
   handles that slip — one oracle trial each, which must end with its reason named (or solve anyway).
 
-Writes ``DIR/faults.json`` and ``DIR/faults.md`` (one table, linked from the README).
+Writes ``DIR/faults.json`` and ``DIR/faults.md`` (one table; the measured one is in docs/faults.md).
 """
 
 from __future__ import annotations

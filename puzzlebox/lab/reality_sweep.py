@@ -78,7 +78,7 @@ class SweepConfig:
 
 def ensure_memory(path: Path, config: SweepConfig) -> Path:
     """The memory agent's store: ``path`` if it holds episodes, else trained there on the paper training
-    boxes (the README's recipe) and returned."""
+    boxes (docs/results.md's recipe) and returned."""
     if path.exists():
         return path
     train = paper_family("train", seed=0)
