@@ -2,7 +2,7 @@
 identification of the box fits the twin to.
 
 :class:`ToggleRecorder` stands between the robot and the pipeline (it satisfies :class:`models.robot.Robot`,
-passing every call through) and follows a :class:`~skills.twin_world.TwinWorld`'s toggle primitive from the
+passing every call through) and follows a :class:`~skills.robot_world.RobotWorld`'s toggle primitive from the
 outside (:meth:`ToggleRecorder.attach` wraps the world's ``toggler.toggle`` on the instance). While a toggle runs,
 every wrench the primitive reads (once per 10 ms control tick) is logged with what the robot reports at that
 instant — joint positions, gripper closure, TCP pose, the F/T sensor's orientation (which turns the wrench into
@@ -85,7 +85,7 @@ class ToggleRecorder:
         return w
 
     def attach(self, world: Any) -> None:
-        """Follow ``world``'s toggles (a :class:`~skills.twin_world.TwinWorld` built on this recorder): its
+        """Follow ``world``'s toggles (a :class:`~skills.robot_world.RobotWorld` built on this recorder): its
         toggler's ``toggle`` is wrapped on the instance, the primitive itself untouched."""
         toggler = world.toggler
         if toggler.robot is not self:

@@ -36,7 +36,7 @@ class Handling:
     pivots between the pads like a pin as the part turns and the gripper need not tilt with it (doors, levers)."""
     verdict: Literal["left_pose", "arc"] = "left_pose"
     """How a marker seen after a try tells that the part moved: ``left_pose``, it left its closed planar pose
-    (moved ``skills.twin_world.MOVED_DISTANCE`` or turned ``MOVED_ANGLE``); ``arc``, the marker centre's turn
+    (moved ``skills.robot_world.MOVED_DISTANCE`` or turned ``MOVED_ANGLE``); ``arc``, the marker centre's turn
     about the hinge as a fraction of the travel (a door's marker rises with its flap, a lever's drops)."""
     read_close_up: bool = False
     """Whether a try's outcome is always read from the wrist camera close up, not from the overview: a part

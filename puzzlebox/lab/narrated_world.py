@@ -8,7 +8,7 @@ from typing import Any
 
 from puzzlebox.lab.observers import TrialObserver
 from puzzlebox.models import SceneObservation, TryResult
-from puzzlebox.skills.twin_world import TwinWorld
+from puzzlebox.skills.robot_world import RobotWorld
 from puzzlebox.twin.rollout_video import Caption
 
 __all__ = ["NarratedWorld"]
@@ -20,7 +20,7 @@ class NarratedWorld:
     after it, ``action_ended(caption)`` with the outcome as sensed and, in evaluation, the truth."""
 
     def __init__(
-        self, world: TwinWorld, observers: Sequence[TrialObserver], decisions: Callable[[], Sequence[Any]]
+        self, world: RobotWorld, observers: Sequence[TrialObserver], decisions: Callable[[], Sequence[Any]]
     ) -> None:
         self._world, self._observers, self._decisions = world, tuple(observers), decisions
         self._last = Caption()

@@ -25,7 +25,7 @@ from puzzlebox.models.robot import CameraImage, Robot
 
 if TYPE_CHECKING:
     from puzzlebox.models import PuzzleSpec
-    from puzzlebox.skills.twin_world import TwinWorld
+    from puzzlebox.skills.robot_world import RobotWorld
     from puzzlebox.twin.rollout_video import Caption
     from puzzlebox.twin.session import TwinSession
 
@@ -40,7 +40,7 @@ class TrialContext:
     spec: PuzzleSpec
     seed: int
     session: TwinSession | None
-    world: TwinWorld | None = None
+    world: RobotWorld | None = None
     agent: Any = None
 
 
@@ -144,7 +144,7 @@ class PeakWristForce(TrialObserver):
         """Largest true external wrist force so far [N]."""
         self.peak_during = ""
         """What the arm was doing at the peak (``"<toggler phase>, action <k>"``, or ``"surveying"``)."""
-        self._world: TwinWorld | None = None
+        self._world: RobotWorld | None = None
 
     def attach(self, trial: TrialContext) -> None:
         self._world = trial.world

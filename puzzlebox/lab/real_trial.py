@@ -30,8 +30,8 @@ from puzzlebox.real.errors import ArmStopped
 from puzzlebox.skills import SkillError
 from puzzlebox.skills.perception import MarkerDetector, PerceptionConfig
 from puzzlebox.skills.primitives import PrimitiveConfig, Toggler
+from puzzlebox.skills.robot_world import RobotWorld, WorldConfig
 from puzzlebox.skills.scene_survey import SurveyConfig
-from puzzlebox.skills.twin_world import TwinWorld, WorldConfig
 
 REST_TOLERANCE = 0.01
 """A handed-over arm farther than this from the cell's rest posture on any joint is moved there first [rad]."""
@@ -59,7 +59,7 @@ def go_to_rest(robot: Robot, cell: CellConfig, primitives: PrimitiveConfig) -> b
 
 
 def _entry(
-    result: RunResult, world: TwinWorld | None, spec: PuzzleSpec, robot: Robot, wall: float, stopped: str
+    result: RunResult, world: RobotWorld | None, spec: PuzzleSpec, robot: Robot, wall: float, stopped: str
 ) -> dict[str, Any]:
     by_marker = {c.marker: c.name for c in spec.components}
     entry = result.to_dict()
@@ -104,7 +104,7 @@ def run_real_trial(
     if primitives is not None:
         world_config = replace(world_config, primitives=primitives)
     by_marker = {c.marker: c for c in spec.components}
-    world: TwinWorld | None = None
+    world: RobotWorld | None = None
     stopped = ""
 
     def progress(action: Any) -> None:
@@ -115,7 +115,7 @@ def run_real_trial(
 
     try:
         go_to_rest(robot, cell, world_config.primitives)
-        world = TwinWorld(
+        world = RobotWorld(
             robot,
             calibration,
             {c.marker: c.kind for c in spec.components},
@@ -139,7 +139,7 @@ def run_real_trial(
     return entry
 
 
-def _unfinished(spec: PuzzleSpec, seed: int, world: TwinWorld | None, wall: float, why: str) -> RunResult:
+def _unfinished(spec: PuzzleSpec, seed: int, world: RobotWorld | None, wall: float, why: str) -> RunResult:
     """The run of a trial that ended early (or so far): the actions the world logged, its goal as perceived."""
     log = world.log if world else []
     actions = [ActionRecord(world.names[a.marker], a.moved, a.outcome, a.reason) for a in log] if world else []

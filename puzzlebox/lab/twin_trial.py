@@ -25,7 +25,7 @@ from puzzlebox.models.calibration import CellCalibration
 from puzzlebox.models.kinds import PUZZLE_KINDS
 from puzzlebox.models.scene import SceneConfig
 from puzzlebox.skills import MarkerDetector, SkillError
-from puzzlebox.skills.twin_world import TwinWorld
+from puzzlebox.skills.robot_world import RobotWorld
 from puzzlebox.twin.errors import SimulationDiverged
 from puzzlebox.twin.nominal_calibration import nominal_calibration
 from puzzlebox.twin.rerun_log import TrialRecording
@@ -42,7 +42,7 @@ def evaluation_world(
     seed: int = 0,
     told_kinds: Mapping[str, str] | None = None,
     detector: MarkerDetector | None = None,
-) -> TwinWorld:
+) -> RobotWorld:
     """The world a twin trial runs on ``session`` (through ``robot``, default the session's): the spec's
     goal and markers, ``calibration`` (default: the nominal one, exact only under ``ideal``), and — for
     scoring only, never for deciding — the simulator's component states and names. ``told_kinds`` (component
@@ -50,7 +50,7 @@ def evaluation_world(
     spec = session.spec
     by_marker = {c.marker: i for i, c in enumerate(spec.components)}
     told = told_kinds or {}
-    return TwinWorld(
+    return RobotWorld(
         robot if robot is not None else session.robot,
         calibration if calibration is not None else nominal_calibration(session),
         {c.marker: told.get(c.name, c.kind) for c in spec.components},
@@ -83,7 +83,7 @@ def twin_session(spec: PuzzleSpec, config: TrialConfig) -> TwinSession:
 @contextlib.contextmanager
 def open_twin_world(
     spec: PuzzleSpec, config: TrialConfig, observers: Sequence[TrialObserver] = ()
-) -> Iterator[TwinWorld]:
+) -> Iterator[RobotWorld]:
     """The world of a twin trial, for one's own loop: ``world.observe()``, ``world.try_toggle(i)`` drive the robot
     through perception and the primitives; ``observers`` see every reading and wait (not the actions: a loop of
     one's own tells no caption). The session closes when the block ends."""

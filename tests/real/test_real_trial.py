@@ -22,7 +22,7 @@ from puzzlebox.real.xarm_driver import XARM7_JOINT_LIMITS, _rpy_matrix
 from puzzlebox.scripts import trial
 from puzzlebox.skills.errors import MarkersNotFound
 from puzzlebox.skills.perception import MarkerDetector, PerceptionConfig
-from puzzlebox.skills.twin_world import TwinWorld
+from puzzlebox.skills.robot_world import RobotWorld
 from puzzlebox.twin.nominal_calibration import nominal_calibration
 from puzzlebox.twin.session import TwinSession
 
@@ -226,7 +226,7 @@ def test_the_worlds_primitives_run_the_cells_thresholds():
         cell = twin_xarm_cell(session, force_limit=45.0, blocked_force=15.0)
         world_config, perception = cell_configs(cell)
         spec = session.spec
-        world = TwinWorld(
+        world = RobotWorld(
             session.robot, nominal_calibration(session), {c.marker: c.kind for c in spec.components},
             spec.components[spec.index_of(spec.goal.component)].marker, config=world_config,
             detector=MarkerDetector(perception),

@@ -18,7 +18,7 @@ from puzzlebox.models.placement import placed
 from puzzlebox.models.scene import SceneConfig
 from puzzlebox.skills import MarkerDetector, joint_model, lid_height, select_markers, upright_pose
 from puzzlebox.skills.primitives import PrimitiveConfig, Toggler
-from puzzlebox.skills.twin_world import TwinWorld
+from puzzlebox.skills.robot_world import RobotWorld
 from puzzlebox.twin.nominal_calibration import nominal_calibration
 from puzzlebox.twin.reality import ArmReality, ForceTorqueReality, PhysicsReality, RealityProfile
 from puzzlebox.twin.session import TwinConfig, TwinSession
@@ -169,7 +169,7 @@ def test_a_calibrated_realistic_cell_perceives_boxes_at_new_placements_within_5_
     spec = paper_family("test")[variant]
     with TwinSession(spec, seed=seed, reality="realistic") as session:
         spec = session.spec  # placed by the profile
-        world = TwinWorld(
+        world = RobotWorld(
             session.robot,
             realistic_calibration,
             {c.marker: c.kind for c in spec.components},
@@ -265,7 +265,7 @@ def test_closing_on_a_handle_puts_no_impact_on_the_wrist():
 def test_a_door_left_part_way_open_is_pushed_on_from_where_it_stands():
     """A try that lost its hold on a door part-way leaves it raised: its handle is no longer where a pinch
     descends (the grasp closes on nothing), and a push placed behind the closed handle lands on the raised
-    post (60-100 N). The door is looked at from over its hinge (``TwinWorld`` does before a retry) and pushed
+    post (60-100 N). The door is looked at from over its hinge (``RobotWorld`` does before a retry) and pushed
     on from the angle seen."""
     spec = placed(paper_family("test", seed=0)[0], (0.45, -0.15, 2.2))
     with TwinSession(spec, seed=0) as session:

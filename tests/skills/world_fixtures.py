@@ -1,4 +1,4 @@
-"""A ``TwinWorld`` over a twin session exactly as a twin trial wires it (``puzzlebox.lab.twin_trial``: nominal
+"""A ``RobotWorld`` over a twin session exactly as a twin trial wires it (``puzzlebox.lab.twin_trial``: nominal
 calibration, the spec's goal, ground truth for scoring only), and the session's robot watched for its peak true
 wrist force, shared by the skills tests."""
 
@@ -6,13 +6,13 @@ from __future__ import annotations
 
 from puzzlebox.lab.observers import ObservedRobot, PeakWristForce
 from puzzlebox.lab.twin_trial import evaluation_world
-from puzzlebox.skills.twin_world import TwinWorld
+from puzzlebox.skills.robot_world import RobotWorld
 from puzzlebox.twin.session import TwinSession
 
 __all__ = ["TrueForceWatch", "twin_world"]
 
 
-def twin_world(session: TwinSession, seed: int = 0) -> TwinWorld:
+def twin_world(session: TwinSession, seed: int = 0) -> RobotWorld:
     return evaluation_world(session, seed=seed)
 
 

@@ -1,4 +1,4 @@
-"""``TwinWorld``: the ``World`` protocol over a robot — perception in, primitives out.
+"""``RobotWorld``: the ``World`` protocol over a robot — perception in, primitives out.
 
 It works on any :class:`models.robot.Robot` (the twin's or a real arm's) with the cell's calibration
 file; it never sees simulator ground truth.
@@ -20,7 +20,7 @@ that marker at the start, else close up from the wrist camera — (a marker that
 vanished, as a door's does when it stands open, moved; one still at its closed pose after a "moved"
 means the handle slipped out of the pads: with a weak grip a latched door's did, with hardly any force).
 
-:attr:`TwinWorld.log` records each try as sensed and — only when an evaluator passes
+:attr:`RobotWorld.log` records each try as sensed and — only when an evaluator passes
 ``ground_truth`` — the simulator's truth beside it, for scoring.
 """
 
@@ -103,7 +103,7 @@ class ActionLog:
 
 
 @dataclass
-class TwinWorld:
+class RobotWorld:
     """See the module docstring. ``robot`` satisfies :class:`models.robot.Robot`; ``calibration`` is the
     cell's camera calibration; ``marker_map`` maps marker ids to kinds; ``goal_marker`` is the id on the
     component that must reach ``goal_state``."""

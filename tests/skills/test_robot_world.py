@@ -12,7 +12,7 @@ from puzzlebox.learning import DualAgent, OracleAgent, run_episode
 from puzzlebox.models import TryResult, World
 from puzzlebox.models.generator import generate_chain
 from puzzlebox.skills.primitives import ToggleResult
-from puzzlebox.skills.twin_world import DOOR_STAYED, HELD_UNDER_PINCH_AND_PUSH, TwinWorld
+from puzzlebox.skills.robot_world import DOOR_STAYED, HELD_UNDER_PINCH_AND_PUSH, RobotWorld
 from puzzlebox.twin.nominal_calibration import nominal_calibration
 from puzzlebox.twin.session import TwinSession
 
@@ -94,7 +94,7 @@ def test_a_marker_nobody_can_see_is_reported_missing():
 
     spec = generate_chain(["door", "slide"], seed=1)
     with TwinSession(spec, seed=0) as session, pytest.raises(MarkersNotFound, match=r"missing marker ids \[9\]"):
-        TwinWorld(
+        RobotWorld(
             session.robot, nominal_calibration(session), {**{c.marker: c.kind for c in spec.components}, 9: "wheel"}, 1
         )
 
