@@ -9,16 +9,38 @@ is the starting point a calibration procedure improves on. Both are made by :fun
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import mujoco
 import numpy as np
 
 from puzzlebox.models.calibration import CameraCalibration, CellCalibration
-from puzzlebox.twin.rendering import camera_pose_in_world, pinhole_intrinsics
+from puzzlebox.models.scene import Scene
+from puzzlebox.twin.rendering import RenderConfig, camera_pose_in_world, pinhole_intrinsics
+from puzzlebox.twin.sensors.encoders import JointEncoders
 
-if TYPE_CHECKING:
-    from puzzlebox.twin.session import TwinSession
+
+class NominalCellConfig(Protocol):
+    """What the nominal calibration reads of a cell's configuration."""
+
+    @property
+    def home_qpos(self) -> tuple[float, ...] | np.ndarray: ...
+    @property
+    def render(self) -> RenderConfig: ...
+
+
+class NominalCell(Protocol):
+    """The parts of a cell the nominal calibration reads (a :class:`~puzzlebox.twin.session.TwinSession` has
+    them): its nominal model, scene names, the arm's qpos indices, home pose and image size, its encoders'
+    nominal kinematics."""
+
+    nominal_model: mujoco.MjModel
+    scene: Scene
+    arm_qpos: np.ndarray
+    encoders: JointEncoders
+
+    @property
+    def config(self) -> NominalCellConfig: ...
 
 
 def camera_calibration(
@@ -47,7 +69,7 @@ def camera_calibration(
     return CameraCalibration(K, dist, size, T_tcp_camera=T_tcp_camera, extra=extra)
 
 
-def nominal_calibration(session: TwinSession) -> CellCalibration:
+def nominal_calibration(session: NominalCell) -> CellCalibration:
     """The nominal (datasheet / CAD) calibration of ``session``'s cell (see the module docstring)."""
     model = session.nominal_model
     names = session.scene.names
@@ -65,4 +87,4 @@ def nominal_calibration(session: TwinSession) -> CellCalibration:
     return CellCalibration(cameras, source="nominal (datasheet / CAD model)")
 
 
-__all__ = ["camera_calibration", "nominal_calibration"]
+__all__ = ["NominalCell", "camera_calibration", "nominal_calibration"]

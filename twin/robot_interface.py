@@ -7,8 +7,9 @@ wrench, the TCP pose the arm's own kinematics report, and joint-position and gri
 exposes no simulator ground truth (no box joint, no latch, no component state, no true camera), so a
 pipeline that works here has nothing a real cell would not give it.
 
-It holds no state of its own: every reading and command goes to the session's sensor models and servo
-interface (:attr:`TwinSession.ft`, ``encoders``, ``cameras``, ``servos``), where the reality profile acts.
+It holds no state of its own: every reading and command goes to the cell's sensor models and servo interface
+(the session's ``ft``, ``encoders``, ``cameras``, ``servos``, where the reality profile acts), which it is given
+with the physics it reads and the session's ``advance``: the parts it reads, not the session.
 
 Frames: the robot base frame is the world frame of the twin. Wrenches are in the F/T sensor frame
 (``ft_site``), as a real sensor reports them; :meth:`RobotInterface.ft_rotation_in_base` turns them
@@ -17,29 +18,45 @@ into the base frame.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Callable
 
+import mujoco
 import numpy as np
 
 from puzzlebox.models.robot import CameraImage
+from puzzlebox.models.scene import SceneNames
 from puzzlebox.twin.errors import CommandError
-
-if TYPE_CHECKING:
-    from puzzlebox.twin.session import TwinSession
+from puzzlebox.twin.sensors.cameras import Cameras
+from puzzlebox.twin.sensors.encoders import JointEncoders
+from puzzlebox.twin.sensors.force_torque import ForceTorqueSensor
+from puzzlebox.twin.servos import Servos
 
 GRIPPER_CTRL_MAX = 255.0
 """The xArm gripper's command range is 0 (open) .. 255 (closed)."""
 
 
 class RobotInterface:
-    """See the module docstring. Obtain it from :attr:`TwinSession.robot`."""
+    """See the module docstring. Obtain it from :attr:`TwinSession.robot`, which gives it the cell's ``model``
+    and ``data``, the scene's ``names``, its sensor models and servos, the arm's dof and actuator indices, and
+    ``advance(seconds)``, which steps the cell."""
 
-    def __init__(self, session: TwinSession) -> None:
-        self._session = session
-        names = session.scene.names
-        m = session.model
-        self.camera_names: tuple[str, ...] = session.cameras.names
-        self._ctrl_range = m.actuator_ctrlrange[session.arm_actuators].copy()
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        data: mujoco.MjData,
+        names: SceneNames,
+        sensors: tuple[JointEncoders, ForceTorqueSensor, Cameras],
+        servos: Servos,
+        arm_dof: np.ndarray,
+        arm_actuators: np.ndarray,
+        advance: Callable[[float], None],
+    ) -> None:
+        self._data = data
+        self._encoders, self._ft, self._cameras = sensors
+        self._servos, self._arm_dof, self._advance = servos, arm_dof, advance
+        m = model
+        self.camera_names: tuple[str, ...] = self._cameras.names
+        self._ctrl_range = m.actuator_ctrlrange[arm_actuators].copy()
         self._low, self._high = self._ctrl_range[:, 0] - 1e-9, self._ctrl_range[:, 1] + 1e-9  # what is accepted
         driver = m.joint(names.gripper_actuator.replace("fingers", "right_driver_joint"))
         self._gripper_qpos, self._gripper_range = driver.qposadr[0], driver.range.copy()
@@ -47,15 +64,15 @@ class RobotInterface:
     # -- proprioception ----------------------------------------------------------------------------
     @property
     def time(self) -> float:
-        return self._session.time
+        return float(self._data.time)
 
     def joint_positions(self) -> np.ndarray:
         """Arm joint positions as the encoders read them [rad], joints 1..7."""
-        return self._session.encoders.positions()
+        return self._encoders.positions()
 
     def joint_velocities(self) -> np.ndarray:
         """Arm joint velocities [rad/s], joints 1..7."""
-        return self._session.data.qvel[self._session.arm_dof].copy()
+        return self._data.qvel[self._arm_dof].copy()
 
     def joint_limits(self) -> np.ndarray:
         """``(7, 2)`` commandable range of each arm joint [rad]."""
@@ -64,17 +81,17 @@ class RobotInterface:
     def gripper_opening(self) -> float:
         """How closed the gripper is, 0 (open) .. 1 (closed), from its driver joint."""
         low, high = self._gripper_range
-        return float(np.clip((self._session.data.qpos[self._gripper_qpos] - low) / (high - low), 0.0, 1.0))
+        return float(np.clip((self._data.qpos[self._gripper_qpos] - low) / (high - low), 0.0, 1.0))
 
     def tcp_pose_in_base(self) -> np.ndarray:
         """4x4 pose of the TCP (between the finger pads; z along the approach) in the base frame, as the
         arm's nominal kinematics compute it from the encoders [m]."""
-        return self._session.encoders.tcp_pose()
+        return self._encoders.tcp_pose()
 
     def ft_rotation_in_base(self) -> np.ndarray:
         """3x3 orientation of the F/T sensor frame in the base frame, as the arm's nominal kinematics
         compute it from the encoders (the same reading as :meth:`tcp_pose_in_base`)."""
-        return self._session.encoders.ft_rotation()
+        return self._encoders.ft_rotation()
 
     # -- the wrist F/T sensor ----------------------------------------------------------------------
     def wrench(self) -> np.ndarray:
@@ -84,11 +101,11 @@ class RobotInterface:
         weight (7.37 N, downwards in the base frame); a push ``F`` on the gripper or on what it holds
         adds ``F``. Noise, bias, drift, delay and saturation are the reality profile's.
         """
-        return self._session.ft.read(self.time)
+        return self._ft.read(self.time)
 
     def tare(self, samples: int = 10) -> None:
         """Zero the wrench on the mean of ``samples`` readings (as a real sensor's bias reset)."""
-        self._session.ft.tare(self.time, samples)
+        self._ft.tare(self.time, samples)
 
     # -- commands ----------------------------------------------------------------------------------
     def command_joint_positions(self, q: np.ndarray) -> None:
@@ -105,23 +122,23 @@ class RobotInterface:
             low, high = self._ctrl_range[:, 0], self._ctrl_range[:, 1]
             detail = ", ".join(f"joint{i + 1}={q[i]:.3f} not in [{low[i]:.3f}, {high[i]:.3f}]" for i in outside)
             raise CommandError(f"joint targets outside the servo ranges: {detail}")
-        self._session.servos.command_joints(q)
+        self._servos.command_joints(q)
 
     def command_gripper(self, closure: float) -> None:
         """Gripper target, 0 (open) .. 1 (closed with full force)."""
         if not np.isfinite(closure) or not 0.0 <= closure <= 1.0:
             raise CommandError(f"gripper closure must be in [0, 1], got {closure}")
-        self._session.servos.command_gripper(closure * GRIPPER_CTRL_MAX)
+        self._servos.command_gripper(closure * GRIPPER_CTRL_MAX)
 
     def wait(self, seconds: float) -> None:
         """Let ``seconds`` of time pass with the current commands [s] (the robot's control period)."""
-        self._session.advance(seconds)
+        self._advance(seconds)
 
     # -- cameras -----------------------------------------------------------------------------------
     def capture(self, camera: str) -> CameraImage | None:
         """A frame from a named camera (``overview`` or the wrist camera) as the camera delivers it
         (lens distortion and all), or None when the camera dropped the frame."""
-        return self._session.cameras.capture(camera, self.time)
+        return self._cameras.capture(camera, self.time)
 
 
 __all__ = ["GRIPPER_CTRL_MAX", "RobotInterface"]

@@ -378,7 +378,9 @@ class TwinSession:
     def robot(self) -> RobotInterface:
         """The robot as its pipeline sees it (the ``models.robot.Robot`` protocol)."""
         if self._robot is None:
-            self._robot = RobotInterface(self)
+            sensors = (self.encoders, self.ft, self.cameras)
+            self._robot = RobotInterface(self.model, self.data, self.scene.names, sensors, self.servos, self.arm_dof,
+                                         self.arm_actuators, self.advance)  # fmt: skip
         return self._robot
 
     def close(self) -> None:

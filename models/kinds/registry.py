@@ -16,12 +16,15 @@ from __future__ import annotations
 import importlib
 import pkgutil
 from collections.abc import Iterable
+from pathlib import Path
 
 from puzzlebox.models.errors import ModelsError, UnknownKindError
-from puzzlebox.models.kinds import door, slide, wheel
+from puzzlebox.models.kinds.door import KIND as DOOR_KIND
 from puzzlebox.models.kinds.family import PAPER_FAMILY, KindFamily, UnknownFamilyError
 from puzzlebox.models.kinds.kind import Kind
+from puzzlebox.models.kinds.slide import KIND as SLIDE_KIND
 from puzzlebox.models.kinds.template import KindTemplate
+from puzzlebox.models.kinds.wheel import KIND as WHEEL_KIND
 
 _NOT_KINDS = frozenset({"family", "kind", "parts", "registry", "template"})
 """Modules of this package that hold no kind."""
@@ -75,15 +78,15 @@ class KindRegistry:
         return name in self._kinds
 
 
-PAPER_KINDS: tuple[Kind, ...] = (door.KIND, slide.KIND, wheel.KIND)
+PAPER_KINDS: tuple[Kind, ...] = (DOOR_KIND, SLIDE_KIND, WHEEL_KIND)
 """The paper's kinds, registered first (their codes in :func:`registry_family` are the paper's)."""
 
 
 def _kind_modules() -> list[str]:
     """Names of this package's modules that may define a kind, sorted (the paper's excluded)."""
-    package = importlib.import_module("puzzlebox.models.kinds")
     paper = {k.name for k in PAPER_KINDS}
-    return sorted(m.name for m in pkgutil.iter_modules(package.__path__) if m.name not in _NOT_KINDS | paper)
+    here = [str(Path(__file__).parent)]  # this package's folder (not the package: it imports this module)
+    return sorted(m.name for m in pkgutil.iter_modules(here) if m.name not in _NOT_KINDS | paper)
 
 
 def _discover() -> tuple[Kind, ...]:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import platform
 import sys
@@ -38,3 +39,12 @@ def fail(message: str, code: int = 2) -> None:
     """Print ``error: message`` on stderr and exit (no traceback for a user's mistake)."""
     print(f"error: {message}", file=sys.stderr)
     raise SystemExit(code)
+
+
+def scripts_folder() -> Path:
+    """The folder of the command-line scripts (``puzzlebox.scripts``), found without importing them: the library
+    runs them in processes of their own, as a user would (a fault suite, an experiment of several commands)."""
+    spec = importlib.util.find_spec("puzzlebox.scripts")
+    if spec is None or not spec.submodule_search_locations:
+        raise ModuleNotFoundError("puzzlebox.scripts is not installed (pip install -e . from the repository)")
+    return Path(next(iter(spec.submodule_search_locations))).resolve()

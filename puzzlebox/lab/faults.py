@@ -35,12 +35,11 @@ from typing import Any
 
 import numpy as np
 
-import puzzlebox.scripts
-from puzzlebox.lab.cli import write_json
+from puzzlebox.lab.cli import scripts_folder, write_json
 from puzzlebox.lab.trial_task import without_timing
 from puzzlebox.learning.memory import MemoryStore
 
-SCRIPTS = Path(puzzlebox.scripts.__file__).resolve().parent
+SCRIPTS = scripts_folder()
 """The command-line scripts, run in real processes as a user runs them."""
 
 

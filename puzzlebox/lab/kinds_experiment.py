@@ -38,14 +38,13 @@ from typing import Any
 
 import numpy as np
 
-import puzzlebox.scripts
-from puzzlebox.lab.cli import write_json
+from puzzlebox.lab.cli import scripts_folder, write_json
 from puzzlebox.models import LockTable, PuzzleSpec, load_spec, save_spec
 from puzzlebox.models.atomic import write_atomically, write_text_atomically
 from puzzlebox.models.generator import RandomGraphConfig, generate_chain, generate_random
 from puzzlebox.models.kinds import registry_family
 
-SCRIPTS = Path(puzzlebox.scripts.__file__).resolve().parent
+SCRIPTS = scripts_folder()
 
 
 @dataclass(frozen=True)

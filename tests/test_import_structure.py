@@ -1,0 +1,92 @@
+"""The house's structure (DESIGN.md, "Layers"): imports go down the layers, never sideways between skills and
+learning, never in a cycle; every package folder installs under the one import root."""
+
+from __future__ import annotations
+
+import ast
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+FOLDERS = {"models": "models", "twin": "twin", "skills": "skills", "learning": "learning", "real": "real",
+           "lab": "puzzlebox/lab", "scripts": "scripts"}  # fmt: skip
+MAY_IMPORT = {
+    "models": set(),
+    "twin": {"models"},
+    "skills": {"models"},
+    "learning": {"models"},
+    "real": {"models"},
+    "lab": {"models", "twin", "skills", "learning", "real"},
+    "scripts": {"models", "twin", "skills", "learning", "real", "lab"},
+}
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for layer, folder in FOLDERS.items():
+        for path in (ROOT / folder).rglob("*.py"):
+            parts = [p for p in path.relative_to(ROOT / folder).with_suffix("").parts if p != "__init__"]
+            out[".".join(["puzzlebox", layer, *parts])] = path
+    return out
+
+
+def _imports(modules: dict[str, Path]) -> dict[str, set[str]]:
+    """Module -> the project modules it imports anywhere in its body (at the top, in functions, for typing)."""
+
+    def resolve(name: str) -> str | None:
+        while name and name not in modules:
+            name = name.rpartition(".")[0]
+        return name or None
+
+    graph: dict[str, set[str]] = {}
+    for name, path in modules.items():
+        found = set()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("puzzlebox."):
+                found |= {resolve(f"{node.module}.{a.name}") for a in node.names}
+            elif isinstance(node, ast.Import):
+                found |= {resolve(a.name) for a in node.names if a.name.startswith("puzzlebox.")}
+        graph[name] = {m for m in found if m and m != name}
+    return graph
+
+
+def test_imports_go_down_the_layers():
+    graph = _imports(_modules())
+    wrong = sorted(
+        f"{m} imports {d}"
+        for m, deps in graph.items()
+        for d in deps
+        if d.split(".")[1] != m.split(".")[1] and d.split(".")[1] not in MAY_IMPORT[m.split(".")[1]]
+    )
+    assert wrong == []
+
+
+def test_no_import_cycle_anywhere():
+    graph = _imports(_modules())
+    cycles, state = [], {}
+
+    def visit(node: str, path: list[str]) -> None:
+        state[node] = "open"
+        for dep in sorted(graph[node]):
+            if state.get(dep) == "open":
+                cycles.append(path[path.index(dep) :] + [dep])
+            elif dep not in state:
+                visit(dep, [*path, dep])
+        state[node] = "done"
+
+    for node in sorted(graph):
+        if node not in state:
+            visit(node, [node])
+    assert cycles == []
+
+
+def test_every_package_folder_installs_under_the_import_root():
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["setuptools"]
+    listed = set(project["packages"])
+    folders = {"puzzlebox": "puzzlebox", **{f"puzzlebox.{k}": v for k, v in FOLDERS.items() if k != "lab"}}
+    on_disk = {"puzzlebox.lab"}
+    for package, folder in folders.items():
+        assert project["package-dir"][package] == folder
+        for init in (ROOT / folder).rglob("__init__.py"):
+            on_disk.add(".".join([package, *init.parent.relative_to(ROOT / folder).parts]))
+    assert on_disk == listed
