@@ -9,8 +9,58 @@ SYMBOLIC_BOX = BoxConfig(realizable=False)
 """Random boxes as drawn before lock mechanisms existed: these symbolic tests chose their seeds for their graphs."""
 
 
-def test_symbolic_world_satisfies_the_world_protocol():
-    assert isinstance(SymbolicWorld(paper_family("test")[0], seed=0), World)
+def observed_order(spec, observation) -> list[int]:
+    """The spec index of each observed component, found by its pose in the world frame (each is unique)."""
+    truth = spec.poses_in_world()
+    return [int(np.flatnonzero((truth == c.pose_in_world).all(axis=1))[0]) for c in observation.components]
+
+
+def try_and_check(world, table: LockTable, order: list[int], state: int, index: int) -> tuple[int, str]:
+    """Try observation ``index`` of ``world`` in true ``state`` (a bitmask in spec order), check the outcome and the
+    next observation against the lock rules, and return the new true state and the outcome."""
+    before = world.observe()
+    result = world.try_toggle(index)
+    after = world.observe()
+    j = order[index]
+    assert result.outcome == ("moved" if table.can_move(state, j) else "blocked")  # symbolic: never failed
+    state ^= int(result.moved) << j
+    assert after.states.tolist() == [(state >> k) & 1 for k in order]
+    assert after.kinds == before.kinds and after.goal_index == before.goal_index
+    np.testing.assert_array_equal(after.poses, before.poses)
+    assert after.solved == table.is_goal(state)
+    return state, result.outcome
+
+
+def test_symbolic_world_keeps_the_world_protocols_promises():
+    """Driven through ``observe`` and ``try_toggle`` alone, the symbolic world does what ``models.world`` promises:
+    it shows the spec's components (kinds, world-frame poses, all closed, the goal) in an order shuffled per episode
+    and fixed within it; a try is ``moved`` exactly when the lock rules let the component move, and the next
+    observation shows that component, and only it, in its other state; ``blocked`` changes nothing; once the goal
+    component reaches its goal state the observation says solved."""
+    spec = paper_family("test")[0]
+    table = LockTable.from_spec(spec)
+    n, goal = len(spec.components), spec.index_of(spec.goal.component)
+    orders, outcomes = set(), set()
+    for seed in range(4):
+        world = SymbolicWorld(spec, seed=seed)
+        assert isinstance(world, World)
+        first = world.observe()
+        order = observed_order(spec, first)
+        orders.add(tuple(order))
+        assert sorted(order) == list(range(n))
+        assert list(first.kinds) == [spec.components[j].kind for j in order]
+        assert first.states.tolist() == [0] * n
+        assert (order[first.goal_index], first.goal_state) == (goal, spec.goal.state) and not first.solved
+        state = 0
+        tries = [int(i) for i in np.random.default_rng(seed).integers(n, size=15)]  # random tries first
+        for index in tries:
+            state, outcome = try_and_check(world, table, order, state, index)
+            outcomes.add(outcome)
+        for j in table.shortest_solution(state):  # then on to the goal
+            state, _ = try_and_check(world, table, order, state, order.index(j))
+        assert world.observe().solved
+    assert outcomes == {"moved", "blocked"}
+    assert len(orders) > 1, "the order is shuffled per episode"
 
 
 def test_oracle_solves_every_paper_box_in_the_optimal_five_actions():

@@ -147,8 +147,17 @@ def test_a_newly_registered_kind_is_built(with_lever):
     assert model.joint(f"{THROWAWAY}-0:joint").type == mujoco.mjtJoint.mjJNT_SLIDE
 
 
-def test_the_registry_is_restored_after_a_test():
-    assert THROWAWAY not in registered_kinds()
+def test_a_copy_of_the_registry_is_extended_without_touching_the_original():
+    """What ``with_lever`` (and anyone extending the kinds for a while) relies on: the copy holds the same kinds and
+    takes a new one; the process-wide registry neither gains it nor can be asked for it."""
+    before = registered_kinds()
+    extended = registry._REGISTRY.copy()
+    assert extended.names() == before and all(extended.get(n) is registered_kind(n) for n in before)
+    assert extended.register(LEVER_KIND) is LEVER_KIND
+    assert extended.names() == (*before, THROWAWAY) and extended.get(THROWAWAY) is LEVER_KIND
+    assert registered_kinds() == before and THROWAWAY not in registry._REGISTRY
+    with pytest.raises(UnknownKindError, match=THROWAWAY):
+        registered_kind(THROWAWAY)
 
 
 @pytest.mark.parametrize("name", [*registered_kinds(), THROWAWAY])

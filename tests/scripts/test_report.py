@@ -9,7 +9,6 @@ import re
 import shutil
 import subprocess
 import sys
-import time
 from html.parser import HTMLParser
 from pathlib import Path
 from urllib.parse import unquote, urlparse
@@ -284,17 +283,18 @@ def test_help_describes_the_command():
 
 
 @pytest.mark.skipif(shutil.which("chromium") is None, reason="chromium is not installed (apt-get install chromium)")
-def test_the_sweep_page_loads_in_headless_chromium_within_2_s(made, tmp_path):
+def test_the_sweep_page_loads_in_headless_chromium_and_shows_every_run(made, tmp_path):
+    """A browser loads the page to its ``load`` event (its script stamps the load time on the page) and the DOM it
+    builds holds the summary, the cells and every run's timeline with its blocks and marks; ``--measure-load`` reads
+    that stamp back. How fast is not asserted here (speed is scripts/bench.py's)."""
     ok(script("report.py", made / "sweep", "--out", tmp_path / "sweep.html"))
     page = tmp_path / "sweep.html"
     command = ["chromium", "--headless=new", "--no-sandbox", "--disable-gpu", "--dump-dom", page.as_uri()]
-    start = time.perf_counter()
     dom = subprocess.run(command, capture_output=True, text=True, timeout=120).stdout
-    wall = time.perf_counter() - start
-    assert '<table class="summary">' in dom and '<table class="cells">' in dom
-    assert dom.count('class="tl"') == 30
-    load_ms = int(re.search(r'data-load-ms="(\d+)"', dom).group(1))
-    print(f"sweep page {page.stat().st_size} bytes: load {load_ms} ms ({wall:.1f} s with the browser's start)")
-    assert load_ms < 2000
+    assert re.search(r'<html[^>]* data-load-ms="\d+"', dom), dom[:300]
+    parsed = Page(dom)
+    assert parsed.errors == [], parsed.errors[:5]
+    assert {"summary", "cells"} <= set(parsed.tables)
+    check_timelines(parsed, records(made / "sweep"))
     result = ok(script("report.py", made / "sweep", "--out", tmp_path / "again.html", "--measure-load"))
-    assert re.search(r"load \d+ ms in headless Chromium", result.stdout), result.stdout
+    assert re.search(r"; load \d+ ms in headless Chromium \([\d.]+ s with browser start\)$", result.stdout.strip())

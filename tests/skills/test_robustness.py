@@ -19,6 +19,7 @@ from puzzlebox.models.scene import SceneConfig
 from puzzlebox.skills import MarkerDetector, joint_model, lid_height, select_markers, upright_pose
 from puzzlebox.skills.primitives import PrimitiveConfig, Toggler
 from puzzlebox.skills.robot_world import RobotWorld
+from puzzlebox.twin.errors import CommandError
 from puzzlebox.twin.nominal_calibration import nominal_calibration
 from puzzlebox.twin.reality import ArmReality, ForceTorqueReality, PhysicsReality, RealityProfile
 from puzzlebox.twin.session import TwinConfig, TwinSession
@@ -37,9 +38,81 @@ def _joint_models(session: TwinSession, kinds: dict[int, str] | None = None) -> 
     }
 
 
-def test_the_twin_robot_satisfies_the_robot_protocol():
-    with TwinSession(generate_chain(["slide", "door"], seed=0), seed=0) as session:
-        assert isinstance(session.robot, Robot)
+def test_the_twin_robot_keeps_the_robot_protocols_promises():
+    """Driven through the protocol's methods alone, the twin's robot does what ``models.robot`` promises: readings
+    in their units and ranges, time that advances by exactly what ``wait`` lets pass, a joint command that is
+    reached and turns the reported TCP about the base axis, a gripper that closes and opens, the gripper's weight
+    on the wrist until a tare, and frames of each camera's calibrated size showing the box where it stands."""
+    spec = generate_chain(["slide", "door"], seed=0)
+    with TwinSession(spec, seed=0) as session:
+        robot: Robot = session.robot
+        calibration = nominal_calibration(session)
+        assert isinstance(robot, Robot)
+        # readings: seven joints within their (7, 2) limits [rad], at rest, gripper open
+        limits, q = robot.joint_limits(), robot.joint_positions()
+        assert limits.shape == (7, 2) and np.all(limits[:, 0] < limits[:, 1])
+        assert q.shape == (7,) and np.all((limits[:, 0] <= q) & (q <= limits[:, 1]))
+        np.testing.assert_allclose(robot.joint_velocities(), np.zeros(7), atol=1e-6)
+        assert robot.gripper_opening() == pytest.approx(0.0, abs=0.01)
+        # poses: a rigid TCP pose and a rotation for the F/T frame; untared, the wrist carries the gripper's weight,
+        # 7.37 N straight down in the base frame; a tare zeroes it
+        T = robot.tcp_pose_in_base()
+        assert T.shape == (4, 4) and T[3].tolist() == [0.0, 0.0, 0.0, 1.0]
+        for R in (T[:3, :3], robot.ft_rotation_in_base()):
+            np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-9)
+            assert np.linalg.det(R) == pytest.approx(1.0)
+        assert 0.0 < T[2, 3] < 1.0  # above the table, within the arm's reach [m]
+        wrench = robot.wrench()
+        assert wrench.shape == (6,)
+        np.testing.assert_allclose(robot.ft_rotation_in_base() @ wrench[:3], [0.0, 0.0, -7.37], atol=0.05)
+        robot.tare()
+        np.testing.assert_allclose(robot.wrench(), np.zeros(6), atol=1e-6)
+        # cameras: a frame of the calibrated size, stamped with the robot's time, in which the box's markers are
+        # found where the spec puts them
+        for camera in robot.camera_names:
+            frame = robot.capture(camera)
+            width, height = calibration.camera(camera).image_size
+            assert frame.camera == camera and frame.time == robot.time
+            assert frame.rgb.shape == (height, width, 3) and frame.rgb.dtype == np.uint8
+        seen = MarkerDetector().detect(robot.capture("overview"), calibration.camera("overview"))
+        truth = {c.marker: pose for c, pose in zip(spec.components, spec.poses_in_world(), strict=True)}
+        assert sorted(d.marker_id for d in seen) == sorted(truth)
+        for d in seen:
+            assert np.linalg.norm(d.T_base_marker[:2, 3] - truth[d.marker_id][:2]) < 0.005
+        # wait lets exactly that much robot time pass; a joint command is reached, joint 1 turning the TCP about
+        # the base's vertical axis by its own angle, at the same radius and height; meanwhile the velocities are
+        # the rate of change of the positions [rad/s]
+        start = robot.time
+        target = q + np.array([0.2, 0, 0, 0, 0, 0, 0])
+        robot.command_joint_positions(target)
+        robot.wait(0.1)
+        assert robot.time == pytest.approx(start + 0.1)
+        q_a, v_a = robot.joint_positions(), robot.joint_velocities()
+        robot.wait(0.01)
+        q_b, v_b = robot.joint_positions(), robot.joint_velocities()
+        assert v_a[0] > 0.1
+        np.testing.assert_allclose((q_b - q_a) / 0.01, (v_a + v_b) / 2, rtol=0.05, atol=0.01)
+        robot.wait(1.39)
+        assert robot.time == pytest.approx(start + 1.5)
+        np.testing.assert_allclose(robot.joint_positions(), target, atol=1e-3)
+        T_turned = robot.tcp_pose_in_base()
+        turn = np.arctan2(T_turned[1, 3], T_turned[0, 3]) - np.arctan2(T[1, 3], T[0, 3])
+        assert turn == pytest.approx(0.2, abs=1e-3)
+        assert np.hypot(*T_turned[:2, 3]) == pytest.approx(np.hypot(*T[:2, 3]), abs=1e-4)
+        assert T_turned[2, 3] == pytest.approx(T[2, 3], abs=1e-4)
+        assert robot.capture("overview").time == robot.time  # a later frame, a later stamp
+        # a refused command (out of range) moves nothing
+        with pytest.raises(CommandError):
+            robot.command_joint_positions(limits[:, 1] + 0.5)
+        robot.wait(0.5)
+        np.testing.assert_allclose(robot.joint_positions(), target, atol=1e-3)
+        # the gripper closes (on nothing: all the way) and opens again
+        robot.command_gripper(1.0)
+        robot.wait(1.0)
+        assert robot.gripper_opening() > 0.9
+        robot.command_gripper(0.0)
+        robot.wait(1.0)
+        assert robot.gripper_opening() < 0.1
 
 
 def test_a_grasp_that_closes_on_nothing_is_failed_not_blocked():

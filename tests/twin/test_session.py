@@ -3,11 +3,11 @@ same seed is bit-identical, divergence raises, state round-trips, commands are c
 
 from dataclasses import replace
 
-import mujoco
 import numpy as np
 import pytest
 
 from puzzlebox.models.generator import generate_chain, paper_family
+from puzzlebox.models.robot import Robot
 from puzzlebox.twin.errors import CommandError, SimulationDiverged
 from puzzlebox.twin.session import TwinSession
 
@@ -195,11 +195,29 @@ def test_a_turned_and_moved_box_keeps_its_latches():
         assert np.abs(session.component_positions()).max() < 0.005
 
 
-def test_robot_interface_offers_no_ground_truth():
+def test_robot_interface_offers_the_robot_protocol_alone_and_hands_out_copies():
+    """The robot is the pipeline's only door into the twin: its public surface is the ``Robot`` protocol and nothing
+    more (no session, model, data, component, latch or state to reach the truth through), and what it hands out
+    are readings, not views of the simulation: scribbling on them changes neither the next reading nor the arm."""
     with TwinSession(paper_family("test")[0], seed=0) as session:
-        public = {name for name in dir(session.robot) if not name.startswith("_")}
-        assert not {n for n in public if "component" in n or "latch" in n or "state" in n}
-        _ = mujoco  # keep the import honest for type checkers
+        robot = session.robot
+        protocol = {name for name in vars(Robot) if not name.startswith("_")} | set(Robot.__annotations__)
+        assert {name for name in dir(robot) if not name.startswith("_")} == protocol
+        robot.wait(0.1)
+        qpos, qvel, ctrl = session.data.qpos.copy(), session.data.qvel.copy(), session.data.ctrl.copy()
+        readings = (robot.joint_positions, robot.joint_velocities, robot.joint_limits, robot.tcp_pose_in_base,
+                    robot.ft_rotation_in_base, robot.wrench, lambda: robot.capture("overview").rgb)  # fmt: skip
+        for read in readings:
+            handed = read()
+            kept = handed.copy()
+            handed[...] = 7
+            np.testing.assert_array_equal(read(), kept)
+        for now, then in ((session.data.qpos, qpos), (session.data.qvel, qvel), (session.data.ctrl, ctrl)):
+            np.testing.assert_array_equal(now, then)
+        held = robot.capture("overview")  # a frame kept is not overwritten by the next one (another camera's)
+        kept = held.rgb.copy()
+        assert all(not np.array_equal(robot.capture(camera).rgb, kept) for camera in robot.camera_names[1:])
+        np.testing.assert_array_equal(held.rgb, kept)
 
 
 def test_a_rule_no_mechanism_serves_is_named_in_a_warning_and_held_by_a_latch():
