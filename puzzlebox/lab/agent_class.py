@@ -6,9 +6,9 @@ import importlib
 import inspect
 from typing import Any
 
-from puzzlebox.lab.errors import AgentClassError
+from puzzlebox.lab.errors import AgentClassError, TrialConfigError
 
-__all__ = ["AGENT_METHODS", "is_agent_class_name", "load_agent_class", "make_agent_object"]
+__all__ = ["AGENT_METHODS", "check_agent", "is_agent_class_name", "load_agent_class", "make_agent_object"]
 
 AGENT_METHODS = ("begin_episode", "choose", "record", "end_episode")
 """What the trial loop calls of an agent (``puzzlebox.learning.Agent``)."""
@@ -58,3 +58,34 @@ def make_agent_object(name: str) -> Any:
     if not isinstance(getattr(agent, "name", None), str):
         agent.name = name.partition(":")[2]
     return agent
+
+
+def check_agent(agent: str, memory: str | None, checkpoint: str | None, max_lockers: int) -> bool:
+    """Refuse an agent that cannot run as asked (``trial.py``'s ``--agent``, ``--memory``, ``--checkpoint``,
+    ``--max-lockers``): :class:`AgentClassError` for a class of one's own that is not an agent,
+    :class:`TrialConfigError` for the rest. True for an agent class of one's own."""
+    from puzzlebox.learning import AGENT_NAMES, LearningError
+    from puzzlebox.learning.agents.factory import BELIEF_AGENT_NAMES
+    from puzzlebox.learning.dual_controller import DualControllerConfig
+
+    own = is_agent_class_name(agent)
+    if own:
+        load_agent_class(agent)
+        if memory or checkpoint or max_lockers != 1:
+            raise TrialConfigError(
+                f"--memory, --checkpoint and --max-lockers are for the project's agents, not {agent!r}"
+            )
+    elif agent not in AGENT_NAMES:
+        raise TrialConfigError(
+            f"unknown agent {agent!r}. Available agents: {sorted(AGENT_NAMES)}, or package.module:Class"
+        )
+    if (agent == "memory") != (memory is not None):
+        raise TrialConfigError("--memory goes with --agent memory (and only with it): train one with scripts/train.py")
+    if max_lockers != 1:
+        if agent not in BELIEF_AGENT_NAMES:
+            raise TrialConfigError(f"--max-lockers is for the agents {list(BELIEF_AGENT_NAMES)}, not {agent!r}")
+        try:
+            DualControllerConfig(max_lockers=max_lockers)
+        except LearningError as err:
+            raise TrialConfigError(f"--max-lockers: {err}") from err
+    return own

@@ -4,13 +4,25 @@ from __future__ import annotations
 
 __all__ = [
     "AgentClassError",
+    "ArmTrialFailed",
+    "ArmTrialRefused",
+    "BoxBuildError",
+    "DatasetError",
+    "ExperimentFailed",
+    "ExperimentSettingsError",
     "LabError",
+    "NotABoxSpec",
+    "OutputFileError",
     "OutputHoldsAnotherConfig",
     "OutputHoldsResults",
     "OutputNotADirectory",
     "OutputNotWritable",
     "ResumeAndForce",
     "RunStoreError",
+    "SpecFileError",
+    "SpecFilesInvalid",
+    "TrainingError",
+    "TrainingSetupError",
     "TrialConfigError",
 ]
 
@@ -49,3 +61,57 @@ class OutputHoldsAnotherConfig(RunStoreError, ValueError):
 
 class OutputNotWritable(RunStoreError, PermissionError):
     """The output directory cannot be written."""
+
+
+class SpecFileError(LabError, ValueError):
+    """A spec file that cannot be read or is not a valid spec (the message names the file and the problem)."""
+
+
+class NotABoxSpec(SpecFileError):
+    """A valid spec with no box (a disassembly scene) where only a puzzle box will do."""
+
+
+class SpecFilesInvalid(SpecFileError):
+    """Some of several spec files cannot be used: :attr:`problems` holds one line per file, in order."""
+
+    def __init__(self, problems: list[str]) -> None:
+        super().__init__("\n".join(problems))
+        self.problems = problems
+
+
+class BoxBuildError(LabError):
+    """A box whose MuJoCo model cannot be built (an unknown kind, a pose out of the robot's reach)."""
+
+
+class DatasetError(LabError, ValueError):
+    """A dataset of specs that cannot be made as asked: a count below 1, an output that is a file, a spec that
+    fails, a runner that cannot start."""
+
+
+class ExperimentSettingsError(LabError, ValueError):
+    """Settings of an experiment that do not go together or are out of range (the message names the flag)."""
+
+
+class ExperimentFailed(LabError):
+    """An experiment the learning layer refused or could not finish (its message unchanged)."""
+
+
+class TrainingError(LabError):
+    """A training run that cannot start as asked."""
+
+
+class TrainingSetupError(TrainingError, ValueError):
+    """Training settings that do not go together, or specs, a reality profile or a calibration that cannot be
+    used (the message names the flag)."""
+
+
+class OutputFileError(LabError):
+    """An output file that cannot be written (a directory, a read-only place); found before any work is done."""
+
+
+class ArmTrialRefused(LabError, ValueError):
+    """A trial on a real arm that cannot run as asked (a flag, the cell config, the calibration, the agent)."""
+
+
+class ArmTrialFailed(LabError, RuntimeError):
+    """The arm refused or failed a call mid-trial (what was done is kept)."""

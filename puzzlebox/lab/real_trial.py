@@ -12,13 +12,15 @@ workspace) ends the trial: the record says so (``stopped``) and keeps every acti
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, replace
 from typing import Any
 
 import numpy as np
 
-from puzzlebox.learning import RunResult, make_agent, run_episode
+from puzzlebox.lab.narrated_world import NarratedWorld
+from puzzlebox.lab.observers import ObservedRobot, TrialContext, TrialObserver
+from puzzlebox.learning import Agent, RunResult, make_agent, run_episode
 from puzzlebox.learning.belief import CELL_BELIEF
 from puzzlebox.learning.memory import MemoryStore
 from puzzlebox.learning.trial import ActionRecord
@@ -89,6 +91,8 @@ def run_real_trial(
     on_record: Callable[[dict[str, Any]], None] | None = None,
     primitives: PrimitiveConfig | None = None,
     max_lockers: int = 1,
+    agent: Agent | None = None,
+    observers: Sequence[TrialObserver] = (),
 ) -> dict[str, Any]:
     """One trial of ``agent_name`` on the box ``spec`` describes, standing in front of ``robot``; returns its
     record (the contract's run entry plus ``timeline``, ``stopped``, ``robot_time_s``, ``perceived_closed_poses``).
@@ -98,7 +102,9 @@ def run_real_trial(
     spec's marker map and goal, never the box's state. ``on_action`` is called after every action as
     ``learning.run_episode`` calls it, ``on_record`` with the record so far after every action and once at the
     end (after a stop too): a caller writes it as it grows. ``max_lockers``: the most lockers the agent's belief
-    allows one component (1: the paper's)."""
+    allows one component (1: the paper's). ``agent``: an agent object of one's own instead of ``agent_name``'s;
+    ``observers`` see every reading, wait and action as in a twin trial (:mod:`puzzlebox.lab.observers`; no
+    session: a real cell has no simulator to read)."""
     wall = time.perf_counter()
     world_config, perception = cell_configs(cell)
     if primitives is not None:
@@ -113,6 +119,9 @@ def run_real_trial(
         if on_record is not None and world is not None:
             on_record(_entry(_unfinished(spec, seed, world, wall, ""), world, spec, robot, wall, ""))
 
+    trial = TrialContext(spec, seed, None)
+    if observers:
+        robot = ObservedRobot(robot, observers)
     try:
         go_to_rest(robot, cell, world_config.primitives)
         world = RobotWorld(
@@ -126,13 +135,20 @@ def run_real_trial(
             names={m: c.name for m, c in by_marker.items()},  # the spec's names, for the record
             detector=MarkerDetector(perception),
         )
-        agent = make_agent(agent_name, spec, memory, checkpoint, belief=CELL_BELIEF, max_lockers=max_lockers)
-        result = run_episode(agent, world, spec.name, seed, max_actions, progress)
+        if agent is None:
+            agent = make_agent(agent_name, spec, memory, checkpoint, belief=CELL_BELIEF, max_lockers=max_lockers)
+        trial.world, trial.agent = world, agent
+        for observer in observers:
+            observer.attach(trial)
+        acting = NarratedWorld(world, observers, lambda: getattr(agent, "decisions", [])) if observers else world
+        result = run_episode(agent, acting, spec.name, seed, max_actions, progress)
     except ArmStopped as err:  # the arm was stopped (force, workspace): what was done before stays in the record
         stopped = str(err)
         result = _unfinished(spec, seed, world, wall, f"{type(err).__name__}: {err}")
     except SkillError as err:  # the cell could not run this trial (markers not seen...): say why
         result = _unfinished(spec, seed, world, wall, f"{type(err).__name__}: {err}")
+    for observer in observers:
+        observer.finish()
     entry = _entry(result, world, spec, robot, wall, stopped)
     if on_record is not None:
         on_record(entry)

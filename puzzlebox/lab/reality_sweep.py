@@ -31,7 +31,7 @@ from puzzlebox.lab.trial_figures import twin_figures
 from puzzlebox.lab.trial_task import trial_task
 from puzzlebox.learning import MemoryAgent, SymbolicWorld, run_episode, summarise
 from puzzlebox.learning.memory import MemoryStore
-from puzzlebox.learning.runner import RecordStore, RunReport, Task, make_executor, run_tasks
+from puzzlebox.learning.runner import RecordStore, Task, make_executor, run_tasks
 from puzzlebox.models.calibration import CellCalibration
 from puzzlebox.models.generator import paper_family
 from puzzlebox.models.spec_loading import spec_from_dict
@@ -113,7 +113,7 @@ def run_sweep(
         calibrations = [Task(name, calibration_task, {"spec": specs[0].to_dict(), "profile": profile.to_dict()})
                         for name, profile in profiles.items()]  # fmt: skip
         done = run_tasks(calibrations, RecordStore(out / "calibrations"), executor, desc="calibrations")
-        _raise_failures(done)
+        done.raise_for_failures()
         trials, by_profile = [], {}
         for name, profile in profiles.items():
             calibration = done.records[name]["calibration"]
@@ -149,7 +149,7 @@ def run_sweep(
 
         report = run_tasks(trials, RecordStore(out / "trials"), executor, on_record=keep, desc="reality sweep",
                            postfix=lambda r: f"solved {sum(x['solved'] for x in r.values())}/{len(r)}")  # fmt: skip
-        _raise_failures(report)
+        report.raise_for_failures()
     found.update(report.records)
     result = summary()
     write_report(result, out)
@@ -160,10 +160,6 @@ def calibration_task(settings: dict[str, Any]) -> dict[str, Any]:
     """Calibrate the cell of a profile (a runner task): the calibration and its figures."""
     run = calibrate_cell(spec_from_dict(settings["spec"]), RealityProfile.from_dict(settings["profile"]))
     return {"calibration": run.calibration.to_dict(), "figures": run.figures}
-
-
-def _raise_failures(report: RunReport) -> None:
-    report.raise_for_failures()
 
 
 def _figures(runs: list[dict[str, Any]], max_actions: int, calibration: dict[str, Any]) -> dict[str, Any]:

@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from puzzlebox.lab.cli import write_json
-from puzzlebox.lab.reality_sweep import _raise_failures, calibration_task
+from puzzlebox.lab.reality_sweep import calibration_task
 from puzzlebox.learning import make_agent, run_episode
 from puzzlebox.learning.runner import RecordStore, Task, make_executor, run_tasks
 from puzzlebox.models.calibration import CellCalibration
@@ -258,7 +258,7 @@ def run_sysid(out: Path, config: SysIdConfig, workers: int | None = None) -> dic
             for c, p in profiles.items()
         ]
         done = run_tasks(calibrations, RecordStore(records / "calibrations"), executor, desc="calibrations")
-        _raise_failures(done)
+        done.raise_for_failures()
         trials, keys = [], {c: {"train": [], "test": []} for c in config.cell_seeds}
         for c, profile in profiles.items():
             calibration = done.records[f"calibration-cell{c}"]["calibration"]
@@ -274,7 +274,7 @@ def run_sysid(out: Path, config: SysIdConfig, workers: int | None = None) -> dic
                         }, context={"log": str(out / "logs" / f"{key}.npz")}))  # fmt: skip
         report = run_tasks(trials, RecordStore(records / "trials"), executor, desc="recorded trials",
                            postfix=lambda r: f"toggles {sum(x['toggles'] for x in r.values())}")  # fmt: skip
-        _raise_failures(report)
+        report.raise_for_failures()
         trial_records = report.records
         fits = [
             Task(f"fit-cell{c}-{kind}", fit_task, {**settings, "kind": kind, "logs": keys[c]["train"]},
@@ -282,7 +282,7 @@ def run_sysid(out: Path, config: SysIdConfig, workers: int | None = None) -> dic
             for c in config.cell_seeds for kind in KIND_NAMES
         ]  # fmt: skip
         fitted = run_tasks(fits, RecordStore(records / "fits"), executor, desc="fits")
-        _raise_failures(fitted)
+        fitted.raise_for_failures()
         factors = {
             c: {k: list(fitted.records[f"fit-cell{c}-{k}"]["factors"].values())
                 for k in KIND_NAMES if fitted.records[f"fit-cell{c}-{k}"].get("toggles")}
@@ -296,7 +296,7 @@ def run_sysid(out: Path, config: SysIdConfig, workers: int | None = None) -> dic
             for c in config.cell_seeds
         ]  # fmt: skip
         evaluated = run_tasks(evaluations, RecordStore(records / "evaluations"), executor, desc="evaluations")
-        _raise_failures(evaluated)
+        evaluated.raise_for_failures()
     reports = (done, report, fitted, evaluated)
     tasks = {
         "planned": sum(r.planned for r in reports), "reused": sum(len(r.reused) for r in reports),

@@ -37,7 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from puzzlebox.lab.cli import write_json
-from puzzlebox.lab.reality_sweep import _raise_failures, calibration_task
+from puzzlebox.lab.reality_sweep import calibration_task
 from puzzlebox.lab.trial_task import trial_task
 from puzzlebox.lab.twin_training import TwinTraining
 from puzzlebox.learning import MemoryAgent, SymbolicWorld, run_episode, summarise
@@ -183,7 +183,7 @@ def run_twin_learning(
         calibrations = run_tasks([Task(reality.name, calibration_task,
                                        {"spec": tests[0].to_dict(), "profile": reality.to_dict()})],
                                  RecordStore(out / "calibrations"), executor, desc="calibration")  # fmt: skip
-        _raise_failures(calibrations)
+        calibrations.raise_for_failures()
         calibration = calibrations.records[reality.name]["calibration"]
         memories = out / "memories"
         chains = [
@@ -198,11 +198,11 @@ def run_twin_learning(
         deep_jobs = _deep_jobs(config, out / "deep")
         if deep_jobs:
             deep = run_tasks(deep_jobs, RecordStore(out / "deep" / "jobs"), executor, desc="deep agents (symbolic)")
-            _raise_failures(deep)
+            deep.raise_for_failures()
             deep_records = deep.records
         phases["deep_training_s"] = time.perf_counter() - begin - sum(phases.values())
         trained = run_tasks(chains, RecordStore(out / "chains"), executor, desc="training in the twin")
-        _raise_failures(trained)
+        trained.raise_for_failures()
         phases["twin_training_s"] = time.perf_counter() - begin - sum(phases.values())
         trials, where = [], {}
         for chain in chains:
@@ -231,7 +231,7 @@ def run_twin_learning(
                     where[key] = (agent, seed, 0.0)
         measured = run_tasks(trials, RecordStore(out / "trials"), executor, desc="test trials",
                              postfix=lambda r: f"solved {sum(x['solved'] for x in r.values())}/{len(r)}")  # fmt: skip
-        _raise_failures(measured)
+        measured.raise_for_failures()
         phases["test_trials_s"] = time.perf_counter() - begin - sum(phases.values())
     summary = _summary(config, reality.name, trained.records, measured.records, where, deep_records)
     summary["wall_time_s"] = time.perf_counter() - begin
