@@ -44,282 +44,96 @@ any number of workers).
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import sys
+from collections.abc import Iterable
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from tqdm import tqdm
 
-from puzzlebox.lab.cli import fail, one_line
-from puzzlebox.models import LockRule, LockTable, ModelsError, PuzzleSpec, SpecError, load_spec, save_spec
-from puzzlebox.models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random, paper_family
-from puzzlebox.models.kinds import family_named
-from puzzlebox.models.mechanism_mjcf import LOCK_MODES, mechanism_layout
-
-if TYPE_CHECKING:
-    import mujoco
-
-    from puzzlebox.models.lock_check import LockCheck
-
-
-def _write(spec: PuzzleSpec, path: Path, plot: bool) -> None:
-    print(f"wrote {save_spec(spec, path)}  ({'-'.join(spec.kinds)})")
-    if plot:
-        from puzzlebox.lab.spec_plot import plot_spec  # matplotlib only when asked
-
-        print(f"wrote {plot_spec(spec, path.with_suffix('.png'))}")
+from puzzlebox.lab.box_exports import export_box_meshes, export_mjcf
+from puzzlebox.lab.cli import fail, write_json
+from puzzlebox.lab.errors import LabError, SpecFilesInvalid
+from puzzlebox.lab.spec_files import load_box_specs, validation_lines, write_spec_file
+from puzzlebox.lab.spec_generators import chain_settings, generate_spec, random_settings
+from puzzlebox.models import ModelsError
+from puzzlebox.models.generator import paper_family
+from puzzlebox.models.mechanism_mjcf import LOCK_MODES
 
 
 def _paper(args: argparse.Namespace) -> None:
     for spec in paper_family(args.split, seed=args.seed):
-        _write(spec, Path(args.out) / f"{spec.name}.json", args.plot)
+        _print(write_spec_file(spec, Path(args.out) / f"{spec.name}.json", args.plot))
 
 
-def _chain(args: argparse.Namespace) -> None:
-    kinds = [k.strip() for k in args.kinds.split(",") if k.strip()]
-    if args.count is not None:
-        return _dataset(args, {"generator": "chain", "kinds": kinds})
-    box = BoxConfig(fit_reach=not args.anywhere)
-    _write(generate_chain(kinds, seed=args.seed, name=args.name, box=box), Path(args.out), args.plot)
+def _generated(args: argparse.Namespace) -> int | None:
+    """chain or random: a spec in the file ``--out``, or with ``--count N`` a dataset in the directory ``--out``."""
+    if args.verb == "chain":
+        generator = chain_settings(args.kinds)
+    else:
+        generator = random_settings(args.components, args.multi_locker, args.kinds)
+    if args.count is None:
+        spec = generate_spec(generator, seed=args.seed, name=args.name, anywhere=args.anywhere)
+        return _print(write_spec_file(spec, Path(args.out), args.plot))
+    from puzzlebox.lab.dataset_run import make_dataset  # the runner only when asked
 
-
-def _dataset(args: argparse.Namespace, generator: dict) -> None:
-    """``--count N``: N specs (seeds S..S+N-1) and a manifest in the directory ``--out``, made in parallel."""
-    from puzzlebox.lab.dataset import spec_task, write_manifest, write_spec
-    from puzzlebox.lab.interrupt import StopRequests
-    from puzzlebox.learning.runner import RunnerError, make_executor
-
-    if args.count < 1:
-        fail(f"--count must be >= 1, got {args.count}")
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        fail(f"--out {out} is a file; with --count it names a directory")
-    generator = {**generator, "name": args.name, "anywhere": args.anywhere, "seed": args.seed}
-    tasks = [spec_task(f"s{args.seed + i}", {**generator, "seed": args.seed + i}) for i in range(args.count)]
-    entries = []
-    try:
-        executor = make_executor(args.workers or (1 if args.count < 64 else None), args.ray)
-        with StopRequests("spec") as stop, executor:
-            bar = tqdm(total=len(tasks), desc=f"{generator['generator']} specs", unit="spec", disable=None)
-            for done in executor.run(tasks, lambda: stop.requested):
-                if not done.ok:
-                    fail(f"seed {done.task.settings['seed']}: {str(done.payload).splitlines()[0]}")
-                path = write_spec(out, done.payload)
-                if args.plot:
-                    from puzzlebox.lab.spec_plot import plot_spec
-
-                    plot_spec(load_spec(path), path.with_suffix(".png"))
-                entries.append(done.payload["entry"])
-                bar.update()
-            bar.close()
-    except RunnerError as err:
-        fail(str(err))
-    if len(entries) < len(tasks):
-        print(f"stopped: {len(entries)} of {len(tasks)} spec(s) written in {out}; no manifest", file=sys.stderr)
+    run = make_dataset(args.out, generator, seed=args.seed, count=args.count, name=args.name,
+                       anywhere=args.anywhere, plot=args.plot, workers=args.workers, ray=args.ray)  # fmt: skip
+    if run.manifest is None:
+        print(f"stopped: {run.written} of {run.count} spec(s) written in {run.out}; no manifest", file=sys.stderr)
         return 130
-    path = write_manifest(out, {**generator, "seed": args.seed, "count": args.count}, entries)
-    print(f"wrote {len(entries)} specs and {path}")
-
-
-def _random(args: argparse.Namespace) -> None:
-    if args.count is not None:
-        settings = {"components": args.components, "multi_locker": args.multi_locker, "kinds": args.kinds}
-        return _dataset(args, {"generator": "random", **settings})
-    config = RandomGraphConfig(args.components, multi_locker=args.multi_locker, family=family_named(args.kinds))
-    box = BoxConfig(fit_reach=not args.anywhere)
-    _write(generate_random(config, seed=args.seed, name=args.name, box=box), Path(args.out), args.plot)
-
-
-def _box_spec(file: str) -> PuzzleSpec | str:
-    """The puzzle-box spec in ``file``, or the one-line reason it is none (invalid, or a spec with no box)."""
-    try:
-        spec = load_spec(file)
-    except SpecError as err:
-        return one_line(err)
-    if spec.box is None:
-        return f"{file}: spec {spec.name!r} is a disassembly scene (no box); only puzzle boxes build as MuJoCo models"
-    return spec
-
-
-def _load_box_spec(file: str) -> PuzzleSpec:
-    """:func:`_box_spec`, or ``fail`` with its reason."""
-    spec = _box_spec(file)
-    if isinstance(spec, str):
-        fail(spec)
-    return spec
-
-
-def _rule_text(rule: LockRule) -> str:
-    return f"{rule.locker}={rule.locker_state} holds {rule.locked}={rule.locked_state}"
-
-
-def _latch_only(spec: PuzzleSpec, locks: str) -> list[tuple[LockRule, str]]:
-    """The rules of ``spec`` no mechanism realizes with ``locks`` (every rule with ``latch``), each with why."""
-    if locks == "latch":
-        return [(rule, "--locks latch: no mechanism") for rule in spec.locks]
-    return [(u.rule, u.reason) for u in mechanism_layout(spec).unrealized]
-
-
-def _mjcf(args: argparse.Namespace) -> None:
-    spec = _load_box_spec(args.spec)
-    try:
-        if args.box_only:
-            from puzzlebox.models.box_export import export_box  # MuJoCo only when asked
-
-            path = export_box(spec, args.out, locks=args.locks)
-        else:
-            from puzzlebox.models.scene import SceneConfig, build_scene
-
-            path = build_scene(spec, SceneConfig(locks=args.locks)).export(args.out)
-    except ModelsError as err:  # an unknown kind, a box pose out of the robot's reach
-        fail(f"{args.spec}: {one_line(err)}")
-    print(f"wrote {path} and its assets ({len(list(Path(args.out).iterdir())) - 1} files)")
-    unrealized = _latch_only(spec, args.locks)
-    if unrealized:  # a rule the model alone does not hold: say so
-        rules = "; ".join(f"{_rule_text(rule)} ({reason})" for rule, reason in unrealized)
-        print(f"{len(unrealized)} rule(s) enforced by latches only in the twin: {rules}")
+    print(f"wrote {run.written} specs and {run.manifest}")
 
 
 def _check_locks(args: argparse.Namespace) -> int:
-    """Push every part of each box from every reachable state (``models.lock_check``): one line per box, one per
-    disagreement; exit 1 if any transition disagrees, 2 if a box could not be built."""
-    from puzzlebox.lab.cli import write_json
-    from puzzlebox.models.lock_check import check_locks  # MuJoCo only when asked
-
-    loaded = [(file, _box_spec(file)) for file in args.specs]  # every file read before any box is built
-    problems = [spec for _, spec in loaded if isinstance(spec, str)]
-    for problem in problems[:-1]:
-        print(f"error: {problem}", file=sys.stderr)
-    if problems:
-        fail(problems[-1])  # one line per invalid file, exit 2
-    specs = [(file, spec) for file, spec in loaded if not isinstance(spec, str)]
-    boxes, errors = [], []
-    for file, spec in tqdm(specs, desc="check-locks", unit="box", disable=None):
-        try:
-            model, joints = _compiled(spec, args.locks, args.with_robot)
-        except ModelsError as err:
-            errors.append({"file": str(file), "spec": spec.name, "error": one_line(err)})
-            tqdm.write(f"error: {file}: {one_line(err)}", file=sys.stderr)
-            continue
-        result = check_locks(spec, model, joints)
-        box = _box_record(file, spec, result, _latch_only(spec, args.locks))
-        boxes.append(box)
-        tqdm.write(_box_line(box))
-        for t in box["disagreements"]:
-            opened = ", ".join(t["open"]) or "none"
-            moved = f"moved {100 * t['moved']:.1f} % of its travel"
-            tqdm.write(f"  open [{opened}]: {t['component']} should be {t['expected']}, {moved}")
-    agreeing, total = sum(b["agreeing"] for b in boxes), sum(b["total"] for b in boxes)
-    held = [b["held_move_max"] for b in boxes if b["held_move_max"] is not None]
-    summary = {
-        "spec": f"total ({len(boxes)} box(es))",
-        "agreeing": agreeing,
-        "total": total,
-        "held_move_max": max(held) if held else None,
-        "unrealized": [u for b in boxes for u in b["unrealized"]],
-    }
-    if args.json:
-        record = {"locks": args.locks, "with_robot": args.with_robot, "agreeing": agreeing, "total": total}
-        print(f"wrote {write_json(Path(args.json), {**record, 'boxes': boxes, 'errors': errors})}")
-    print(_box_line(summary) + (f"; {len(errors)} box(es) not built" if errors else ""))
-    if errors:
-        return 2
-    return 1 if agreeing < total else 0
-
-
-def _compiled(spec: PuzzleSpec, locks: str, with_robot: bool) -> tuple[mujoco.MjModel, dict[str, str]]:
-    """The compiled model of ``spec`` (the box alone, or the whole scene) and each component's joint name."""
-    if not with_robot:
-        from puzzlebox.models.box_export import compile_box
-
-        return compile_box(spec, locks)
-    from puzzlebox.models.scene import SceneConfig, build_scene
-
-    scene = build_scene(spec, SceneConfig(locks=locks))  # UnreachableBoxPose: a ModelsError
-    return scene.compile(), {name: names.joint for name, names in scene.names.components.items()}
-
-
-def _box_record(file: str, spec: PuzzleSpec, result: LockCheck, unrealized: list[tuple[LockRule, str]]) -> dict:
-    """One box's check as JSON-ready data (moves are fractions of a part's travel)."""
-    held = result.held_moves()
-    return {
-        "spec": spec.name,
-        "file": str(file),
-        "agreeing": result.agreeing,
-        "total": len(result.transitions),
-        "held_move_max": max(held) if held else None,
-        "disagreements": [
-            {
-                "open": [c.name for k, c in enumerate(spec.components) if (t.state >> k) & 1],
-                "component": t.component,
-                "expected": "free" if t.expected_free else "held",
-                "moved": t.moved,
-            }
-            for t in result.disagreements()
-        ],
-        "unrealized": [{**dataclasses.asdict(rule), "reason": reason} for rule, reason in unrealized],
-    }
-
-
-def _box_line(box: dict) -> str:
-    held = box["held_move_max"]
-    moved = "no part held" if held is None else f"held parts moved at most {100 * held:.1f} % of their travel"
-    agree = f"{box['agreeing']}/{box['total']} transitions agree"
-    return f"{box['spec']}: {agree}; {moved}; {len(box['unrealized'])} rule(s) without a mechanism"
-
-
-def _mesh(args: argparse.Namespace) -> None:
-    from puzzlebox.models.lock_features import layout_lock_features
-    from puzzlebox.models.mesh_export import export_meshes  # MuJoCo and trimesh only when asked
+    """Exit 1 if any transition disagrees, 2 if a spec is invalid (one line each) or a box cannot be built."""
+    from puzzlebox.lab.lock_checks import LockChecks  # MuJoCo only when asked
 
     try:
-        spec = load_spec(args.spec)
-    except SpecError as err:
-        fail(one_line(err))
-    if spec.box is None:
-        fail(f"{args.spec}: spec {spec.name!r} is a disassembly scene (no box); only puzzle boxes export as meshes")
-    paths = export_meshes(spec, args.out)
-    print(f"wrote {len(paths)} files in {args.out}: {', '.join(p.name for p in paths[:3])} and one STL per part")
-    layout = layout_lock_features(spec)
-    print(f"lock features: {len(layout.features)} shown, {len(layout.skipped)} without room on their locker")
-    for skipped in layout.skipped:  # a lock the physics enforces but the model cannot show: say so
-        print(f"  not shown: {skipped.locker} -> {skipped.locked}: {skipped.reason}")
+        specs = load_box_specs(args.specs)  # every file read before any box is built
+    except SpecFilesInvalid as err:
+        for problem in err.problems[:-1]:
+            print(f"error: {problem}", file=sys.stderr)
+        fail(err.problems[-1])  # one line per invalid file, exit 2
+    checks = LockChecks(args.locks, args.with_robot)
+    checks.run(tqdm(specs, desc="check-locks", unit="box", disable=None), say=tqdm.write,
+               warn=lambda line: tqdm.write(line, file=sys.stderr))  # fmt: skip
+    if args.json:
+        print(f"wrote {write_json(Path(args.json), checks.record())}")
+    print(checks.total_line())
+    return checks.exit_code
+
+
+def _print(lines: Iterable[str]) -> None:
+    for line in lines:
+        print(line)
 
 
 def _validate(args: argparse.Namespace) -> int:
     invalid = 0
     for file in args.files:
-        try:
-            spec = load_spec(file)
-        except SpecError as err:
-            invalid += 1
-            for problem in err.problems:
-                print(f"{file}: {problem}")
-            continue
-        plan = LockTable.from_spec(spec).shortest_solution()
-        print(f"{file}: valid ({len(spec.components)} components, shortest solution {len(plan or [])} actions)")
+        lines, valid = validation_lines(file)
+        _print(lines)
+        invalid += not valid
     if invalid:
         print(f"{invalid} of {len(args.files)} file(s) invalid", file=sys.stderr)
     return 1 if invalid else 0
 
 
-def _dataset_flags(parser: argparse.ArgumentParser) -> None:
+def _generator_flags(parser: argparse.ArgumentParser, name_from: str) -> None:
+    """The flags chain and random share: the output, the name, the plot, the pose, and those of a dataset."""
+    parser.add_argument("--out", required=True, help="output JSON file")
+    parser.add_argument("--name", default=None, help=f"spec name (default: derived from {name_from} and seed)")
+    parser.add_argument("--plot", action="store_true", help="also write a top-view PNG beside each JSON")
+    parser.add_argument("--anywhere", action="store_true", help="keep the box at the default pose even if the robot "
+                        "cannot reach every handle (symbolic only)")  # fmt: skip
     parser.add_argument("--count", type=int, default=None, help="N specs, seeds S..S+N-1: --out is a directory")
     parser.add_argument("--workers", type=int, default=None, help="with --count: worker processes (default: cores)")
     parser.add_argument("--ray", default=None, metavar="auto|ADDRESS", help="with --count: generate on Ray")
 
 
-def _locks_flag(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--locks",
-        choices=LOCK_MODES,
-        default="contact",
-        help="lock rules as mechanisms that block by contact (default) or as latches alone (no mechanism)",
-    )
-
-
 def main(argv: list[str] | None = None) -> int:
+    locks = {"choices": LOCK_MODES, "default": "contact", "help": "lock rules as mechanisms that block by contact "
+             "(default) or as latches alone (no mechanism)"}  # fmt: skip
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     verbs = parser.add_subparsers(dest="verb", required=True)
 
@@ -333,59 +147,37 @@ def main(argv: list[str] | None = None) -> int:
     chain = verbs.add_parser("chain", help="a chain of any registered kinds whose neighbours may lock each other")
     chain.add_argument("--kinds", required=True, help="comma-separated, e.g. door,slide,wheel")
     chain.add_argument("--seed", type=int, required=True)
-    chain.add_argument("--out", required=True, help="output JSON file")
-    chain.add_argument("--name", default=None, help="spec name (default: derived from kinds and seed)")
-    chain.add_argument("--plot", action="store_true", help="also write a top-view PNG beside each JSON")
-    chain.add_argument(
-        "--anywhere",
-        action="store_true",
-        help="keep the box at the default pose even if the robot cannot reach every handle (symbolic only)",
-    )
-    _dataset_flags(chain)
-    chain.set_defaults(run=_chain)
+    _generator_flags(chain, "kinds")
+    chain.set_defaults(run=_generated)
 
     rand = verbs.add_parser("random", help="a random solvable lock graph of N components")
     rand.add_argument("--components", type=int, required=True)
     rand.add_argument("--seed", type=int, required=True)
     rand.add_argument("--multi-locker", action="store_true", help="some components get two lockers")
-    rand.add_argument(
-        "--kinds",
-        choices=("paper", "all"),
-        default="paper",
-        help="kinds drawn: the paper's door/slide/wheel (default) or every registered kind (models.kinds)",
-    )
-    rand.add_argument("--out", required=True, help="output JSON file")
-    rand.add_argument("--name", default=None, help="spec name (default: derived from N and seed)")
-    rand.add_argument("--plot", action="store_true", help="also write a top-view PNG beside each JSON")
-    rand.add_argument(
-        "--anywhere",
-        action="store_true",
-        help="keep the box at the default pose even if the robot cannot reach every handle (symbolic only)",
-    )
-    _dataset_flags(rand)
-    rand.set_defaults(run=_random)
+    rand.add_argument("--kinds", choices=("paper", "all"), default="paper", help="kinds drawn: the paper's "
+                      "door/slide/wheel (default) or every registered kind (models.kinds)")  # fmt: skip
+    _generator_flags(rand, "N")
+    rand.set_defaults(run=_generated)
 
     scene = verbs.add_parser("mjcf", help="the MuJoCo scene of a spec: DIR/scene.xml (or DIR/box.xml) + assets")
     scene.add_argument("spec", help="puzzle spec file")
     scene.add_argument("--out", required=True, help="output directory")
     scene.add_argument("--box-only", action="store_true", help="the box alone, lid frame at the origin: DIR/box.xml")
-    _locks_flag(scene)
-    scene.set_defaults(run=_mjcf)
+    scene.add_argument("--locks", **locks)
+    scene.set_defaults(run=lambda args: _print(export_mjcf(args.spec, args.out, args.box_only, args.locks)))
 
     check = verbs.add_parser("check-locks", help="does each box's model alone hold its lock rules? exit 1 if not")
     check.add_argument("specs", nargs="+", metavar="SPEC", help="puzzle spec files")
     check.add_argument("--with-robot", action="store_true", help="check the whole scene (table, robot, box)")
-    _locks_flag(check)
+    check.add_argument("--locks", **locks)
     check.add_argument("--json", default=None, metavar="FILE", help="also write every box's result to FILE")
     check.set_defaults(run=_check_locks)
 
-    mesh = verbs.add_parser(
-        "mesh",
-        help="the box as meshes: DIR/<name>.glb, .obj, .stl and one STL per part (shell, components, mechanisms)",
-    )
+    mesh = verbs.add_parser("mesh", help="the box as meshes: DIR/<name>.glb, .obj, .stl and one STL per part "
+                            "(shell, components, mechanisms)")  # fmt: skip
     mesh.add_argument("spec", help="puzzle spec file")
     mesh.add_argument("--out", required=True, help="output directory")
-    mesh.set_defaults(run=_mesh)
+    mesh.set_defaults(run=lambda args: _print(export_box_meshes(args.spec, args.out)))
 
     validate = verbs.add_parser("validate", help="check spec files; exit 1 if any is invalid")
     validate.add_argument("files", nargs="+")
@@ -396,7 +188,7 @@ def main(argv: list[str] | None = None) -> int:
         fail("--workers and --ray go with --count (a dataset)")
     try:
         return args.run(args) or 0
-    except ModelsError as err:
+    except (LabError, ModelsError) as err:
         fail(str(err))
     except OSError as err:
         fail(f"cannot write output: {err}")

@@ -32,22 +32,15 @@ uninterrupted one writes (a kill loses at most the episode in progress).
 from __future__ import annotations
 
 import argparse
-import json
-import os
-import sqlite3
 import sys
 from pathlib import Path
 
-from tqdm import tqdm
-
-from puzzlebox.lab.cells import profile_of_calibration
-from puzzlebox.lab.cli import fail, versions, write_json
-from puzzlebox.lab.interrupt import StopRequests
-from puzzlebox.learning import DEEP_AGENT_NAMES, MemoryAgent, SymbolicWorld, run_episode
-from puzzlebox.learning.dual_controller import DualControllerConfig
-from puzzlebox.learning.errors import LearningError
-from puzzlebox.learning.memory import MemoryStore
-from puzzlebox.models import SpecError, load_spec
+from puzzlebox.lab.cli import fail, versions
+from puzzlebox.lab.deep_training import train_deep
+from puzzlebox.lab.errors import LabError
+from puzzlebox.lab.memory_training import MemoryTraining, training_command
+from puzzlebox.lab.training_setup import check_writable, load_training_specs, memory_controller, twin_training_for
+from puzzlebox.learning import DEEP_AGENT_NAMES
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -73,140 +66,44 @@ def main(argv: list[str] | None = None) -> int:
     if args.seed < 0:
         fail(f"--seed must be >= 0, got {args.seed}")
     try:
-        specs = [load_spec(path) for path in args.specs]
-    except SpecError as err:
+        return _train(args)
+    except LabError as err:
         fail(str(err))
+    return 2  # not reached: fail exits
+
+
+def _train(args: argparse.Namespace) -> int:
+    specs = load_training_specs(args.specs)
     if args.sim == "symbolic" and (args.reality is not None or args.calibration is not None):
         fail("--reality and --calibration are for --sim twin")
-    controller = None
-    if args.max_lockers != 1:
-        if args.sim != "symbolic" or args.agent != "memory":
-            fail("--max-lockers is for the memory agent with --sim symbolic (the twin's keeps the one-locker belief)")
-        try:
-            controller = DualControllerConfig(max_lockers=args.max_lockers)
-        except LearningError as err:
-            fail(f"--max-lockers: {err}")
-    twin = _twin_setup(args, specs) if args.sim == "twin" else None
+    controller = memory_controller(args.max_lockers, args.sim, args.agent)
+    twin = twin_training_for(args.reality, args.calibration, args.specs, specs) if args.sim == "twin" else None
     if args.agent != "memory":
         if twin is not None:
             fail("--sim twin trains the memory agent only (deep agents train in the symbolic simulator)")
         if args.checkpoint is None or args.memory is not None:
             fail(f"--agent {args.agent} trains a network: give --checkpoint FILE (and no --memory)")
-        _check_writable(Path(args.checkpoint), "--checkpoint")
-        return _train_deep(args, specs)
+        check_writable(Path(args.checkpoint), "--checkpoint")
+        command = {"command": "train", **vars(args), "versions": versions()}
+        solved = train_deep(args.agent, specs, seed=args.seed, episodes=args.episodes, max_actions=args.max_actions,
+                            checkpoint=args.checkpoint, command=command)  # fmt: skip
+        print(f"trained {args.agent} for {args.episodes} episode(s), {solved} solved -> {args.checkpoint}")
+        return 0
     if args.memory is None:
         fail("the memory agent needs --memory MEM.sqlite")
-    memory_path = Path(args.memory)
-    _check_writable(memory_path, "--memory")
-    command = {key: value for key, value in vars(args).items() if key != "resume"}
-    if args.max_lockers == 1:  # the default leaves the command as it was before k existed (resumable)
-        del command["max_lockers"]
-    try:
-        store = MemoryStore(args.memory)
-        run_id, done_seeds = _resumed_run(store, command) if args.resume else (None, set())
-        if run_id is None:
-            run_id = store.begin_training_run({"command": "train", **command, "versions": versions()})
-    except LearningError as err:
-        fail(str(err))
-    except sqlite3.OperationalError as err:  # e.g. a read-only directory for SQLite's journal
-        fail(f"--memory {memory_path}: cannot write ({err})")
-
-    log_path = Path(args.memory + ".train.json")
-    solved = 0
-    done = len(done_seeds)
-    if done:
-        print(f"resuming training run {run_id}: {done} of {args.episodes} episode(s) already in the memory")
-    with StopRequests("episode") as stop:
-        try:
-            todo = [e for e in range(args.episodes) if args.seed + e not in done_seeds]
-            for e in tqdm(todo, desc=f"training ({args.sim})", unit="episode", disable=None):
-                if stop.requested:
-                    break
-                spec = specs[e % len(specs)]
-                agent = MemoryAgent(store, learn=True, config=controller if twin is None else twin.controller)
-                agent.episode_label, agent.episode_seed, agent.training_run = spec.name, args.seed + e, run_id
-                if twin is None:
-                    result = run_episode(agent, SymbolicWorld(spec, args.seed + e), spec.name, args.seed + e,
-                                         args.max_actions)  # fmt: skip
-                else:
-                    result = twin.episode(agent, spec, args.seed + e, args.max_actions)
-                solved, done = solved + result.solved, done + 1
-        except KeyboardInterrupt:
-            pass
-    # the log is in the memory file, episode by episode; its export is written once, at the end (reading
-    # the whole log after every episode made a long training quadratic)
-    write_json(log_path, {"memory": args.memory, "runs": store.training_log()})
-    store.close()
-    print(f"trained {done} episode(s), {solved} solved; memory holds {store.num_episodes} -> {args.memory}")
+    check_writable(Path(args.memory), "--memory")
+    training = MemoryTraining(args.memory, training_command(vars(args)), args.resume)
+    if training.resumed:
+        print(f"resuming training run {training.run_id}: {training.resumed} of {args.episodes} episode(s) already "
+              "in the memory")  # fmt: skip
+    done, solved = training.train(specs, seed=args.seed, episodes=args.episodes, max_actions=args.max_actions,
+                                  sim=args.sim, controller=controller, twin=twin)  # fmt: skip
+    held = training.finish()
+    print(f"trained {done} episode(s), {solved} solved; memory holds {held} -> {args.memory}")
     if done < args.episodes:
         print(f"stopped after {done} of {args.episodes} episode(s): every finished one is in the memory",
               file=sys.stderr)  # fmt: skip
         return 130
-    return 0
-
-
-def _resumed_run(store: MemoryStore, command: dict) -> tuple[int | None, set[int]]:
-    """The latest training run in ``store`` made by the same ``command`` (versions aside) and the seeds of the
-    episodes it stored; (None, empty) when there is none."""
-    for run in reversed(store.training_log()):
-        config = dict(run["config"])  # type: ignore[arg-type]
-        config.pop("versions", None)
-        config.pop("command", None)
-        if config == json.loads(json.dumps(command)):
-            return run["id"], {e["seed"] for e in run["episodes"]}  # type: ignore[union-attr]
-    return None, set()
-
-
-def _twin_setup(args: argparse.Namespace, specs: list):
-    """The twin episode runner for ``--sim twin`` (the twin loads only when asked); a calibration must be the
-    one of this cell (profile and box height), as ``trial.py`` checks."""
-    from puzzlebox.lab.twin_training import TwinTraining
-    from puzzlebox.models.calibration import CalibrationError, CellCalibration
-    from puzzlebox.twin.errors import TwinError
-    from puzzlebox.twin.reality import load_profile
-
-    try:
-        reality = load_profile(args.reality or "ideal")
-        calibration = CellCalibration.load(args.calibration) if args.calibration else None
-        reality = profile_of_calibration(reality, calibration)  # the cell the calibration was made in
-    except (TwinError, CalibrationError) as err:
-        fail(str(err))
-    for path, spec in zip(args.specs, specs, strict=True):
-        if calibration is not None:
-            try:
-                calibration.check_cell(reality.name, reality.cell_seed, spec.box.size[2], spec=str(path))
-            except CalibrationError as err:
-                fail(f"--calibration {args.calibration} for spec {spec.name}: {err}")
-    return TwinTraining(reality, calibration)
-
-
-def _check_writable(path: Path, flag: str) -> None:
-    """Fail now, not after the training, if ``path`` cannot be written."""
-    if path.is_dir():
-        fail(f"{flag} {path} is a directory, not a file")
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as err:
-        fail(f"{flag} {path}: cannot create its directory ({err.strerror})")
-    target = path if path.exists() else path.parent
-    if not os.access(target, os.W_OK):
-        fail(f"{flag} {path}: cannot write {'it' if path.exists() else 'there'} (read-only)")
-
-
-def _train_deep(args: argparse.Namespace, specs: list) -> int:
-    from puzzlebox.learning.baselines import make_learner, save_checkpoint  # torch only when asked
-
-    agent = make_learner(args.agent, args.seed)
-    log = {"command": "train", **vars(args), "versions": versions(), "runs": []}
-    for e in tqdm(range(args.episodes), desc=f"training {args.agent}", unit="episode", disable=None):
-        spec = specs[e % len(specs)]
-        result = run_episode(agent, SymbolicWorld(spec, args.seed + e), spec.name, args.seed + e, args.max_actions)
-        log["runs"].append({k: v for k, v in result.to_dict().items() if k != "actions"})
-        if (e + 1) % 50 == 0 or e + 1 == args.episodes:  # nothing much lost on a crash
-            save_checkpoint(agent, args.checkpoint)
-            write_json(Path(args.checkpoint + ".train.json"), log)
-    solved = sum(r["solved"] for r in log["runs"])
-    print(f"trained {args.agent} for {args.episodes} episode(s), {solved} solved -> {args.checkpoint}")
     return 0
 
 

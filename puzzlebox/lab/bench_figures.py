@@ -1,0 +1,119 @@
+"""The figures ``bench.py`` measures, in the order it measures them, each with where it goes in the results file
+and the lines it prints: the symbolic figures (``puzzlebox.lab.symbolic_speed``), the twin's
+(``puzzlebox.lab.twin_speed``), then the scale figures (``puzzlebox.lab.bench_scale``). Each figure is measured
+when its generator is advanced, so a caller can print and keep it before the next one starts."""
+
+from __future__ import annotations
+
+import platform
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
+from puzzlebox.lab.cli import versions
+from puzzlebox.lab.symbolic_speed import (
+    SIZES,
+    decision_latency,
+    disassembly_latency,
+    env_steps_per_second,
+    multi_locker_latency,
+)
+from puzzlebox.lab.twin_speed import box_visibility_figures, rollout_figures, twin_figures, twin_trial_figures
+
+
+@dataclass(frozen=True)
+class Figure:
+    """One measured figure: ``value`` goes under ``key`` (a path of nested keys) in the results; ``lines`` are
+    printed."""
+
+    key: tuple[str, ...]
+    value: Any
+    lines: list[str]
+
+    def keep(self, results: dict[str, Any]) -> None:
+        """Put the value in ``results`` under its key (making the nested dicts on the way)."""
+        *parents, last = self.key
+        for key in parents:
+            results = results.setdefault(key, {})
+        results[last] = self.value
+
+
+def bench_header() -> dict[str, Any]:
+    """What the results file starts with: the command, the machine and the versions."""
+    return {"command": "bench", "machine": platform.processor() or platform.machine(), "versions": versions()}
+
+
+def default_scale_trials(quick: bool) -> int:
+    """Twin trials per executor for the scale figures when not given: 40 (``quick``: 4)."""
+    return 4 if quick else 40
+
+
+def _latency_line(what: str, stats: dict[str, float]) -> str:
+    return (
+        f"{what}: median {stats['median_ms']:.3f} ms, p90 {stats['p90_ms']:.3f} ms over {stats['decisions']} decisions"
+    )
+
+
+def measured_figures(quick: bool) -> Iterator[Figure]:
+    """Every figure but the scale ones, one at a time (``quick``: fewer episodes and repeats, a CI smoke run)."""
+    episodes = 1 if quick else 5
+    for n in SIZES:
+        stats = decision_latency(n, episodes, max_decisions=3 * n)
+        yield Figure(("decision_latency", f"N={n}"), stats, [_latency_line(f"decision latency N={n:>2}", stats)])
+    multi = multi_locker_latency(episodes=episodes)
+    what = "decision + update N=8 two-locker boxes, {}"
+    yield Figure(("multi_locker_latency_n8",), multi, [_latency_line(what.format(k), s) for k, s in multi.items()])
+    scene = disassembly_latency(episodes=episodes)
+    what = "decision + update, disassembly scene (lab-computer-b), {}"
+    lines = [_latency_line(what.format(k), s) for k, s in (scene or {}).items()]
+    yield Figure(("disassembly_latency",), scene, lines)
+    rate = env_steps_per_second(0.3 if quick else 2.0)
+    yield Figure(("symbolic_env_steps_per_s",), rate, [f"symbolic env: {rate:,.0f} steps/s"])
+    twin = twin_figures(quick)
+    yield Figure(("twin",), twin, [
+        f"twin: build+compile {twin['scene_build_compile_s_median']:.3f} s; bare mj_step "
+        f"{twin['bare_mj_step_per_call_per_s']:,.0f}/s per call, {twin['bare_mj_step_nstep_per_s']:,.0f}/s nstep; "
+        f"twin {twin['twin_step_per_s']:,.0f}/s (x{twin['twin_over_bare_per_call']:.2f} per call, "
+        f"x{twin['twin_over_bare_nstep']:.2f} nstep); overview render {twin['overview_render_ms_no_shadows']:.1f} ms "
+        f"({twin['overview_render_ms_shadows']:.1f} ms with shadows)"
+    ])  # fmt: skip
+    trial = twin_trial_figures(quick)
+    yield Figure(("twin_trial",), trial, [
+        "twin trial (oracle, ideal): "
+        + "; ".join(
+            f"{label} x{trial[f'{label}_sim_over_wall']:.1f} ({trial[f'{label}_sim_s']:.0f} s simulated in "
+            f"{trial[f'{label}_wall_s']:.2f} s, {trial[f'{label}_actions']} actions)"
+            for label in ("first", "second")
+            if f"{label}_sim_s" in trial
+        )
+    ])  # fmt: skip
+    rollout = rollout_figures(quick)
+    yield Figure(("rollout",), rollout, [
+        f"twin trial outputs (oracle, ideal, median of {rollout['repeats']}): plain {rollout['plain_wall_s']:.2f} s, "
+        f"--video {rollout['video_wall_s']:.2f} s (x{rollout['video_over_plain']:.2f}), --record "
+        f"{rollout['record_wall_s']:.2f} s (x{rollout['record_over_plain']:.2f})"
+    ])  # fmt: skip
+    seen = box_visibility_figures(quick)
+    yield Figure(("box_visibility",), seen, [
+        f"rollout views: over {seen['frames']} frames of {seen['trials']} trials the best view showed at least "
+        f"{seen['worst_frame_best_view']:.1%} of the box ({seen['frames_below_0.9']} frames below 90 %)"
+    ])  # fmt: skip
+
+
+def scale_figures(trials: int, quick: bool) -> Iterator[Figure]:
+    """The scale figures (``puzzlebox.lab.bench_scale``): each executor's overhead per no-op task, then twin trials
+    per hour of ``trials`` oracle trials on each executor, start-up included and warm."""
+    from puzzlebox.lab.bench_scale import overhead_ms, twin_throughput  # Ray only when asked
+
+    overhead = overhead_ms(50 if quick else 200)
+    line = "per-task overhead on no-op tasks: " + ", ".join(f"{k} {v:.2f} ms" for k, v in overhead.items())
+    yield Figure(("executor_overhead_ms_per_noop_task",), overhead, [line])
+    scale = twin_throughput(trials)
+    lines = []
+    for key, label in (("trials_per_hour", "start-up included"), ("warm_trials_per_hour", "warm")):
+        speedup = key.replace("trials_per_hour", "speedup_over_one_worker")
+        lines.append(f"twin trials per hour ({trials} oracle trials, ideal, paper test boxes; {label}): " + "; ".join(
+            f"{k} {v[key]:.0f}" + (f" (x{v[speedup]:.2f})" if speedup in v else "")
+            for k, v in scale.items() if isinstance(v, dict)
+        ))  # fmt: skip
+    yield Figure(("twin_throughput",), scale, lines)

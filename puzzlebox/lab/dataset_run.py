@@ -1,0 +1,75 @@
+"""Making a dataset of specs (``generate.py random|chain ... --count N --out DIR``): the specs of seeds
+S..S+N-1 generated in parallel as runner tasks (``puzzlebox.lab.dataset``), each written the moment it is made
+(with its top view if asked), and the manifest written once every spec is there. A stop request (Ctrl-C,
+SIGTERM) ends the run after the current spec, without a manifest."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from tqdm import tqdm
+
+from puzzlebox.lab.dataset import spec_task, write_manifest, write_spec
+from puzzlebox.lab.errors import DatasetError
+from puzzlebox.lab.interrupt import StopRequests
+from puzzlebox.learning.runner import RunnerError, make_executor
+from puzzlebox.models import load_spec
+
+
+@dataclass(frozen=True)
+class DatasetRun:
+    """What a dataset run wrote: ``written`` of ``count`` specs in ``out``; ``manifest`` None if it stopped."""
+
+    out: Path
+    written: int
+    count: int
+    manifest: Path | None
+
+
+def make_dataset(
+    out: str | Path,
+    generator: dict[str, Any],
+    *,
+    seed: int,
+    count: int,
+    name: str | None,
+    anywhere: bool,
+    plot: bool,
+    workers: int | None,
+    ray: str | None,
+) -> DatasetRun:
+    """``count`` specs of ``generator`` (its name and arguments) with seeds ``seed``.. in the directory ``out`` and
+    ``manifest.json``, on ``workers`` processes (default: one for fewer than 64 specs, else one per core) or on
+    Ray (``ray``). :class:`DatasetError` for a count below 1, an output that is a file, a spec that fails or a
+    runner that cannot run."""
+    if count < 1:
+        raise DatasetError(f"--count must be >= 1, got {count}")
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise DatasetError(f"--out {out} is a file; with --count it names a directory")
+    generator = {**generator, "name": name, "anywhere": anywhere, "seed": seed}
+    tasks = [spec_task(f"s{seed + i}", {**generator, "seed": seed + i}) for i in range(count)]
+    entries = []
+    try:
+        executor = make_executor(workers or (1 if count < 64 else None), ray)
+        with StopRequests("spec") as stop, executor:
+            bar = tqdm(total=len(tasks), desc=f"{generator['generator']} specs", unit="spec", disable=None)
+            for done in executor.run(tasks, lambda: stop.requested):
+                if not done.ok:
+                    raise DatasetError(f"seed {done.task.settings['seed']}: {str(done.payload).splitlines()[0]}")
+                path = write_spec(out, done.payload)
+                if plot:
+                    from puzzlebox.lab.spec_plot import plot_spec  # matplotlib only when asked
+
+                    plot_spec(load_spec(path), path.with_suffix(".png"))
+                entries.append(done.payload["entry"])
+                bar.update()
+            bar.close()
+    except RunnerError as err:
+        raise DatasetError(str(err)) from err
+    if len(entries) < len(tasks):
+        return DatasetRun(out, len(entries), len(tasks), None)
+    manifest = write_manifest(out, {**generator, "seed": seed, "count": count}, entries)
+    return DatasetRun(out, len(entries), len(tasks), manifest)

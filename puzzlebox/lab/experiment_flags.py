@@ -1,0 +1,110 @@
+"""The settings of ``experiment.py`` as one value: which protocol, which agents, where to write, how big; the checks
+every protocol shares (its agents, its runs, its workers), each failing with :class:`ExperimentSettingsError`
+whose message names the flag; and the ``DIR/<name>.config.json`` written beside every result."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+from typing import Any, TypeVar
+
+from puzzlebox.lab.cli import versions, write_json
+from puzzlebox.lab.errors import ExperimentSettingsError
+from puzzlebox.learning.experiments import PROTOCOLS, SYMBOLIC_AGENTS
+from puzzlebox.learning.experiments.deep_protocols import DEEP_AGENTS
+
+DISASSEMBLY = "disassembly"
+REALITY = "reality"
+FAULTS = "faults"
+TWIN_LEARNING = "twin-learning"
+SYSID = "sysid"
+KINDS = "kinds"
+ALL = "all"
+PROTOCOL_NAMES = (*PROTOCOLS, ALL, REALITY, FAULTS, TWIN_LEARNING, SYSID, DISASSEMBLY, KINDS)
+"""Every protocol ``experiment.py`` runs: the paper's symbolic ones, all three of them, and the twin's."""
+AGENTS = (*SYMBOLIC_AGENTS, *DEEP_AGENTS)
+"""The agents of the paper's symbolic protocols."""
+
+Config = TypeVar("Config")
+
+
+@dataclass(frozen=True)
+class ExperimentFlags:
+    """The command line of ``experiment.py``, flag by flag (None: not given), in the order of its flags."""
+
+    protocol: str
+    agents: str | None = None
+    out: str = "."
+    quick: bool = False
+    runs: int | None = None
+    seeds: int | None = None
+    workers: int | None = None
+    ray: str | None = None
+    poses: str = "relative"
+    memory: str | None = None
+    cells: str | None = None
+    validation: bool = False
+    no_holding_rule: bool = False
+
+    def check(self) -> None:
+        """The flags that belong to one protocol only are not given to another."""
+        if self.cells is not None and self.protocol != SYSID:
+            raise ExperimentSettingsError("--cells goes with the sysid protocol")
+        if (self.validation or self.no_holding_rule) and self.protocol != DISASSEMBLY:
+            raise ExperimentSettingsError("--validation and --no-holding-rule go with the disassembly protocol")
+
+    def agent_names(self, available: tuple[str, ...]) -> list[str]:
+        """The ``--agents`` of a protocol that needs them, each one of ``available``."""
+        if self.agents is None:
+            raise ExperimentSettingsError(
+                f"protocol {self.protocol!r} needs --agents (comma-separated, from {list(available)})"
+            )
+        agents = [a.strip() for a in self.agents.split(",") if a.strip()]
+        unknown = [a for a in agents if a not in available]
+        if not agents or unknown:
+            raise ExperimentSettingsError(
+                f"unknown agents {unknown or agents} for {self.protocol!r}; available: {list(available)}"
+            )
+        return agents
+
+    def check_workers(self, show: bool = False) -> None:
+        """``--workers``, if given, is at least 1 (``show``: the message shows the value given)."""
+        if self.workers is not None and self.workers < 1:
+            raise ExperimentSettingsError("--workers must be >= 1" + (f", got {self.workers}" if show else ""))
+
+    def with_runs(self, config: Config, field: str, minimum: int, why: str = "") -> Config:
+        """``config`` with ``--runs`` in ``field`` (unchanged without it); at least ``minimum`` (``why`` says
+        why, if it is not obvious)."""
+        if self.runs is None:
+            return config
+        if self.runs < minimum:
+            raise ExperimentSettingsError(f"--runs must be >= {minimum}{why}, got {self.runs}")
+        return replace(config, **{field: self.runs})
+
+    def with_seeds(self, config: Config, field: str, as_range: bool = False) -> Config:
+        """``config`` with ``--seeds`` (at least 1) in ``field``: the number, or with ``as_range`` the seeds
+        0..N-1; unchanged without it."""
+        if self.seeds is None:
+            return config
+        if self.seeds < 1:
+            raise ExperimentSettingsError(f"--seeds must be >= 1, got {self.seeds}")
+        return replace(config, **{field: tuple(range(self.seeds)) if as_range else self.seeds})
+
+    def only(self, allowed: str, *names: str) -> None:
+        """None of the flags ``names`` is given to a protocol that takes only ``allowed`` (a phrase)."""
+        given = [f"--{name}" for name in names if getattr(self, name) is not None]
+        if given:
+            raise ExperimentSettingsError(f"the {self.protocol} protocol takes only {allowed}, got {' '.join(given)}")
+
+    def out_dir(self, directory_only: bool = False) -> Path:
+        """``--out`` as a path (``directory_only``: refused if it is a file)."""
+        out = Path(self.out)
+        if directory_only and out.exists() and not out.is_dir():
+            raise ExperimentSettingsError(f"--out {out} is a file, not a directory")
+        return out
+
+    def write_config(self, out: Path, name: str, **settings: Any) -> None:
+        """``DIR/<name>.config.json``: the command line, the resolved settings and the versions, beside the
+        results."""
+        write_json(out / f"{name}.config.json", {"command": "experiment", **asdict(self), **settings,
+                                                  "versions": versions()})  # fmt: skip

@@ -1,0 +1,179 @@
+"""Every protocol of ``experiment.py`` from its settings (:class:`ExperimentFlags`): the paper's symbolic ones
+(``puzzlebox.lab.paper_protocols``) and the twin's — ``reality`` (``reality_sweep``), ``twin-learning``,
+``kinds`` (``kinds_experiment``), ``sysid``, ``disassembly`` (``learning.experiments.disassembly``) and
+``faults``. Each checks the flags it takes, writes ``DIR/<name>.config.json``, runs (resuming what a previous run
+of the same command finished) and hands its report (``DIR/<name>.md``) and wall time to ``echo``. A mistake in the
+settings is an :class:`ExperimentSettingsError`; the learning layer's refusal an :class:`ExperimentFailed`."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import asdict, replace
+from pathlib import Path
+from typing import Any
+
+from puzzlebox.lab.cli import write_json
+from puzzlebox.lab.errors import ExperimentFailed, ExperimentSettingsError
+from puzzlebox.lab.experiment_flags import (
+    DISASSEMBLY,
+    FAULTS,
+    KINDS,
+    REALITY,
+    SYSID,
+    TWIN_LEARNING,
+    ExperimentFlags,
+)
+from puzzlebox.lab.paper_protocols import run_paper_protocols
+from puzzlebox.learning.errors import LearningError
+from puzzlebox.learning.experiments.deep_protocols import DEEP_AGENTS
+
+Echo = Callable[[str], object]
+
+
+def run_experiment(flags: ExperimentFlags, echo: Echo = print) -> None:
+    """Check ``flags`` and run its protocol."""
+    flags.check()
+    runs = {REALITY: run_reality, FAULTS: run_faults, TWIN_LEARNING: run_twin_learning, SYSID: run_sysid,
+            DISASSEMBLY: run_disassembly, KINDS: run_kinds}  # fmt: skip
+    runs.get(flags.protocol, run_paper_protocols)(flags, echo)
+
+
+def run_reality(flags: ExperimentFlags, echo: Echo = print) -> None:
+    """The reality-gap sweep: the memory agent end to end in the twin, each factor of the gap at each level."""
+    from puzzlebox.lab.reality_sweep import SweepConfig, run_sweep
+
+    if flags.agents not in (None, "memory"):
+        raise ExperimentSettingsError(f"the reality protocol runs the memory agent only, got --agents {flags.agents}")
+    if flags.seeds is not None:
+        raise ExperimentSettingsError("--seeds is for the symbolic protocols")
+    flags.check_workers()
+    config = flags.with_runs(SweepConfig().quick() if flags.quick else SweepConfig(), "placements", 1)
+    memory = None
+    if flags.memory is not None:
+        memory = Path(flags.memory)
+        if not memory.is_file():
+            raise ExperimentSettingsError(
+                f"--memory {memory}: no such file (train one with scripts/train.py, or leave it out)"
+            )
+    out = flags.out_dir()
+    flags.write_config(out, REALITY, sweep=asdict(config))
+    try:
+        summary = run_sweep(out, config, memory, flags.workers, flags.ray)
+    except LearningError as err:
+        raise ExperimentFailed(str(err)) from err
+    report(out, REALITY, summary, echo)
+
+
+def run_twin_learning(flags: ExperimentFlags, echo: Echo = print) -> None:
+    """Learning in the twin: the memory agent from each start (and the deep agents asked for beside it)."""
+    from puzzlebox.lab.twin_learning import TwinLearningConfig, run_twin_learning
+
+    if flags.memory is not None:
+        raise ExperimentSettingsError(
+            "the twin-learning protocol runs the memory agent from its own memories (no --memory)"
+        )
+    flags.check_workers()
+    config = TwinLearningConfig().quick() if flags.quick else TwinLearningConfig()
+    if flags.agents is not None:  # the memory's curve always; the deep agents asked for beside it
+        agents = [a.strip() for a in flags.agents.split(",") if a.strip()]
+        unknown = [a for a in agents if a not in ("memory", *DEEP_AGENTS)]
+        if unknown or "memory" not in agents:
+            raise ExperimentSettingsError(
+                f"twin-learning --agents: memory and any of {list(DEEP_AGENTS)}, got {agents}"
+            )
+        config = replace(config, deep_agents=tuple(a for a in agents if a != "memory"))
+    config = flags.with_seeds(flags.with_runs(config, "placements", 1), "seeds", as_range=True)
+    out = flags.out_dir()
+    flags.write_config(out, TWIN_LEARNING, twin_learning=asdict(config))
+    try:
+        summary = run_twin_learning(out, config, flags.workers, flags.ray)
+    except LearningError as err:
+        raise ExperimentFailed(str(err)) from err
+    report(out, TWIN_LEARNING, summary, echo)
+
+
+def run_kinds(flags: ExperimentFlags, echo: Echo = print) -> None:
+    """Boxes mixing every registered kind, symbolically and end to end in the twin."""
+    from puzzlebox.lab.kinds_experiment import KindsConfig, run_kinds
+
+    flags.only("--out, --runs, --workers and --quick", "agents", "seeds", "ray", "memory")
+    flags.check_workers()
+    config = flags.with_runs(KindsConfig().quick() if flags.quick else KindsConfig(), "runs", 1)
+    out = flags.out_dir()
+    flags.write_config(out, KINDS, kinds=asdict(config))
+    report(out, KINDS, run_kinds(out, config, flags.workers), echo)
+
+
+def run_sysid(flags: ExperimentFlags, echo: Echo = print) -> None:
+    """System identification of the box's joints and latches from logged toggles, nominal against fitted."""
+    from puzzlebox.lab.sysid import SysIdConfig, run_sysid
+
+    flags.only("--out, --workers, --cells and --quick", "agents", "runs", "seeds", "ray", "memory")
+    flags.check_workers(show=True)
+    config = SysIdConfig().quick() if flags.quick else SysIdConfig()
+    if flags.cells is not None:
+        config = replace(config, cell_seeds=cell_seeds(flags.cells))
+    out = flags.out_dir(directory_only=True)
+    flags.write_config(out, SYSID, sysid=asdict(config))
+    try:
+        summary = run_sysid(out, config, flags.workers)
+    except LearningError as err:
+        raise ExperimentFailed(str(err)) from err
+    report(out, SYSID, summary, echo)
+
+
+def cell_seeds(cells: str) -> tuple[int, ...]:
+    """``--cells``: distinct cell seeds >= 0, comma-separated."""
+    try:
+        seeds = tuple(int(c) for c in cells.split(","))
+    except ValueError:
+        raise ExperimentSettingsError(f"--cells takes comma-separated integers (cell seeds), got {cells!r}") from None
+    if not seeds or min(seeds) < 0 or len(set(seeds)) != len(seeds):
+        raise ExperimentSettingsError(f"--cells takes distinct cell seeds >= 0, got {cells!r}")
+    return seeds
+
+
+def run_disassembly(flags: ExperimentFlags, echo: Echo = print) -> None:
+    """The disassembly domain: train on one measured computer, test on another and its variants."""
+    from puzzlebox.learning.experiments.disassembly import AGENTS as DISASSEMBLY_AGENTS
+    from puzzlebox.learning.experiments.disassembly import DisassemblyConfig, run_disassembly
+    from puzzlebox.learning.experiments.disassembly_report import plot as plot_disassembly
+    from puzzlebox.learning.experiments.disassembly_report import table as disassembly_table
+
+    if flags.memory is not None:
+        raise ExperimentSettingsError("the disassembly protocol trains its own memories (no --memory)")
+    agents = flags.agent_names(DISASSEMBLY_AGENTS)
+    flags.check_workers(show=True)
+    config = flags.with_runs(DisassemblyConfig().quick() if flags.quick else DisassemblyConfig(), "runs_per_test", 1)
+    config = flags.with_seeds(config, "training_seeds")
+    config = replace(config, validation=flags.validation, holding_rule=not flags.no_holding_rule)
+    out = flags.out_dir(directory_only=True)
+    flags.write_config(out, DISASSEMBLY, disassembly=asdict(config))
+    try:
+        summary = run_disassembly(out, agents, config, flags.workers, flags.ray)
+    except LearningError as err:
+        raise ExperimentFailed(str(err)) from err
+    write_json(out / f"{DISASSEMBLY}.json", summary)
+    plot_disassembly(summary, out / f"{DISASSEMBLY}.png")
+    (out / f"{DISASSEMBLY}.md").write_text(f"# Disassembly\n\n{disassembly_table(summary)}")
+    report(out, DISASSEMBLY, summary, echo)
+
+
+def run_faults(flags: ExperimentFlags, echo: Echo = print) -> None:
+    """Each fault class on purpose in real processes: kills and resumes, concurrent trainers, truncated memories,
+    command-line mistakes."""
+    from puzzlebox.lab.faults import FaultsConfig, run_faults
+
+    if any(v is not None for v in (flags.agents, flags.seeds, flags.workers, flags.ray, flags.memory)):
+        raise ExperimentSettingsError("the faults protocol takes only --out, --quick and --runs")
+    config = flags.with_runs(FaultsConfig().quick() if flags.quick else FaultsConfig(), "trial_runs", 2,
+                             " (a kill lands between two runs)")  # fmt: skip
+    out = flags.out_dir()
+    flags.write_config(out, FAULTS, faults=asdict(config))
+    report(out, FAULTS, run_faults(out, config), echo)
+
+
+def report(out: Path, name: str, summary: dict[str, Any], echo: Echo = print) -> None:
+    """Hand ``DIR/<name>.md`` and the wall time to ``echo``."""
+    echo((out / f"{name}.md").read_text())
+    echo(f"{name}: {summary['wall_time_s']:.0f} s -> {out}/")

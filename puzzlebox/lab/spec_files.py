@@ -1,0 +1,60 @@
+"""Spec files as ``generate.py`` reads and writes them: a generated spec written (with its top view if asked),
+a file loaded as a puzzle box (not a disassembly scene), several loaded at once with every problem named, and
+a file's validation lines."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from puzzlebox.lab.cli import one_line
+from puzzlebox.lab.errors import NotABoxSpec, SpecFileError, SpecFilesInvalid
+from puzzlebox.models import LockTable, PuzzleSpec, SpecError, load_spec, save_spec
+
+
+def write_spec_file(spec: PuzzleSpec, path: Path, plot: bool) -> list[str]:
+    """Write ``spec`` to ``path`` (and, if ``plot``, its top view as a PNG beside it): one line per file written."""
+    lines = [f"wrote {save_spec(spec, path)}  ({'-'.join(spec.kinds)})"]
+    if plot:
+        from puzzlebox.lab.spec_plot import plot_spec  # matplotlib only when asked
+
+        lines.append(f"wrote {plot_spec(spec, path.with_suffix('.png'))}")
+    return lines
+
+
+def load_box_spec(file: str | Path, use: str = "build as MuJoCo models") -> PuzzleSpec:
+    """The puzzle-box spec in ``file``: :class:`SpecFileError` if it is unreadable or invalid (its problems on
+    one line), :class:`NotABoxSpec` if it is a disassembly scene (only puzzle boxes ``use``, e.g. "export as
+    meshes")."""
+    try:
+        spec = load_spec(file)
+    except SpecError as err:
+        raise SpecFileError(one_line(err)) from err
+    if spec.box is None:
+        raise NotABoxSpec(f"{file}: spec {spec.name!r} is a disassembly scene (no box); only puzzle boxes {use}")
+    return spec
+
+
+def load_box_specs(files: list[str]) -> list[tuple[str, PuzzleSpec]]:
+    """Every file's puzzle-box spec, each with its file, read before any box is built;
+    :class:`SpecFilesInvalid` naming every file that is not one (one line each) if any is not."""
+    loaded: list[tuple[str, PuzzleSpec]] = []
+    problems: list[str] = []
+    for file in files:
+        try:
+            loaded.append((file, load_box_spec(file)))
+        except SpecFileError as err:
+            problems.append(str(err))
+    if problems:
+        raise SpecFilesInvalid(problems)
+    return loaded
+
+
+def validation_lines(file: str) -> tuple[list[str], bool]:
+    """The lines ``generate.py validate`` prints for ``file`` (one per problem, or one saying it is valid with its
+    size and shortest solution) and whether it is valid."""
+    try:
+        spec = load_spec(file)
+    except SpecError as err:
+        return [f"{file}: {problem}" for problem in err.problems], False
+    plan = LockTable.from_spec(spec).shortest_solution()
+    return [f"{file}: valid ({len(spec.components)} components, shortest solution {len(plan or [])} actions)"], True
