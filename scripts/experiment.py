@@ -64,7 +64,7 @@ from __future__ import annotations
 import argparse
 
 from puzzlebox.lab.cli import fail
-from puzzlebox.lab.errors import LabError
+from puzzlebox.lab.errors import ExperimentStepFailed, LabError
 from puzzlebox.lab.experiment_flags import AGENTS, PROTOCOL_NAMES, ExperimentFlags
 from puzzlebox.lab.experiment_protocols import run_experiment
 from puzzlebox.learning.agents.factory import POSE_ENCODINGS
@@ -100,6 +100,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         run_experiment(ExperimentFlags(**vars(args)))
+    except ExperimentStepFailed as err:  # the command it ran said why itself
+        return err.returncode
     except LabError as err:
         fail(str(err))
     return 0

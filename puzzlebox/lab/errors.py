@@ -10,6 +10,7 @@ __all__ = [
     "DatasetError",
     "ExperimentFailed",
     "ExperimentSettingsError",
+    "ExperimentStepFailed",
     "LabError",
     "NotABoxSpec",
     "OutputFileError",
@@ -94,6 +95,15 @@ class ExperimentSettingsError(LabError, ValueError):
 
 class ExperimentFailed(LabError):
     """An experiment the learning layer refused or could not finish (its message unchanged)."""
+
+
+class ExperimentStepFailed(ExperimentFailed):
+    """A command an experiment ran in a process of its own failed; it said why on stderr itself, and
+    :attr:`returncode` is its exit code."""
+
+    def __init__(self, command: str, returncode: int) -> None:
+        super().__init__(f"{command} exited with {returncode}")
+        self.returncode = returncode
 
 
 class TrainingError(LabError):

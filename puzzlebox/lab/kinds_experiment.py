@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from puzzlebox.lab.cli import scripts_folder, write_json
+from puzzlebox.lab.errors import ExperimentStepFailed
 from puzzlebox.models import LockTable, PuzzleSpec, load_spec, save_spec
 from puzzlebox.models.atomic import write_atomically, write_text_atomically
 from puzzlebox.models.generator import RandomGraphConfig, generate_chain, generate_random
@@ -114,7 +115,7 @@ def _run(command: list[str]) -> None:
     print("$", " ".join(shown), flush=True)
     done = subprocess.run([sys.executable, *command], check=False)
     if done.returncode != 0:
-        raise SystemExit(done.returncode)
+        raise ExperimentStepFailed(" ".join(shown), done.returncode)
 
 
 def _trial(out: Path, specs: list[Path], settings: list[str]) -> dict[str, Any]:
