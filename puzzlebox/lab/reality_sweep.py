@@ -2,7 +2,7 @@
 all factors together, on the paper test boxes placed at random reachable poses.
 
 For every profile (``twin.reality_levels``: level 0 ideal, 1 realistic, 2 harsh) the cell is calibrated
-from ChArUco images as a real one would be (``_calibration_run``), then the memory agent runs every test
+from ChArUco images as a real one would be (``lab.calibration_run``), then the memory agent runs every test
 box at ``placements`` random reachable placements (seeds ``seed .. seed + placements - 1``, the same
 placements at every level). A second sweep raises the F/T force noise alone, to find the noise at which
 outcome agreement drops below 99 %.

@@ -2,7 +2,7 @@
 damping, joint friction and latch compliance from logged robot data of toggles.
 
 For each cell (``cell_seeds``: one box hardware each, its per-kind factors drawn from the cell seed; the
-``realistic`` profile), the cameras are calibrated from ChArUco images first (``_calibration_run``), as in the
+``realistic`` profile), the cameras are calibrated from ChArUco images first (``lab.calibration_run``), as in the
 other twin experiments. Then the oracle agent solves the paper training boxes (at random reachable placements:
 ``train_seeds``) and the unseen paper test boxes (``test_seeds``) end to end, every toggle logged as robot data
 only (:class:`skills.toggle_recorder.ToggleRecorder`; ``DIR/logs/*.npz``); beside the logs, for evaluation only,

@@ -14,7 +14,7 @@ Each start is run for every training seed (the spread in the plot). Beside them,
 (``dqn``, ``model-based``: ``deep_agents``) trained to convergence in the symbolic simulator (the paper
 protocols' 650 episodes on the 9 training variants, one network per training seed) run the same test trials:
 the paper's robot figures for them are 5.4 and 21.2 actions. The cell is calibrated from ChArUco
-images first (``_calibration_run``); training stores only what the robot sensed (``_twin_training``).
+images first (``lab.calibration_run``); training stores only what the robot sensed (``lab.twin_training``).
 
 Everything is a task of ``learning.runner`` (``--workers K``, or Ray): one training chain per start and
 seed (its memory file grows episode by episode in ``DIR/memories/``, and a copy of it is taken at each

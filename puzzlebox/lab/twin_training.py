@@ -1,6 +1,6 @@
 """Training episodes of the memory agent end to end in the twin, for ``scripts/train.py --sim twin``.
 
-An episode is a twin trial (:func:`_twin_trial.evaluation_world`: perception through the cell's calibration,
+An episode is a twin trial (:func:`twin_trial.evaluation_world`: perception through the cell's calibration,
 the primitives, the F/T outcomes) whose agent learns: what it adds to the memory is its belief, built from
 the outcomes the robot sensed, keyed by the poses the robot perceived. The simulator's truth reaches only
 the episode's log (whether each try truly moved a part), never the agent. Each stored episode carries its
