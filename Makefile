@@ -32,9 +32,28 @@ $(STAMP): pyproject.toml Makefile
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check --no-deps robosuite==1.5.2
 	touch $(STAMP)
 
-lint: $(STAMP)
+# pyright's stubs of mujoco (a pybind11 extension, without any), made from the installed mujoco: a stub-only
+# package, mujoco-stubs, in the venv's site-packages.
+MUJOCO_STUBS := $(VENV)/mujoco-stubs.stamp
+
+$(MUJOCO_STUBS): $(STAMP)
+	cd "$$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_path("purelib"))')" && rm -rf mujoco-stubs \
+		&& $(CURDIR)/$(BIN)/python -m pybind11_stubgen mujoco --root-suffix=-stubs --output-dir . >/dev/null 2>&1
+	touch $@
+
+# The installed layout for pyright (pyproject.toml [tool.pyright]): puzzlebox.<layer> -> <layer>/, as symlinks.
+PYRIGHT_ROOT := build/pyright-root/puzzlebox
+
+$(PYRIGHT_ROOT):
+	mkdir -p $@
+	ln -sfn ../../../puzzlebox/__init__.py $@/__init__.py
+	ln -sfn ../../../puzzlebox/lab $@/lab
+	for layer in models twin skills learning real scripts; do ln -sfn ../../../$$layer $@/$$layer; done
+
+lint: $(STAMP) $(MUJOCO_STUBS) $(PYRIGHT_ROOT)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
+	$(BIN)/pyright
 
 test: lint
 	$(BIN)/python -m pytest -q

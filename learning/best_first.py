@@ -25,6 +25,7 @@ import math
 import numpy as np
 
 from puzzlebox.learning.belief import Belief
+from puzzlebox.learning.lock_belief import LockBelief
 
 COST_TOLERANCE = 1e-12
 """A path within this [nats] of the best one counts as equal to it: without it, the many paths of
@@ -47,7 +48,7 @@ class BestFirstPlanner:
     at a goal, so the successors' searches reuse the first one's work.
     """
 
-    def __init__(self, belief: Belief, goal: int, goal_state: int, gamma: float) -> None:
+    def __init__(self, belief: LockBelief, goal: int, goal_state: int, gamma: float) -> None:
         self.belief = belief
         self.num_components = n = belief.num_components
         self.goal, self.goal_state, self.gamma = goal, goal_state, gamma
@@ -66,6 +67,7 @@ class BestFirstPlanner:
     def _prepare(self) -> None:
         """What :meth:`expand` reads, from the belief's additive one-locker structure."""
         belief, n, goal, goal_state = self.belief, self.num_components, self.goal, self.goal_state
+        assert isinstance(belief, Belief)  # this heuristic is the one-locker belief's (any: SetBestFirstPlanner)
         lockers = belief.locker_matrix().reshape(n, 2, n, 2)  # [c, s_c, m, s_m]
         # the goal's block when it is toggled towards the goal: [m, s_m]
         self._goal_lockers = lockers[goal, 1 - goal_state]

@@ -58,7 +58,8 @@ class LockerSets:
 
     def held(self, states_bits: np.ndarray) -> np.ndarray:
         """``(S, H)`` bool: set ``h`` holds (some member is active) in each of ``S`` joint states."""
-        return self.active_pairs(states_bits)[:, self.members].any(axis=2)
+        # (numpy types any(axis=...) as a scalar or an array: it cannot tell the array is 3-D)
+        return self.active_pairs(states_bits)[:, self.members].any(axis=2)  # pyright: ignore[reportReturnType]
 
     def member_indicator(self) -> np.ndarray:
         """``(H, 2N)`` float: 1 where pair ``p`` is a member of set ``h``, else 0 (the empty set's row is 0)."""

@@ -168,15 +168,15 @@ class MultiBelief:
         bits = np.insert(low, goal, 1 - goal_state, axis=1)  # the goal's bit back, fixed off the goal
         return self.free_rows(bits, np.asarray(rows, dtype=np.int64))
 
-    def free_rows(self, bits: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        """``(len(rows), S)``: ``P(c free | x)`` for the components ``rows`` in the joint states ``bits``
+    def free_rows(self, states_bits: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """``(len(rows), S)``: ``P(c free | x)`` for the components ``rows`` in the joint states ``states_bits``
         (``(S, N)`` of 0/1): one gather of the sets that hold in each state, one matrix product with the blocks."""
         sets = self.sets
-        free = np.empty((rows.size, bits.shape[0]))
+        free = np.empty((rows.size, states_bits.shape[0]))
         blocks = self.probs[rows].reshape(2 * rows.size, -1)  # [2r + own bit]: both of each row's blocks
         chunk = max(1, CHUNK_ENTRIES // sets.count)
-        for start in range(0, bits.shape[0], chunk):
-            part = bits[start : start + chunk]
+        for start in range(0, states_bits.shape[0], chunk):
+            part = states_bits[start : start + chunk]
             free_sets = (~sets.held(part)).astype(np.float64)  # (S', H)
             by_own = (free_sets @ blocks.T).reshape(-1, rows.size, 2)  # (S', R, own bit)
             own = part[:, rows]  # (S', R): the bit that picks each row's block
@@ -194,7 +194,8 @@ class MultiBelief:
         """
         n = self.num_components
         by_first = np.zeros((n, 2, 2 * n + 1))
-        np.add.at(by_first, (slice(None), slice(None), self.sets.first_member), self.probs)
+        # numpy's stubs type ufunc.at's indices as integers only, not the tuple of indices it takes
+        np.add.at(by_first, (slice(None), slice(None), self.sets.first_member), self.probs)  # pyright: ignore[reportArgumentType]
         least_held = by_first[:, :, : 2 * n].reshape(n, 2, n, 2).min(axis=3).sum(axis=2)
         return np.clip(1.0 - least_held, 0.0, 1.0)
 

@@ -185,5 +185,6 @@ def _sweep_values(
 def _best_first_values(belief: LockBelief, x: int, goal: int, goal_state: int, config: PlannerConfig) -> np.ndarray:
     """``Q_exploit`` by best-first search alone, ``config.max_expansions`` per search (a lower bound). The
     one-locker belief's additive structure gives a sharper heuristic; any other belief gets the generic one."""
-    search = BestFirstPlanner if isinstance(belief, Belief) else SetBestFirstPlanner
-    return search(belief, goal, goal_state, config.gamma).exploit_values(x, config.max_expansions)
+    if isinstance(belief, Belief):
+        return BestFirstPlanner(belief, goal, goal_state, config.gamma).exploit_values(x, config.max_expansions)
+    return SetBestFirstPlanner(belief, goal, goal_state, config.gamma).exploit_values(x, config.max_expansions)

@@ -6,10 +6,16 @@ Poses are ``(x, y, yaw)`` [m, m, rad]; ``compose(T_a_b, T_b_c) = T_a_c``.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import overload
 
 import numpy as np
 
 
+@overload
+def wrap_angle(angle: float) -> float: ...
+@overload
+def wrap_angle(angle: np.ndarray) -> np.ndarray: ...
 def wrap_angle(angle: float | np.ndarray) -> float | np.ndarray:
     """Wrap an angle [rad] (or each of an array of them) into [-pi, pi)."""
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
@@ -36,7 +42,7 @@ def inverse(T_a_b: tuple[float, float, float]) -> tuple[float, float, float]:
     return (-c * x - s * y, s * x - c * y, wrap_angle(-t))
 
 
-def transform_points(T_a_b: tuple[float, float, float], points_in_b: np.ndarray) -> np.ndarray:
+def transform_points(T_a_b: Sequence[float], points_in_b: np.ndarray) -> np.ndarray:
     """Express points given in frame b (shape ``(n, 2)`` [m]) in frame a."""
     x, y, t = T_a_b
     c, s = math.cos(t), math.sin(t)

@@ -10,6 +10,7 @@ lid frame [m] and written into the moving body's frame, as MuJoCo will move them
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,7 +44,7 @@ class JointMotion:
     lift: float
 
     @classmethod
-    def of(cls, template: KindTemplate, pose: tuple[float, float, float]) -> JointMotion:
+    def of(cls, template: KindTemplate, pose: Sequence[float]) -> JointMotion:
         """The motion of a ``template`` component at ``pose`` ``[x, y, yaw]`` [m, m, rad] on the lid."""
         x, y, yaw = pose
         c, s = math.cos(yaw), math.sin(yaw)

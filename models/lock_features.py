@@ -40,6 +40,7 @@ from typing import Literal
 
 import numpy as np
 import trimesh
+from trimesh.visual import ColorVisuals
 
 from puzzlebox.models.errors import UnknownKindError
 from puzzlebox.models.geometry import circle_polygon, polygon_gap, rectangle, transform_points
@@ -203,6 +204,7 @@ def layout_lock_features(spec: PuzzleSpec) -> LockFeatureLayout:
         mesh, strip = placed
         mesh.apply_translation([0.0, 0.0, _lift(locker.kind)])  # on a raised locker's plate (a lever's arm)
         rgba = FEATURE_RGBA[kind]
+        assert isinstance(mesh.visual, ColorVisuals)  # a new mesh's
         mesh.visual.face_colors = np.round(255 * np.array(rgba)).astype(np.uint8)
         features.append(LockFeature(name, kind, locker.name, locked.name, tuple(rules), mesh, rgba, strip))
         obstacles.polygons.append(strip)
@@ -457,4 +459,6 @@ def _mesh(kind, centre, d, n, t, w, s0, s1, post, notch, post_on_locked) -> trim
         R[:3, 3] = [mid[0], mid[1], base + NOTCH_THICKNESS / 2]
         plate.apply_transform(R)
         pieces.append(plate)
-    return trimesh.util.concatenate(pieces)
+    merged = trimesh.util.concatenate(pieces)
+    assert isinstance(merged, trimesh.Trimesh)  # of meshes: a mesh (its return type is any geometry)
+    return merged

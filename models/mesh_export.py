@@ -51,6 +51,8 @@ import mujoco
 import numpy as np
 import scipy.spatial
 import trimesh
+import trimesh.exchange.obj
+from trimesh.visual import ColorVisuals
 
 from puzzlebox.models.atomic import write_atomically
 from puzzlebox.models.errors import ModelsError
@@ -125,13 +127,27 @@ def export_meshes(
         scene.add_geometry(part.mesh, node_name=part.name, geom_name=part.name)
     meshes = [part.mesh for part in parts]
     files: list[tuple[Path, Callable[[], bytes]]] = [
-        (out / f"{stem}.glb", lambda: scene.export(file_type="glb")),
+        (out / f"{stem}.glb", lambda: _export(scene, "glb")),
         (out / f"{stem}.obj", lambda: trimesh.exchange.obj.export_obj(scene, include_texture=False).encode()),
-        (out / f"{stem}.stl", lambda: trimesh.util.concatenate(meshes).export(file_type="stl")),
+        (out / f"{stem}.stl", lambda: _export(_merged(meshes), "stl")),
     ]
     for part in parts:
-        files.append((out / f"{stem}-{part.stem}.stl", lambda mesh=part.mesh: mesh.export(file_type="stl")))
+        files.append((out / f"{stem}-{part.stem}.stl", lambda mesh=part.mesh: _export(mesh, "stl")))
     return [write_atomically(path, lambda tmp, make=make: tmp.write_bytes(make())) for path, make in files]
+
+
+def _export(geometry: trimesh.Trimesh | trimesh.Scene, file_type: str) -> bytes:
+    """``geometry`` as a ``file_type`` file (trimesh types ``export`` for all formats at once: dict, bytes or str)."""
+    data = geometry.export(file_type=file_type)
+    assert isinstance(data, bytes)
+    return data
+
+
+def _merged(meshes: list[trimesh.Trimesh]) -> trimesh.Trimesh:
+    """``trimesh.util.concatenate(meshes)``: one mesh (its return type is any geometry)."""
+    merged = trimesh.util.concatenate(meshes)
+    assert isinstance(merged, trimesh.Trimesh)
+    return merged
 
 
 def geom_mesh(model: mujoco.MjModel, geom: int) -> trimesh.Trimesh:
@@ -204,7 +220,9 @@ def _parts(spec: PuzzleSpec, lock_features: bool, locks: LockMode) -> list[_Part
     pieces = {BOX_PART: [_posed(model, data, g, T_lid_world) for g in box_geoms if g not in taken | mechanism]} | pieces
     if lock_features:
         for feature in features_of(spec):
-            rgba = tuple(feature.mesh.visual.face_colors[0] / 255.0) if len(feature.mesh.faces) else _GREY
+            visual = feature.mesh.visual
+            assert isinstance(visual, ColorVisuals)  # lock_features coloured its faces
+            rgba = tuple(visual.face_colors[0] / 255.0) if len(feature.mesh.faces) else _GREY
             pieces[feature.locker] += [(body, rgba) for body in _bodies(feature.mesh)]
     order = {prefix: k for k, prefix in enumerate(prefixes.values())}
     spec_names = {prefix: name for name, prefix in prefixes.items()}
@@ -462,7 +480,8 @@ def _solid(pieces: Iterable[tuple[trimesh.Trimesh, tuple]]) -> trimesh.Trimesh:
     # union's face nearest to it (it moved by less than _WELD)
     welded = _manifold(vertices, faces).simplify(_WELD).to_mesh64()
     out = trimesh.Trimesh(np.asarray(welded.vert_properties)[:, :3], np.asarray(welded.tri_verts, np.int64))
-    nearest = scipy.spatial.cKDTree(vertices[faces].mean(axis=1)).query(out.triangles_center)[1]
+    nearest = scipy.spatial.KDTree(vertices[faces].mean(axis=1)).query(out.triangles_center)[1]
+    assert isinstance(out.visual, ColorVisuals)  # a new mesh's
     out.visual.face_colors = np.round(255 * rgba[nearest]).astype(np.uint8)
     return out
 

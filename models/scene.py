@@ -195,7 +195,7 @@ def build_scene(spec: PuzzleSpec, config: SceneConfig | None = None) -> Scene:
         from puzzlebox.models.charuco import add_board_body
 
         add_board_body(world)
-    return Scene(spec, root, _names(spec), tuple(box_pose), T_world_lid, config)
+    return Scene(spec, root, _names(spec), (x, y, yaw), T_world_lid, config)
 
 
 def _names(spec: PuzzleSpec) -> SceneNames:
@@ -237,6 +237,7 @@ def _check_reach(spec: PuzzleSpec, T_world_lid: np.ndarray, config: SceneConfig)
     yaw = math.atan2(T_world_lid[1, 0], T_world_lid[0, 0])
     problems = unreachable_handles(spec, (T_world_lid[0, 3], T_world_lid[1, 3], yaw), config)
     if problems:
+        assert spec.box is not None  # build_scene refused a spec without one
         raise UnreachableBoxPose(
             f"box pose {spec.box.pose} puts handles outside the robot's reach "
             f"({config.min_reach:.2f}..{config.max_reach:.2f} m from the base axis): {', '.join(problems)}"

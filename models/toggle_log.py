@@ -128,7 +128,8 @@ def save_toggles(path: str | Path, toggles: list[ToggleLog], context: dict[str, 
 
     def write(tmp: Path) -> None:
         buffer = io.BytesIO()
-        np.savez_compressed(buffer, **arrays)
+        # the checker matches **arrays against allow_pickle too: its keys are "header" and "<i>.<name>"
+        np.savez_compressed(buffer, **arrays)  # pyright: ignore[reportArgumentType]
         tmp.write_bytes(buffer.getvalue())
 
     return write_atomically(path, write)

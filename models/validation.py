@@ -16,7 +16,7 @@ raises on bad input: it returns the list of problems, empty for a valid spec.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, TypeGuard
 
 from puzzlebox.models.disassembly_kinds import DISASSEMBLY_KIND_NAMES, DISASSEMBLY_KINDS, DISASSEMBLY_POSE_SIZE
 from puzzlebox.models.errors import ReachabilityUndecided, SpecProblem
@@ -57,7 +57,7 @@ def _is_state(value: Any) -> bool:
     return isinstance(value, int) and not isinstance(value, bool) and value in (0, 1)
 
 
-def _number_list(value: Any, lengths: tuple[int, ...]) -> bool:
+def _number_list(value: Any, lengths: tuple[int, ...]) -> TypeGuard[list[float]]:
     return isinstance(value, list) and len(value) in lengths and all(_is_number(v) for v in value)
 
 
@@ -195,6 +195,7 @@ def validate_data(data: Any) -> list[SpecProblem]:
             else:
                 markers[marker] = name if isinstance(name, str) else where
         if ok:
+            assert isinstance(name, str)  # else not ok
             valid_components[name] = comp
 
     locks = data.get("locks")
@@ -274,6 +275,7 @@ def _check_geometry(data: dict[str, Any], components: dict[str, dict[str, Any]])
         problems.append(SpecProblem("box.pose", "must be 3 finite numbers: x, y, yaw [m, m, rad]"))
     if not size_ok:
         return problems
+    assert size is not None  # size_ok
 
     half_x, half_y = size[0] / 2.0, size[1] / 2.0
     footprints = {}
@@ -332,8 +334,10 @@ def _check_edge(
             f"a {kind} is mounted at the lid's edge, its +x pointing out of the lid perpendicular to an edge: its "
             f"yaw must be a multiple of 90 degrees, got {math.degrees(yaw):.1f} degrees",
         )
-    outward, front = template.front_in_lid((x, y, yaw))  # its +x's lid axis, its front's coordinate along it
+    placement = template.front_in_lid((x, y, yaw))  # its +x's lid axis, its front's coordinate along it
     edge_x = template.edge_x
+    assert placement is not None and edge_x is not None  # an edge-mounted kind's (template.at_edge)
+    outward, front = placement
     half = half_x if outward[0] != 0.0 else half_y
     off = front - half
     if abs(off) <= EDGE_TOLERANCE:

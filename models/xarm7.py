@@ -75,6 +75,13 @@ def robosuite_assets() -> tuple[Path, Path]:
     return robot, gripper
 
 
+def _element(root: mjcf.RootElement, namespace: str, identifier: str) -> mjcf.Element:
+    """``root.find(namespace, identifier)``: an element the robosuite model files have."""
+    element = root.find(namespace, identifier)
+    assert element is not None, f"robosuite's {root.model} model has no {namespace} {identifier!r}"
+    return element
+
+
 def _load_gripper(path: Path) -> mjcf.RootElement:
     text = path.read_text()
     # MuJoCo rejects a `group` attribute on <default>; geoms carry their own group anyway.
@@ -94,7 +101,7 @@ def _load_gripper(path: Path) -> mjcf.RootElement:
     for joint in gripper.find_all("joint"):
         joint.range = [0.0, 0.85]
         joint.limited = True
-    gripper.find("actuator", "fingers_actuator").name = "fingers"
+    _element(gripper, "actuator", "fingers_actuator").name = "fingers"
     # the left and right finger linkages never meet (12 mm or more apart at any opening; their pads do meet)
     for left in ("left_outer_knuckle", "left_inner_knuckle"):
         for right in ("right_outer_knuckle", "right_inner_knuckle"):
@@ -111,15 +118,15 @@ def build_xarm7(config: XArm7Config | None = None) -> mjcf.RootElement:
     robot.model = "xarm7"
     for actuator in list(robot.actuator.all_children()):
         actuator.remove()  # torque motors: replaced by position servos below
-    robot.find("body", "right_hand").remove()  # robosuite's mount, 2.7 cm inside link7
-    robot.find("site", "right_center").remove()
+    _element(robot, "body", "right_hand").remove()  # robosuite's mount, 2.7 cm inside link7
+    _element(robot, "site", "right_center").remove()
     camera = robot.find("camera", "robotview")
     if camera is not None:
         camera.remove()
 
     for i, joint_name in enumerate(ARM_JOINTS, start=1):
         kp, kv, force, damping = _SERVO_GAINS[_SERVO_CLASS[i]]
-        joint = robot.find("joint", joint_name)
+        joint = _element(robot, "joint", joint_name)
         joint.damping = damping
         joint.armature = 0.1
         joint.frictionloss = 1.0
@@ -140,14 +147,14 @@ def build_xarm7(config: XArm7Config | None = None) -> mjcf.RootElement:
     for body1, body2 in (("base", "link1"), ("base", "link2")):
         robot.contact.add("exclude", body1=body1, body2=body2)
 
-    link7 = robot.find("body", "link7")
+    link7 = _element(robot, "body", "link7")
     flange = link7.add("body", name="flange")
     flange.add("site", name="ft_site", size=[0.005], rgba=[1, 0.5, 0, 1], group=4)
     robot.sensor.add("force", name="wrist_force", site="ft_site")
     robot.sensor.add("torque", name="wrist_torque", site="ft_site")
 
     gripper = _load_gripper(gripper_xml)
-    base = gripper.find("body", "xarm_gripper_base_link")
+    base = _element(gripper, "body", "xarm_gripper_base_link")
     base.add("site", name="tcp", pos=[0, 0, TCP_OFFSET], size=[0.004], rgba=[0, 1, 0, 1], group=4)
     # the camera looks along its -z: turned 180 deg about x it looks along the approach axis (+z)
     base.add("camera", name="wrist_camera", pos=[0.075, 0.0, 0.04], quat=[0, 1, 0, 0], fovy=config.wrist_camera_fovy)

@@ -83,7 +83,8 @@ def probe_controller(ip: str, port: int = XARM_CONTROL_PORT, timeout: float = PR
 
 def _default_sdk(ip: str) -> Any:
     try:
-        from xarm.wrapper import XArmAPI
+        # the optional `real` extra, which make install leaves out: missing, it is the error below
+        from xarm.wrapper import XArmAPI  # pyright: ignore[reportMissingImports]
     except ImportError:
         raise SDKMissing(
             "the xArm driver needs xarm-python-sdk: pip install 'puzzlebox[real]' (or xarm-python-sdk)"

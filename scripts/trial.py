@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from puzzlebox.lab.agent_class import check_agent
-from puzzlebox.lab.arm_trial_command import ArmTrialRequest, run_arm_trial
+from puzzlebox.lab.arm_trial_command import ArmTrialRequest, reach_arm, run_arm_trial
 from puzzlebox.lab.cells import CellError, load_cell
 from puzzlebox.lab.cli import fail, one_line
 from puzzlebox.lab.errors import AgentClassError, ArmTrialFailed, ArmTrialRefused, RunStoreError, TrialConfigError
@@ -34,10 +34,9 @@ from puzzlebox.learning.memory import MemoryStore
 from puzzlebox.learning.runner import RunnerError, make_executor
 from puzzlebox.models import SpecError, load_spec
 
-SIMS = ("symbolic", "twin")
-ROBOTS = ("twin", "xarm")
+SIMS, ROBOTS = ("symbolic", "twin"), ("twin", "xarm")
+# where and how runs execute, not their records: left out of the resumable configuration
 NOT_RESULTS = ("out", "resume", "force", "workers", "ray", "robot", "ip", "cell", "record")
-"""Arguments that change where and how runs execute, not their records (left out of the resumable config)."""
 
 
 def _arm_main(args, arm: Callable[[str, Any], Any] | None) -> int:
@@ -46,23 +45,24 @@ def _arm_main(args, arm: Callable[[str, Any], Any] | None) -> int:
         fail("--robot xarm needs --ip ADDRESS (the arm's controller) and --cell FILE (the cell config)")
     if args.sim != "twin":
         fail("--robot xarm runs the perception and skills pipeline: give --sim twin")
-    twin_only = [flag for flag, given in (
-        ("--video", args.video), ("--record", args.record is not None), ("--wrong-kind", args.wrong_kind),
-        ("--reality", args.reality != "ideal"), ("--workers", args.workers is not None),
-        ("--ray", args.ray is not None), ("--resume", args.resume),
-    ) if given]  # fmt: skip
-    if twin_only:
-        fail(f"--robot xarm runs one trial on the arm: {', '.join(twin_only)} are for twin trials")
-    if len(args.specs) != 1:
-        fail(f"--robot xarm tries the one box on the table: give one spec, got {len(args.specs)}")
-    if args.runs != 1:
-        fail(f"--robot xarm runs one trial per command: give --runs 1, got {args.runs}")
-    if args.calibration is None:
-        fail("--robot xarm needs --calibration FILE: the cell's camera calibration (scripts/calibrate.py)")
-    request = ArmTrialRequest(args.ip, args.cell, args.calibration, args.specs[0], args.agent, args.memory,
-                              args.checkpoint, args.seed, args.max_actions, args.max_lockers, Path(args.out),
-                              args.force)  # fmt: skip
     try:
+        reach_arm(args.ip, args.cell, probe=arm is None)  # an address where no arm answers is refused first
+        twin_only = [flag for flag, given in (
+            ("--video", args.video), ("--record", args.record is not None), ("--wrong-kind", args.wrong_kind),
+            ("--reality", args.reality != "ideal"), ("--workers", args.workers is not None),
+            ("--ray", args.ray is not None), ("--resume", args.resume),
+        ) if given]  # fmt: skip
+        if twin_only:
+            fail(f"--robot xarm runs one trial on the arm: {', '.join(twin_only)} are for twin trials")
+        if len(args.specs) != 1:
+            fail(f"--robot xarm tries the one box on the table: give one spec, got {len(args.specs)}")
+        if args.runs != 1:
+            fail(f"--robot xarm runs one trial per command: give --runs 1, got {args.runs}")
+        if args.calibration is None:
+            fail("--robot xarm needs --calibration FILE: the cell's camera calibration (scripts/calibrate.py)")
+        request = ArmTrialRequest(args.ip, args.cell, args.calibration, args.specs[0], args.agent, args.memory,
+                                  args.checkpoint, args.seed, args.max_actions, args.max_lockers, Path(args.out),
+                                  args.force)  # fmt: skip
         record, out = run_arm_trial(request, arm)
     except ArmTrialRefused as err:
         fail(f"--robot xarm: {err}")

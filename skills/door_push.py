@@ -16,14 +16,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
 from puzzlebox.models.kinds import HANDLE_HEIGHT, HANDLE_MARGIN, HANDLE_SIZE
 from puzzlebox.skills.errors import IKFailure
 from puzzlebox.skills.joint_model import GRASP_DEPTH, JointModel, cross
-from puzzlebox.skills.kinematics import top_down
+from puzzlebox.skills.kinematics import ArmKinematics, top_down
 from puzzlebox.skills.toggle_result import ToggleResult
+
+if TYPE_CHECKING:
+    from puzzlebox.models.robot import Robot
 
 PUSHED_IN_VAIN = "latched: pushed without progress"
 
@@ -197,9 +201,59 @@ class DoorPush:
         return math.atan2(b, a) - math.acos(max(-1.0, min(1.0, self.contact[0] / radius)))
 
 
+class PushingConfig(Protocol):
+    """What the pushes read of the toggler's config (:class:`skills.primitives.PrimitiveConfig`, which this
+    module cannot import: it imports this one)."""
+
+    @property
+    def push(self) -> DoorPushConfig: ...
+    @property
+    def tick(self) -> float: ...
+    @property
+    def settle_time(self) -> float: ...
+    @property
+    def actuate_time(self) -> float: ...
+    @property
+    def release_time(self) -> float: ...
+    @property
+    def breakaway_fraction(self) -> float: ...
+    @property
+    def breakaway_pace(self) -> float: ...
+    @property
+    def moved_fraction(self) -> float: ...
+    @property
+    def blocked_progress(self) -> float: ...
+    @property
+    def blocked_force(self) -> float: ...
+    @property
+    def blocked_magnitude(self) -> float: ...
+    @property
+    def overtravel_force(self) -> float: ...
+
+
 class DoorPushing:
     """The door pushes of :class:`skills.primitives.Toggler` (a mixin: it moves through the toggler's own
     ticks, force guard and retreat, and reads ``config.push``)."""
+
+    # What the pushes use of the toggler, declared for type checkers (Toggler sets and defines them).
+    config: PushingConfig
+    robot: Robot
+    ik: ArmKinematics
+    force_in_base: np.ndarray
+    slowdown: float
+    phase: str
+    progress: float
+    cautious: bool
+
+    if TYPE_CHECKING:
+
+        def grasp_yaw(self, jm: JointModel) -> float: ...
+        def filtered_noise_now(self) -> float: ...
+        def move_to(self, target: np.ndarray, duration: float) -> None: ...
+        def _tick(self, target: np.ndarray) -> tuple[float, float]: ...
+        def _descend_to(self, target: np.ndarray) -> None: ...
+        def _let_go_and_retreat(self, guarded: bool = True) -> None: ...
+        def _verdict(self, progress: float, forces: list[float], latched: str | None = None) -> ToggleResult: ...
 
     def _push_door_open(self, jm: JointModel, start: float = 0.0) -> ToggleResult:
         """Open a door by pushing the back face of its handle with the inner face of a finger pad (see
@@ -417,7 +471,7 @@ class DoorPushing:
                 if pressed_at is None:
                     pressed_at = (progress, face)
             slid = pressed_at is not None and progress - pressed_at[0] >= p.slide_turn / door.travel
-            if slid and face - pressed_at[1] < 0.5 * (progress - pressed_at[0]):
+            if slid and pressed_at is not None and face - pressed_at[1] < 0.5 * (progress - pressed_at[0]):
                 self._back_off(door, angle)
                 if start >= c.blocked_progress:  # a door held part-way open is stuck, not latched: no evidence
                     return ToggleResult("failed", f"Jammed: the door held at {start:.0%} of its travel",

@@ -31,7 +31,7 @@ class VelocityQP:
         damping: float,
     ) -> None:
         model = configuration.model
-        kinds = (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
+        kinds = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
         if model.nq != model.nv or not np.isin(model.jnt_type, kinds).all():
             raise ValueError("VelocityQP needs a model of hinge and slide joints only (q and v then coincide)")
         self._configuration, self._frame, self._posture = configuration, frame, posture
@@ -53,6 +53,7 @@ class VelocityQP:
         q = self._configuration.data.qpos
         W, e, mu = self._frame.compute_qp_residual(self._configuration)
         posture = self._posture
+        assert posture.target_q is not None  # ArmKinematics set it
         cost = posture.cost
         # hinge/slide joints: q ⊖ q* is a plain difference (mink's mj_differentiatePos)
         weighted_posture_error = cost * (-posture.gain * (q - posture.target_q))

@@ -90,7 +90,8 @@ def upright_pose(planar_pose: np.ndarray, height: float) -> np.ndarray:
     Seen from above, a small marker's tilt is ill-conditioned (the two IPPE solutions differ by
     several degrees) while its position and yaw are accurate; a box on a level table has its lid
     level, so components are placed upright."""
-    return geometry.upright_pose(*planar_pose, height)
+    x, y, yaw = planar_pose
+    return geometry.upright_pose(x, y, yaw, height)
 
 
 def lid_height(detections: dict[int, MarkerDetection], lifts: dict[int, float] | None = None) -> float:

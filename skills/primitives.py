@@ -49,6 +49,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from puzzlebox.models.cell_config import CellConfig
+from puzzlebox.models.robot import Robot
 from puzzlebox.skills.door_push import DoorPushConfig, DoorPushing
 from puzzlebox.skills.errors import ForceLimitExceeded, GraspFailure, IKFailure, SlipDetected
 from puzzlebox.skills.joint_model import JointModel
@@ -310,7 +311,11 @@ def _median_rows(rows: collections.abc.Sequence[np.ndarray]) -> np.ndarray:
 class Toggler(DoorPushing):
     """Runs toggle primitives on a robot interface (``twin.robot_interface.RobotInterface`` or a real one)."""
 
-    def __init__(self, robot, config: PrimitiveConfig | None = None, kinematics: ArmKinematics | None = None) -> None:
+    config: PrimitiveConfig
+
+    def __init__(
+        self, robot: Robot, config: PrimitiveConfig | None = None, kinematics: ArmKinematics | None = None
+    ) -> None:
         self.robot = robot
         self.config = config or PrimitiveConfig()
         self.ik = kinematics or ArmKinematics()
@@ -603,8 +608,9 @@ class Toggler(DoorPushing):
         self.rest_noise = self.force_noise()  # coming to rest above the part
         self.robot.tare(self.tare_samples(self.rest_noise))  # fingers open, arm still: the gripper's load alone
         # older samples were taken with another zero; the window is as long as this noise needs
-        self._force_window = collections.deque(maxlen=self.filter_samples(self.rest_noise))
-        self.slowdown = self._force_window.maxlen / c.force_filter_samples
+        samples = self.filter_samples(self.rest_noise)
+        self._force_window = collections.deque(maxlen=samples)
+        self.slowdown = samples / c.force_filter_samples
         self.phase = "descending"
         if not self.cautious:
             self.move_to(target, c.descend_time * self.slowdown)
@@ -645,7 +651,9 @@ class Toggler(DoorPushing):
             jm.travel
             if jm.joint == "slide"
             else jm.travel
-            * np.linalg.norm((jm.grasp_point - jm.origin) - np.dot(jm.grasp_point - jm.origin, jm.axis) * jm.axis)
+            * float(
+                np.linalg.norm((jm.grasp_point - jm.origin) - np.dot(jm.grasp_point - jm.origin, jm.axis) * jm.axis)
+            )
         )
         lead = c.lead / path_length  # as a fraction of the travel
         end = 1.0 + (c.door_overtravel if jm.handling.swings_up and sign > 0 else 0.0)
@@ -849,6 +857,7 @@ class Toggler(DoorPushing):
                 for side in (0.0, 1.0, -1.0):
                     try:
                         if side:
+                            assert origin is not None  # the first try (side 0) ended in a touch
                             self._step_along_pads(origin, side * away)
                         up = self.robot.tcp_pose_in_base()
                         self._rise(up, min(up[2, 3] + c.lift_slow_height, top))

@@ -128,6 +128,7 @@ class SceneSurvey:
         so the TCP stays at least ``MIN_REACH`` from the base axis; False if the arm cannot, or if the force
         limit stopped it (it then withdraws)."""
         T_tcp_camera = self.calibration.camera(self.config.wrist_camera).T_tcp_camera
+        assert T_tcp_camera is not None  # the wrist camera is on the arm
         for yaw in yaws:
             target = top_down(np.zeros(3), yaw)
             target[:3, 3] = np.asarray(point, float) + (0.0, 0.0, height) - target[:3, :3] @ T_tcp_camera[:3, 3]

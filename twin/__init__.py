@@ -11,7 +11,7 @@ pay for that (nor fail there when EGL is unavailable: the renderer reports that 
 
 import importlib
 import os
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # before mujoco/dm_control load: headless EGL by default
 
@@ -27,6 +27,15 @@ from puzzlebox.twin.errors import (  # noqa: E402
 )
 from puzzlebox.twin.rendering import RenderConfig, Renderer  # noqa: E402
 from puzzlebox.twin.video import VideoWriter  # noqa: E402
+
+if TYPE_CHECKING:  # the lazy names below, for type checkers
+    from puzzlebox.twin.reality import PRESETS, RealityProfile, load_profile
+    from puzzlebox.twin.robot_interface import RobotInterface
+    from puzzlebox.twin.scripted_sweep import sweep_open
+    from puzzlebox.twin.session import TwinConfig, TwinSession, TwinState
+    from puzzlebox.twin.system_id import FitConfig, fit_kind
+    from puzzlebox.twin.toggle_replay import KindScales, ToggleReplay
+    from puzzlebox.twin.toggle_scoring import prepare, toggle_errors
 
 _LAZY = {
     "PRESETS": "puzzlebox.twin.reality",

@@ -125,7 +125,9 @@ class CalibrationCell:
     @property
     def box_height(self) -> float:
         """Height of the box's lid above the table [m] (the spec's; the overview camera hangs 0.5 m above it)."""
-        return float(self.session.spec.box.size[2])
+        box = self.session.spec.box
+        assert box is not None  # the twin builds puzzle boxes only (models.scene)
+        return float(box.size[2])
 
     def close(self) -> None:
         self.session.close()
@@ -231,6 +233,7 @@ class CalibrationCell:
         :attr:`RigConfig.wrist_max_roll` (hand-eye needs rotations about several axes)."""
         c = self.config
         T_tcp_camera = self.nominal.camera(self.wrist_camera).T_tcp_camera
+        assert T_tcp_camera is not None  # the wrist camera is on the arm
         centre = T_base_board[:3, :3] @ self.board.center_in_board + T_base_board[:3, 3]
         up = -T_base_board[:3, 2]  # the board's z goes into the board
         # Nominal: the gripper straight down, its x along the base x (skills.kinematics.top_down(p, 0)).
@@ -249,7 +252,7 @@ class CalibrationCell:
             )
             R_camera0 = (Rotation.from_matrix(R_down) * R_tcp).as_matrix() @ T_tcp_camera[:3, :3]
             # The smallest turn taking the nominal camera axis onto the wanted one keeps the roll.
-            turn, _ = Rotation.align_vectors([z_camera], [R_camera0[:, 2]])
+            turn = Rotation.align_vectors([z_camera], [R_camera0[:, 2]])[0]
             T_base_camera = np.eye(4)
             T_base_camera[:3, :3] = turn.as_matrix() @ R_camera0
             T_base_camera[:3, 3] = camera_position

@@ -41,6 +41,7 @@ from pathlib import Path
 import imageio.v3 as iio
 import mujoco
 import numpy as np
+from numpy.typing import ArrayLike
 
 from puzzlebox.models.atomic import write_atomically
 from puzzlebox.models.kinds import get_kind
@@ -102,7 +103,7 @@ class View:
     """The point on the optical axis the view was framed on, world frame [m]."""
 
 
-def _camera_axes(towards_camera: np.ndarray, up: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _camera_axes(towards_camera: ArrayLike, up: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Unit right, image-up and back (target to camera) axes of a camera, world frame."""
     back = np.asarray(towards_camera, dtype=float)
     back = back / np.linalg.norm(back)
@@ -116,7 +117,8 @@ def _camera_axes(towards_camera: np.ndarray, up: np.ndarray) -> tuple[np.ndarray
 def _view(name: str, position: np.ndarray, axes: tuple[np.ndarray, ...], fovy: float, target: np.ndarray) -> View:
     quat = np.empty(4)
     mujoco.mju_mat2Quat(quat, np.column_stack(axes).ravel())
-    return View(name, tuple(np.asarray(position, float).tolist()), tuple(quat.tolist()), fovy, tuple(target.tolist()))
+    w, x, y, z = quat.tolist()
+    return View(name, tuple(np.asarray(position, float).tolist()), (w, x, y, z), fovy, tuple(target.tolist()))
 
 
 def frame_view(
@@ -124,7 +126,7 @@ def frame_view(
     towards_camera: np.ndarray,
     points: np.ndarray,
     aspect: float,
-    up: np.ndarray = (0.0, 0.0, 1.0),
+    up: ArrayLike = (0.0, 0.0, 1.0),
     fovy: float = FOVY,
     margin: float = MARGIN,
 ) -> View:
@@ -252,7 +254,7 @@ class Gallery:
         """Image width / height."""
         return self.config.width / self.config.height
 
-    def _lid_to_world(self, points: np.ndarray) -> np.ndarray:
+    def _lid_to_world(self, points: ArrayLike) -> np.ndarray:
         T = self.scene.T_world_lid
         return np.asarray(points, dtype=float) @ T[:3, :3].T + T[:3, 3]
 
@@ -276,6 +278,7 @@ class Gallery:
     def box_points(self) -> np.ndarray:
         """``(n, 3)`` points every whole-box view frames, world frame [m]: the shell's eight corners (lid frame
         ``(±length/2, ±width/2, 0 or -height)``) and every component's :meth:`component_points`."""
+        assert self.spec.box is not None  # build_scene refused a spec without one
         length, width, height = self.spec.box.size
         shell = [[sx * length / 2, sy * width / 2, z] for sx in (-1, 1) for sy in (-1, 1) for z in (0.0, -height)]
         parts = [self.component_points(c.name) for c in self.spec.components]

@@ -27,7 +27,7 @@ class Jams:
     def __init__(
         self,
         model: mujoco.MjModel,
-        part_geoms: Sequence[Sequence[int]],
+        part_geoms: Sequence[np.ndarray | Sequence[int]],
         gripper_bodies: np.ndarray,
         travel: np.ndarray,
         probability: float,

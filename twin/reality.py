@@ -327,7 +327,7 @@ def _convert(hint: Any, value: Any, path: str) -> Any:
                 return None
             raise ProfileError(f"{path}: may not be null")
         return _convert(options[0], value, path)
-    if dataclasses.is_dataclass(hint):
+    if isinstance(hint, type) and dataclasses.is_dataclass(hint):  # (a hint is a class, never an instance)
         return _from_plain(hint, value, path)
     if origin is tuple:
         args = typing.get_args(hint)

@@ -122,6 +122,7 @@ def _value_at(section: str, name: str, level: float) -> Any:
             return high if high is not None else low
         low, high = (nominal if low is None else low), (nominal if high is None else high)
     if isinstance(high, tuple):
+        assert isinstance(low, tuple)  # the presets' fields have one type (the nominal ones are floats)
         return tuple(_clip(section, name, _lerp(a, b, t)) for a, b in zip(low, high, strict=True))
     if isinstance(high, int) and not isinstance(high, bool) and isinstance(low, int):
         return max(1, round(_lerp(low, high, t))) if name == "occluder_count" else round(_lerp(low, high, t))

@@ -376,7 +376,7 @@ class Renderer:
             RenderingError: if the renderer is closed.
         """
         self._camera.fixedcamid = self.camera_id(camera)
-        if self._mjr_context is None:
+        if self._mjr_context is None or self._gl_context is None:  # (closed together)
             raise RenderingError("render() called on a closed Renderer; create a new one")
         mujoco.mjv_updateScene(
             self._model, data, self._option, None, self._camera, mujoco.mjtCatBit.mjCAT_ALL, self._scene

@@ -235,9 +235,10 @@ class RolloutDrawer:
         for view in VIEWS:
             image = np.ascontiguousarray(self.render_view(view))
             camera = {"overview": self.cameras.overview, "wrist": self.cameras.wrist}.get(view)
-            captured, found = frame.detections.get(camera, (-math.inf, []))
-            if camera is not None and frame.time - captured <= c.detection_hold:
-                self._outline(image, found)
+            if camera is not None:
+                captured, found = frame.detections.get(camera, (-math.inf, []))
+                if frame.time - captured <= c.detection_hold:
+                    self._outline(image, found)
             cv2.rectangle(image, (0, 0), (8 + 9 * len(view), 22), (30, 30, 30), -1)
             cv2.putText(image, view, (5, 16), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA)
             tiles.append(image)
@@ -311,7 +312,7 @@ def _serve(inbox, outbox) -> None:
     _watch_parent(multiprocessing.parent_process(), current)
     while (job := inbox.get()) is not None:
         try:
-            outbox.put(("ok", _draw_video(*job, inbox, current)))
+            outbox.put(("ok", _draw_video(*job, inbox=inbox, current=current)))
         except BaseException as err:  # noqa: BLE001 (reported to the parent, which raises it)
             outbox.put(("error", f"{type(err).__name__}: {err}"))
             return
@@ -363,8 +364,9 @@ def _watch_parent(parent: Any, current: dict[str, Any]) -> None:
         # (ffmpeg, its input closed by the exit, finishes into the unlinked file and exits)
         video = current["video"]
         for path in (current["model"], None if video is None else video.temporary_path):
-            with contextlib.suppress(FileNotFoundError, TypeError):
-                os.unlink(path)
+            if path is not None:
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(path)
         os._exit(1)
 
     threading.Thread(target=watch, name="rollout-parent-watch", daemon=True).start()

@@ -108,7 +108,7 @@ def fit_kind(kind: str, toggles: Sequence[PreparedToggle], config: FitConfig | N
     weight = config.prior_weight
 
     def scales_of(x: np.ndarray) -> KindScales:
-        values = dict.fromkeys(PARAMETERS, 1.0)
+        values: dict[str, float] = dict.fromkeys(PARAMETERS, 1.0)
         values.update({p: float(math.exp(v)) for p, v in zip(free, x, strict=True)})
         return KindScales(**values)
 

@@ -233,7 +233,7 @@ class ToggleReplay:
             k = self.window.start + i
             servos.command_joints(log.joint_command[k])
             servos.command_gripper(float(log.gripper_command[k]) * GRIPPER_CTRL_MAX)
-            self._advance(round((log.time[k] - log.time[k - 1]) / dt), servos, ft)
+            self._advance(round(float(log.time[k] - log.time[k - 1]) / dt), servos, ft)
             R = d.site_xmat[self._site].reshape(3, 3)
             load = ft.read(float(d.time))
             out.force[i], out.torque[i], out.rotation[i] = R @ load[:3], R @ load[3:], R

@@ -12,7 +12,9 @@ import contextlib
 import os
 import tempfile
 import warnings
+from collections.abc import Generator
 from pathlib import Path
+from typing import Any
 
 import imageio_ffmpeg
 import numpy as np
@@ -74,7 +76,7 @@ class VideoWriter(PublishedOnExit):
         self._shape: tuple[int, int, int] | None = None
         self._frames = 0
         self._temporary: Path | None = None
-        self._encoder = None
+        self._encoder: Generator[Any, Any, Any] | None = None
         self._closed = False
 
     @property
@@ -129,6 +131,7 @@ class VideoWriter(PublishedOnExit):
                 f"frame {self._frames} has shape {frame.shape}, but this video's frames have shape {self._shape} "
                 "(fixed by the first frame)"
             )
+        assert self._encoder is not None  # started by the first frame, None again only once closed
         try:
             self._encoder.send(np.ascontiguousarray(frame))
         except Exception as exc:
@@ -142,13 +145,15 @@ class VideoWriter(PublishedOnExit):
         handle, name = tempfile.mkstemp(prefix=f".{self._path.stem}.", suffix=".mp4", dir=self._path.parent)
         os.close(handle)
         self._temporary = Path(name)
-        self._encoder = imageio_ffmpeg.write_frames(
+        # (imageio-ffmpeg has no annotations: the checker takes its fps and quality for ints, from their defaults)
+        self._encoder = encoder = imageio_ffmpeg.write_frames(
             str(self._temporary),
             (width, height),
             pix_fmt_in="rgb24",
             pix_fmt_out="yuv420p",
-            fps=self._fps,
-            quality=None,  # imageio-ffmpeg's 0-10 scale; the crf below says it in x264's own terms
+            fps=self._fps,  # pyright: ignore[reportArgumentType]
+            # imageio-ffmpeg's 0-10 scale; the crf below says it in x264's own terms
+            quality=None,  # pyright: ignore[reportArgumentType]
             codec="libx264",
             # Sizes are checked to be even above; ffmpeg must not rescale to multiples of 16.
             macro_block_size=1,
@@ -157,7 +162,7 @@ class VideoWriter(PublishedOnExit):
             output_params=["-crf", str(self._crf), "-preset", self._preset]
             + (["-movflags", "+faststart"] if self._faststart else []),
         )
-        self._encoder.send(None)  # start ffmpeg
+        encoder.send(None)  # start ffmpeg
 
     def close(self) -> None:
         """Finish the video and move it to its final path. Idempotent.
@@ -170,7 +175,7 @@ class VideoWriter(PublishedOnExit):
         self._closed = True
         encoder, temporary = self._encoder, self._temporary
         self._encoder = self._temporary = None
-        if encoder is None:
+        if encoder is None or temporary is None:  # (None together)
             raise VideoError(f"no frames were appended; nothing was written to {self._path}")
         try:
             encoder.close()  # waits for ffmpeg to finish the file

@@ -42,7 +42,7 @@ class DQNConfig(LearnerConfig):
     taken back for one that puts a component back, 1 -> 0 (so a cycle earns nothing). 0: sparse."""
 
 
-class DQNAgent(EpsilonGreedyLearner):
+class DQNAgent(EpsilonGreedyLearner[DQNConfig]):
     """The agent (``Agent`` protocol). ``training=True``: epsilon-greedy with learning; else evaluation."""
 
     base_name = "dqn"
@@ -56,6 +56,7 @@ class DQNAgent(EpsilonGreedyLearner):
         self.optimizer = torch.optim.Adam(self.q.parameters(), lr=self.config.learning_rate, fused=True)
 
     def greedy_values(self, observation: SceneObservation) -> np.ndarray:
+        assert self._last is not None  # choose() set it
         nodes, edges = self._last
         with torch.no_grad():
             return self.q(torch.from_numpy(nodes)[None], torch.from_numpy(edges)[None])[0].numpy()
@@ -66,6 +67,7 @@ class DQNAgent(EpsilonGreedyLearner):
         self._goal = (observation.goal_index, observation.goal_state)
 
     def observe_outcome(self, index: int, moved: bool, observation: SceneObservation) -> None:
+        assert self._last is not None  # record() checked
         nodes, edges = self._last
         next_nodes, next_edges = self.tensors(observation)
         if self.config.is_multitask:  # stored once the episode's outcome is known
@@ -106,5 +108,8 @@ class DQNAgent(EpsilonGreedyLearner):
         loss.backward()
         self.optimizer.step()
         with torch.no_grad():  # target <- (1 - tau) target + tau q, in one fused call
-            torch._foreach_lerp_(list(self.target.parameters()), list(self.q.parameters()), self.config.tau)
+            # (torch leaves its fused foreach ops out of its public names)
+            torch._foreach_lerp_(  # pyright: ignore[reportPrivateImportUsage]
+                list(self.target.parameters()), list(self.q.parameters()), self.config.tau
+            )
         return loss.item()

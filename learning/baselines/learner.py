@@ -8,7 +8,7 @@ from __future__ import annotations
 import random
 from collections import defaultdict, deque
 from dataclasses import dataclass, field
-from typing import Any, Self
+from typing import Any, Generic, Self, TypeVar
 
 import numpy as np
 import torch
@@ -47,8 +47,12 @@ class LearnerConfig:
         return self.share_across_tasks or self.balance
 
 
-class EpsilonGreedyLearner:
-    """Base of the deep agents, configured by a :class:`LearnerConfig` (or a subclass of it); named
+ConfigT = TypeVar("ConfigT", bound=LearnerConfig)
+"""A deep agent's config class."""
+
+
+class EpsilonGreedyLearner(Generic[ConfigT]):
+    """Base of the deep agents, configured by a :class:`LearnerConfig` (or a subclass of it, ``ConfigT``); named
     ``base_name``, with an ``mt-`` prefix when the config turns MT-OPT on.
 
     The replay holds, per component count, two buffers: ``success`` and ``failure`` examples (what
@@ -59,7 +63,7 @@ class EpsilonGreedyLearner:
 
     base_name = "learner"
 
-    def __init__(self, config: LearnerConfig) -> None:
+    def __init__(self, config: ConfigT) -> None:
         self.config = config
         self.name = f"mt-{self.base_name}" if config.is_multitask else self.base_name
         torch.manual_seed(config.seed)

@@ -46,7 +46,7 @@ class _Example:
     moved: bool
 
 
-class ModelBasedAgent(EpsilonGreedyLearner):
+class ModelBasedAgent(EpsilonGreedyLearner[ModelBasedConfig]):
     """The agent (``Agent`` protocol); ``training=True`` explores and fits, else evaluates."""
 
     base_name = "model-based"
@@ -75,6 +75,7 @@ class ModelBasedAgent(EpsilonGreedyLearner):
         return self.config.gamma * free[:, x] * values[[x ^ (1 << c) for c in range(len(observation))]]
 
     def observe_outcome(self, index: int, moved: bool, observation: SceneObservation) -> None:
+        assert self._last is not None  # record() checked
         nodes, edges = self._last
         goals = range(len(nodes)) if self.config.share_across_tasks else [None]
         for goal in goals:

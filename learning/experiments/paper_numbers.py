@@ -2,10 +2,23 @@
 
 from __future__ import annotations
 
+from typing import TypedDict
+
 CONVERGED = "converged"
 """An x value meaning "the deep agents' training until convergence" (``DeepSchedule.converged_episodes``)."""
 
-PAPER: dict[str, list[dict[str, object]]] = {
+
+class PaperFigure(TypedDict):
+    """One of the paper's figures: what it is, the agent and x value it belongs to, the result's key, the value."""
+
+    what: str
+    agent: str
+    x: int | str
+    key: str
+    paper: float
+
+
+PAPER: dict[str, list[PaperFigure]] = {
     "variants": [
         {"what": "1 training variant, success", "agent": "memory", "x": 1, "key": "success_rate", "paper": 0.987},
         {"what": "9 training variants, success", "agent": "memory", "x": 9, "key": "success_rate", "paper": 1.0},

@@ -63,7 +63,9 @@ def _trained_store(variants: Sequence[int], episodes: int, seed: int, config: Pr
     return store
 
 
-def _untrained_scores(agents: Sequence[str], config: ProtocolConfig, **kwargs: Any) -> dict[str, dict[str, float]]:
+def _untrained_scores(
+    agents: Sequence[str], config: ProtocolConfig, **kwargs: Any
+) -> dict[str, dict[str, float | int | list[float]]]:
     """Agents that learn nothing across tasks score the same at every x: evaluate them once."""
     return {
         name: summarise_scores([evaluate(agent_factory(name, None, config), config, **kwargs)])

@@ -275,7 +275,8 @@ class MemoryStore:
         every compact pair key as its SE(3) key (schemas 1 to 3)."""
         if self._conn is None or self._schema == str(SCHEMA_VERSION):
             return
-        conn = self._conn
+        conn, path = self._conn, self.path
+        assert path is not None  # the connection is to the file at path
         conn.execute("BEGIN IMMEDIATE")  # hold the write lock: another trainer may be upgrading too
         try:
             schema = conn.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()[0]
@@ -286,7 +287,7 @@ class MemoryStore:
                 rows = conn.execute("SELECT rowid, key FROM pair_entries").fetchall()
                 conn.executemany(
                     "UPDATE pair_entries SET key = ? WHERE rowid = ?",
-                    [(se3_key_from_legacy(_decode(key, self.path), self.rotation_weight).tobytes(), rowid)
+                    [(se3_key_from_legacy(_decode(key, path), self.rotation_weight).tobytes(), rowid)
                      for rowid, key in rows],
                 )  # fmt: skip
                 conn.execute("INSERT INTO meta VALUES ('rotation_weight', ?)", (repr(self.rotation_weight),))

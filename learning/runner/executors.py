@@ -267,6 +267,7 @@ class RayExecutor:
 
     def run(self, tasks: Iterable[Task], stop: Callable[[], bool]) -> Iterator[Completion]:
         import ray
+        import ray.exceptions
 
         pending: deque[Task] = deque(tasks)
         in_flight: dict[Any, Task] = {}
@@ -275,8 +276,11 @@ class RayExecutor:
             while pending or in_flight:
                 while pending and len(in_flight) < window and not stop():
                     task = pending.popleft()
+                    # (ray's overloads of remote() took execute for its first two parameters: the third has a default)
                     ref = self._remote.options(num_cpus=task.cpus).remote(
-                        task.function, dict(task.settings), task.context
+                        task.function,
+                        dict(task.settings),
+                        task.context,  # pyright: ignore[reportCallIssue]
                     )
                     in_flight[ref] = task
                 if not in_flight:

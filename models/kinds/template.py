@@ -15,6 +15,7 @@ above the surface were grasped in every randomized run).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -78,7 +79,7 @@ class KindTemplate:
             return self.footprint
         return clip_below_x(self.footprint, self.edge_x)
 
-    def front_in_lid(self, pose: tuple[float, float, float]) -> tuple[tuple[float, float], float] | None:
+    def front_in_lid(self, pose: Sequence[float]) -> tuple[tuple[float, float], float] | None:
         """For an edge-mounted kind at ``pose`` ``[x, y, yaw]`` (yaw taken to the nearest multiple of 90
         degrees): the lid axis its +x points along, ``(±1, 0)`` or ``(0, ±1)``, and its front face's
         coordinate along that axis [m]; None for a kind that stands anywhere on the lid."""
@@ -88,10 +89,10 @@ class KindTemplate:
         axis = (float(round(math.cos(yaw))), float(round(math.sin(yaw))))
         return axis, axis[0] * x + axis[1] * y + self.edge_x
 
-    def on_lid_footprint_in_lid(self, pose: tuple[float, float, float]) -> np.ndarray:
+    def on_lid_footprint_in_lid(self, pose: Sequence[float]) -> np.ndarray:
         """:meth:`on_lid_footprint` in the lid frame for a component at ``pose`` ``[x, y, yaw]``."""
         return transform_points(pose, self.on_lid_footprint())
 
-    def footprint_in_lid(self, pose: tuple[float, float, float]) -> np.ndarray:
+    def footprint_in_lid(self, pose: Sequence[float]) -> np.ndarray:
         """The footprint polygon in the lid frame for a component at ``pose`` ``[x, y, yaw]``."""
         return transform_points(pose, self.footprint)

@@ -18,8 +18,9 @@ from puzzlebox.lab.run_store import RunStore
 from puzzlebox.learning import LearningError, make_agent, summarise
 from puzzlebox.learning.memory import MemoryStore
 from puzzlebox.models import SpecError, load_spec
+from puzzlebox.models.cell_config import CellConfig
 
-__all__ = ["ArmTrialRequest", "run_arm_trial"]
+__all__ = ["ArmTrialRequest", "reach_arm", "run_arm_trial"]
 
 
 @dataclass(frozen=True)
@@ -42,20 +43,29 @@ class ArmTrialRequest:
     force: bool
 
 
+def reach_arm(ip: str, cell: Path, probe: bool = True) -> CellConfig:
+    """The cell config at ``cell``, and — with ``probe`` — whether an arm answers at ``ip`` (in about a second):
+    what is refused first, before any other check. Raises :class:`ArmTrialRefused`."""
+    from puzzlebox.models.cell_config import CellConfigError, load_cell_config
+    from puzzlebox.real import RealError, probe_controller
+
+    try:
+        config = load_cell_config(cell)
+        if probe:
+            probe_controller(ip)
+    except (CellConfigError, RealError) as err:
+        raise ArmTrialRefused(one_line(err)) from err
+    return config
+
+
 def run_arm_trial(request: ArmTrialRequest, arm: Callable[[str, Any], Any] | None = None) -> tuple[dict, Path]:
     """Run the trial ``request`` asks for on the arm ``arm(ip, cell)`` connects to (default ``real.XArmRobot``,
     after probing the address); returns its record and the output directory. Raises :class:`ArmTrialRefused`
     (before the arm moves) or :class:`ArmTrialFailed` (the arm failed a call mid-trial; what was done is kept)."""
     from puzzlebox.models.calibration import CalibrationError, CellCalibration
-    from puzzlebox.models.cell_config import CellConfigError, load_cell_config
-    from puzzlebox.real import RealError, XArmRobot, probe_controller
+    from puzzlebox.real import RealError, XArmRobot
 
-    try:
-        cell = load_cell_config(request.cell)
-        if arm is None:
-            probe_controller(request.ip)
-    except (CellConfigError, RealError) as err:
-        raise ArmTrialRefused(one_line(err)) from err
+    cell = reach_arm(request.ip, request.cell, probe=False)  # probed first by the caller (reach_arm)
     if request.max_actions < 1 or request.seed < 0:
         raise ArmTrialRefused("--max-actions must be >= 1 and --seed >= 0")
     try:

@@ -60,7 +60,8 @@ _rays_lock = threading.Lock()
 
 
 def _cached_rays(K: np.ndarray, dist: np.ndarray, size: tuple[int, int]) -> np.ndarray:
-    key = (np.asarray(K, dtype=np.float64).tobytes(), np.asarray(dist, dtype=np.float64).tobytes(), tuple(size))
+    width, height = size  # (a list, read from a file, is no key)
+    key = (np.asarray(K, dtype=np.float64).tobytes(), np.asarray(dist, dtype=np.float64).tobytes(), (width, height))
     with _rays_lock:
         rays = _rays_cache.get(key)
     if rays is None:
@@ -154,7 +155,7 @@ class Cameras:
             self._renderer = renderer_pool.acquire(self._model, self.render_config)
         rgb = self._renderer.render(self._data, camera)
         lens = self._lenses[camera]
-        if lens.map_x is not None:
+        if lens.map_x is not None and lens.map_y is not None:  # (None together)
             rgb = cv2.remap(rgb, lens.map_x, lens.map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
         if self._frame_effects:
             rgb = self._effects(rgb, camera, lens, rng)

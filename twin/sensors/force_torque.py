@@ -88,7 +88,8 @@ class ForceTorqueSensor:
         value = self._delayed_load(time) + self.bias + self.drift_rate * time
         if self._noise is not None:
             value = value + self._rng.normal(0.0, self._noise)
-        if self._limits is not None:  # the sensor's raw range, before any tare (np.clip of a finite value)
+        # the sensor's raw range, before any tare (np.clip of a finite value); _low is None with _limits
+        if self._limits is not None and self._low is not None:
             value = np.minimum(np.maximum(value, self._low), self._limits)
         if self._resolution is not None:
             value = np.where(self._quantised, np.round(value / self._step) * self._step, value)
