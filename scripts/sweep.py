@@ -43,7 +43,7 @@ def cell_summaries(records: dict[str, dict], cells: dict[str, Cell], max_actions
                                "box_pose": cell.box_pose, "agent": cell.agent, "profile": cell.profile,
                                "runs_done": len(runs)}  # fmt: skip
         if runs:
-            s = summarise(runs, max_actions)
+            s = summarise(list(runs), max_actions)
             row.update(success_rate=s["success_rate"], mean_actions=s["mean_actions"])
             timeline = [a for r in runs for a in r.get("timeline", [])]
             if timeline:
@@ -105,7 +105,7 @@ def main(argv: list[str] | None = None) -> int:
 
     def results() -> dict[str, Any]:
         runs = [found[k] for k in keys if k in found]
-        summary = summarise(runs, sweep["max_actions"])
+        summary = summarise(list(runs), sweep["max_actions"])
         summary.update(runs_done=len(runs), runs_planned=len(tasks),
                        cells=cell_summaries(found, cells, sweep["max_actions"]))  # fmt: skip
         return summary

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib
 import inspect
+from os import PathLike
 from typing import Any
 
 from puzzlebox.lab.errors import AgentClassError, TrialConfigError
@@ -60,7 +61,7 @@ def make_agent_object(name: str) -> Any:
     return agent
 
 
-def check_agent(agent: str, memory: str | None, checkpoint: str | None, max_lockers: int) -> bool:
+def check_agent(agent: str, memory: str | PathLike[str] | None, checkpoint: str | None, max_lockers: int) -> bool:
     """Refuse an agent that cannot run as asked (``trial.py``'s ``--agent``, ``--memory``, ``--checkpoint``,
     ``--max-lockers``): :class:`AgentClassError` for a class of one's own that is not an agent,
     :class:`TrialConfigError` for the rest. True for an agent class of one's own."""

@@ -11,7 +11,7 @@ from puzzlebox.lab.cli import one_line
 from puzzlebox.lab.errors import BoxBuildError
 from puzzlebox.lab.spec_files import load_box_spec
 from puzzlebox.models import LockRule, ModelsError, PuzzleSpec
-from puzzlebox.models.mechanism_mjcf import mechanism_layout
+from puzzlebox.models.mechanism_mjcf import LockMode, mechanism_layout
 
 
 def rule_text(rule: LockRule) -> str:
@@ -26,7 +26,7 @@ def latch_only(spec: PuzzleSpec, locks: str) -> list[tuple[LockRule, str]]:
     return [(u.rule, u.reason) for u in mechanism_layout(spec).unrealized]
 
 
-def export_mjcf(file: str, out: str, box_only: bool, locks: str) -> Iterator[str]:
+def export_mjcf(file: str, out: str, box_only: bool, locks: LockMode) -> Iterator[str]:
     """Write the MuJoCo model of the box in ``file`` to the directory ``out``: ``scene.xml`` (table, robot, box)
     or with ``box_only`` ``box.xml`` (the box alone, lid frame at the origin), and their assets. Yields what was
     written and, if any, the rules the model alone does not hold (:class:`BoxBuildError` if it cannot be built)."""

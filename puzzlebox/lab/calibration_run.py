@@ -128,6 +128,7 @@ def calibrate_cell(
             T_est, T_true, pose_rms = overview_pose.T_base_camera, t.T_base_camera, overview_pose.rms_px
         else:
             T_est, T_true, pose_rms = wrist_pose.T_tcp_camera, t.T_tcp_camera, wrist_pose.rms_px
+        assert T_true is not None  # the truth of a fixed camera has its base pose, of an arm camera its TCP pose
         position, angle = pose_error(T_est, T_true)
         focal = (np.diag(intrinsics.K)[:2] / np.diag(t.K)[:2] - 1.0) * 100.0
         principal = intrinsics.K[:2, 2] - t.K[:2, 2]

@@ -8,7 +8,7 @@ import platform
 import sys
 from importlib import metadata
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 from puzzlebox.models.atomic import write_text_atomically
 from puzzlebox.models.spec import dumps_compact
@@ -35,7 +35,7 @@ def one_line(err: Exception) -> str:
     return " ".join(line.strip() for line in str(err).splitlines())
 
 
-def fail(message: str, code: int = 2) -> None:
+def fail(message: str, code: int = 2) -> NoReturn:
     """Print ``error: message`` on stderr and exit (no traceback for a user's mistake)."""
     print(f"error: {message}", file=sys.stderr)
     raise SystemExit(code)

@@ -6,12 +6,15 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from puzzlebox.lab.cli import versions, write_json
 from puzzlebox.lab.errors import ExperimentSettingsError
 from puzzlebox.learning.experiments import PROTOCOLS, SYMBOLIC_AGENTS
 from puzzlebox.learning.experiments.deep_protocols import DEEP_AGENTS
+
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
 
 DISASSEMBLY = "disassembly"
 REALITY = "reality"
@@ -25,7 +28,7 @@ PROTOCOL_NAMES = (*PROTOCOLS, ALL, REALITY, FAULTS, TWIN_LEARNING, SYSID, DISASS
 AGENTS = (*SYMBOLIC_AGENTS, *DEEP_AGENTS)
 """The agents of the paper's symbolic protocols."""
 
-Config = TypeVar("Config")
+Config = TypeVar("Config", bound="DataclassInstance")  # a protocol's config, a dataclass (see with_runs)
 
 
 @dataclass(frozen=True)

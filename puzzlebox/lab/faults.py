@@ -29,9 +29,10 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -258,7 +259,7 @@ def concurrent_trainers(out: Path, config: FaultsConfig, trainers: int) -> Fault
     errors = [p.communicate(timeout=1800)[1] for p in procs]
     ok = sum(p.returncode == 0 for p in procs)
     store = MemoryStore.open_existing(memory)
-    logged = sum(len(r["episodes"]) for r in store.training_log())
+    logged = sum(len(cast(list, r["episodes"])) for r in store.training_log())  # each run's episodes: a list
     wanted = trainers * config.trainer_episodes
     store.close()
     return FaultRow(
@@ -396,7 +397,7 @@ def run_faults(out: Path, config: FaultsConfig) -> dict[str, Any]:
     """Run every fault class; write ``DIR/faults.{json,md}`` after each (nothing lost if interrupted)."""
     start = time.perf_counter()
     rows: list[FaultRow] = []
-    steps = [
+    steps: list[Callable[[], FaultRow | list[FaultRow]]] = [
         lambda: cli_mistakes(out),
         lambda: truncated_memory(out),
         lambda: concurrent_trainers(out, config, 2),

@@ -5,7 +5,12 @@ from __future__ import annotations
 
 import signal
 import sys
+from collections.abc import Callable
 from types import FrameType
+from typing import Any
+
+_Handler = Callable[[int, FrameType | None], Any] | int | signal.Handlers | None
+"""What ``signal.signal`` installs and returns: a function, ``SIG_DFL``/``SIG_IGN``, or None (not set from Python)."""
 
 
 class StopRequests:
@@ -14,7 +19,7 @@ class StopRequests:
     def __init__(self, what: str = "run") -> None:
         self.what = what
         self.requested = False
-        self._previous: dict[int, object] = {}
+        self._previous: dict[int, _Handler] = {}
 
     def _handle(self, signum: int, frame: FrameType | None) -> None:
         if self.requested:

@@ -18,13 +18,15 @@ if TYPE_CHECKING:
     import mujoco
 
     from puzzlebox.models.lock_check import LockCheck
+    from puzzlebox.models.mechanism_mjcf import LockMode
 
 
 class LockChecks:
     """The checks of several boxes with ``locks`` (contact or latch), the box alone or ``with_robot``."""
 
-    def __init__(self, locks: str, with_robot: bool) -> None:
-        self.locks, self.with_robot = locks, with_robot
+    def __init__(self, locks: LockMode, with_robot: bool) -> None:
+        self.locks: LockMode = locks
+        self.with_robot = with_robot
         self.boxes: list[dict[str, Any]] = []
         self.errors: list[dict[str, str]] = []
 
@@ -93,7 +95,7 @@ class LockChecks:
         return 1 if self.agreeing < self.total else 0
 
 
-def compiled_model(spec: PuzzleSpec, locks: str, with_robot: bool) -> tuple[mujoco.MjModel, dict[str, str]]:
+def compiled_model(spec: PuzzleSpec, locks: LockMode, with_robot: bool) -> tuple[mujoco.MjModel, dict[str, str]]:
     """The compiled model of ``spec`` (the box alone, or the whole scene) and each component's joint name."""
     if not with_robot:
         from puzzlebox.models.box_export import compile_box

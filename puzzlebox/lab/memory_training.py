@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 import sqlite3
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 from tqdm import tqdm
 
@@ -40,7 +40,7 @@ def resumed_run(store: MemoryStore, command: dict) -> tuple[int | None, set[int]
     """The latest training run in ``store`` made by the same ``command`` (versions aside) and the seeds of the
     episodes it stored; (None, empty) when there is none."""
     for run in reversed(store.training_log()):
-        config = dict(run["config"])  # type: ignore[arg-type]
+        config = dict(cast("dict[str, Any]", run["config"]))  # a run's config: a JSON object
         config.pop("versions", None)
         config.pop("command", None)
         if config == json.loads(json.dumps(command)):

@@ -158,7 +158,9 @@ def run_real_trial(
 def _unfinished(spec: PuzzleSpec, seed: int, world: RobotWorld | None, wall: float, why: str) -> RunResult:
     """The run of a trial that ended early (or so far): the actions the world logged, its goal as perceived."""
     log = world.log if world else []
-    actions = [ActionRecord(world.names[a.marker], a.moved, a.outcome, a.reason) for a in log] if world else []
+    names = world.names if world else {}
+    assert names is not None  # run_real_trial's world is made with the spec's names
+    actions = [ActionRecord(names[a.marker], a.moved, a.outcome, a.reason) for a in log]
     solved = bool(world is not None and world.observe().solved)
     return RunResult(spec.name, seed, solved, len(log), time.perf_counter() - wall, actions, ended=why)
 

@@ -118,6 +118,7 @@ def run_sweep(
         for name, profile in profiles.items():
             calibration = done.records[name]["calibration"]
             for spec in specs:
+                assert spec.box is not None  # the paper's boxes
                 CellCalibration.from_dict(calibration).check_cell(name, profile.cell_seed, spec.box.size[2], spec.name)
                 for seed in range(config.seed, config.seed + config.placements):
                     key = f"{name}-{spec.name}-seed{seed}"
@@ -163,7 +164,7 @@ def calibration_task(settings: dict[str, Any]) -> dict[str, Any]:
 
 
 def _figures(runs: list[dict[str, Any]], max_actions: int, calibration: dict[str, Any]) -> dict[str, Any]:
-    results = summarise(runs, max_actions)
+    results = summarise(list(runs), max_actions)
     figures = twin_figures(runs)
     return {
         "trials": len(runs),

@@ -45,12 +45,14 @@ class RecordingDetector(MarkerDetector):
 
 def scene_cameras(session: TwinSession) -> SceneCameras:
     """What the rollout video's views look at in ``session``: its cameras, and its lid for the perspective view."""
-    length, width, _ = session.spec.box.size
-    names, render = session.scene.names, session.config.render
+    box = session.spec.box
+    assert box is not None  # the twin builds puzzle boxes only (models.scene refuses a spec with none)
+    length, width, _ = box.size
+    names, render, lid = session.scene.names, session.config.render, session.scene.T_world_lid[:3, 3]
     return SceneCameras(
         overview=names.overview_camera,
         wrist=names.wrist_camera,
-        lid_centre=tuple(float(v) for v in session.scene.T_world_lid[:3, 3]),
+        lid_centre=(float(lid[0]), float(lid[1]), float(lid[2])),
         lid_diagonal=float(np.hypot(length, width)),
         capture_size=(render.width, render.height),
     )

@@ -29,7 +29,7 @@ import glob
 import json
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -137,7 +137,7 @@ def _seeds(sweep: dict[str, Any]) -> list[int]:
 def _agents(sweep: dict[str, Any], base: Path) -> list[dict[str, Any]]:
     agents = []
     for entry in sweep.get("agents", ["memory"]):
-        agent = {"name": entry} if isinstance(entry, str) else dict(entry)
+        agent: dict[str, Any] = {"name": entry} if isinstance(entry, str) else dict(entry)
         if agent.get("name") not in AGENT_NAMES:
             raise SweepError(f"unknown agent {agent.get('name')!r}; available: {sorted(AGENT_NAMES)}")
         for key in ("memory", "checkpoint"):
@@ -176,7 +176,8 @@ def _placements(sweep: dict[str, Any], spec: PuzzleSpec) -> list[tuple[float, fl
     if isinstance(chosen, int):
         rng = np.random.default_rng([int(sweep.get("placement_seed", 0)), len(spec.components)])
         chosen = [sample_reachable_pose(spec, rng) for _ in range(chosen)]
-    return [file_precision(tuple(float(v) for v in pose)) for pose in chosen]  # as the placed spec stores it
+    # as the placed spec stores it; each an [x, y, yaw] [m, m, rad] (the sweep format, sample_reachable_pose's)
+    return [cast("tuple[float, float, float]", file_precision(tuple(float(v) for v in pose))) for pose in chosen]
 
 
 def grid(sweep: dict[str, Any], base: Path) -> tuple[list[Task], dict[str, Cell]]:
@@ -206,7 +207,8 @@ def grid(sweep: dict[str, Any], base: Path) -> tuple[list[Task], dict[str, Cell]
                     if pose is not None and reality is not None:
                         reality = replace(reality, placement=None)  # the sweep placed the box
                     calibration = calibrations.get(profile)
-                    if calibration is not None:
+                    if calibration is not None and spec.box is not None:  # no box: the twin refuses it (SceneError)
+                        assert reality is not None  # a calibration is only loaded for a twin profile, as its reality
                         calibration.check_cell(reality.name, reality.cell_seed, spec.box.size[2], spec=spec.name)
                     cell = Cell(spec.name, None if pose is None else p, pose, agent["label"], profile)
                     for seed in seeds:

@@ -142,7 +142,8 @@ def record_task(settings: dict[str, Any], context: dict[str, Any]) -> dict[str, 
     calibration = CellCalibration.from_dict(settings["calibration"])
     with TwinSession(spec, seed=seed, reality=profile) as session:
         trace = TruthTrace(session.robot, session)
-        recorder = ToggleRecorder(trace, {"spec": spec.name, "seed": seed, "cell_seed": profile.cell_seed})
+        # a Robot: TruthTrace forwards every call but wrench() to session.robot (__getattr__, unseen by pyright)
+        recorder = ToggleRecorder(trace, {"spec": spec.name, "seed": seed, "cell_seed": profile.cell_seed})  # pyright: ignore[reportArgumentType]
         world = evaluation_world(session, recorder, calibration, seed)
         recorder.attach(world)
         agent = make_agent(settings["agent"], session.spec, None, None, belief=CELL_BELIEF)
@@ -207,6 +208,7 @@ def evaluate_task(settings: dict[str, Any], context: dict[str, Any]) -> dict[str
         nominal = toggle_errors(t)
         scales = fitted.get(t.log.kind, KindScales())
         after = toggle_errors(t, scales)
+        assert t.log.truth is not None  # record_task gives every logged toggle its truth
         true = t.log.truth["kind_factors"]  # evaluation only: how far a perfect identification would get
         kind = t.log.kind
         at_truth = toggle_errors(t, KindScales(true["joint_damping"][kind], true["joint_friction"][kind],

@@ -62,7 +62,7 @@ def twin_training_for(
     except (TwinError, CalibrationError) as err:
         raise TrainingSetupError(str(err)) from err
     for path, spec in zip(spec_paths, specs, strict=True):
-        if cell is not None:
+        if cell is not None and spec.box is not None:  # no box (a disassembly scene): the twin refuses it
             try:
                 cell.check_cell(profile.name, profile.cell_seed, spec.box.size[2], spec=str(path))
             except CalibrationError as err:

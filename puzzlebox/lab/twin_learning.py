@@ -34,7 +34,7 @@ import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from puzzlebox.lab.cli import write_json
 from puzzlebox.lab.reality_sweep import calibration_task
@@ -121,6 +121,11 @@ def _symbolic_training(store: MemoryStore, seed: int, episodes: int, max_actions
         run_episode(agent, SymbolicWorld(spec, 1000 * seed + e), spec.name, 1000 * seed + e, max_actions)
 
 
+def _provenance(store: MemoryStore) -> dict[str, Any]:
+    """``store.provenance()`` as the JSON-like object it is (per source a dict: episodes, robot hours...)."""
+    return cast("dict[str, Any]", store.provenance())
+
+
 def training_chain(settings: dict[str, Any], context: dict[str, Any]) -> dict[str, Any]:
     """One start's learning in the twin (a runner task): its memory grows in ``context['dir']`` and is copied
     at each checkpoint of ``settings['hours']``; a chain killed part-way goes on from its file."""
@@ -138,14 +143,15 @@ def training_chain(settings: dict[str, Any], context: dict[str, Any]) -> dict[st
         hours = [0.0] if start == "symbolic" else sorted(settings["hours"])
         checkpoints, skipped, runs = [], [], []
         for h in hours:
-            while store.provenance()["twin"]["robot_hours"] < h:
+            while _provenance(store)["twin"]["robot_hours"] < h:
                 # (resumed: the episodes stored are not run again; one the cell could not run stores nothing)
-                e = store.provenance()["twin"]["episodes"] + len(skipped)
+                e = _provenance(store)["twin"]["episodes"] + len(skipped)
                 spec = train[e % len(train)]
                 agent = MemoryAgent(store, learn=True, config=twin.controller)
-                agent.episode_label, agent.episode_seed = spec.name, settings["train_seed"] + 1000 * seed + e
+                episode_seed = settings["train_seed"] + 1000 * seed + e
+                agent.episode_label, agent.episode_seed = spec.name, episode_seed
                 before = store.num_episodes
-                result = twin.episode(agent, spec, agent.episode_seed, settings["max_actions"])
+                result = twin.episode(agent, spec, episode_seed, settings["max_actions"])
                 runs.append({"episode": e, "spec": spec.name, "seed": agent.episode_seed, "solved": result.solved,
                              "num_actions": result.num_actions, "ended": result.ended})  # fmt: skip
                 if store.num_episodes == before:
@@ -153,16 +159,16 @@ def training_chain(settings: dict[str, Any], context: dict[str, Any]) -> dict[st
             target = folder / f"{start}-s{seed}@{h:g}h.sqlite"
             if not target.exists():
                 _snapshot(path, target)
-            provenance = store.provenance()
+            provenance = _provenance(store)
             checkpoints.append({
                 "hours": h, "robot_hours": provenance["twin"]["robot_hours"], "memory": target.name,
                 "twin_episodes": provenance["twin"]["episodes"], "episodes": provenance["episodes"],
             })  # fmt: skip
-        log = store.training_log()
+        log = store.training_log()  # each run's "episodes": a list
     finally:
         store.close()
     return {"start": start, "seed": seed, "checkpoints": checkpoints, "skipped": skipped, "runs": runs,
-            "episodes": [e for run in log for e in run["episodes"]]}  # fmt: skip
+            "episodes": [e for run in log for e in cast(list, run["episodes"])]}  # fmt: skip
 
 
 def run_twin_learning(

@@ -133,6 +133,7 @@ def box_visibility_figures(quick: bool) -> dict[str, float]:
         for spec in specs:
             run_trial(spec, TrialConfig(agent="oracle", seed=0, max_actions=12), video=Path("unused.mp4")).to_dict()
             kept = FrameCollector.last
+            assert kept is not None  # the trial's video made one (BackgroundRollout, patched above)
             drawer = RolloutDrawer(kept.model, kept.cameras, kept.config)
             best += [max(drawer.box_visibility(f.qpos).values()) for f in kept.frames]
             drawer.close()

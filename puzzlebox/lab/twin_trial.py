@@ -123,13 +123,15 @@ def run_twin_trial(
         peak, digest = PeakWristForce(session), SensedDigest()
         with contextlib.ExitStack() as outputs:
             watching: list[TrialObserver] = []
-            detector = RecordingDetector() if video is not None or recording is not None else None
-            if video is not None:
-                rollout = outputs.enter_context(BackgroundRollout(video, session.model, scene_cameras(session)))
-                watching.append(RolloutVideo(session, rollout, detector))
-            if recording is not None:
-                rrd = outputs.enter_context(TrialRecording(recording, f"{spec.name}-seed{seed}"))
-                watching.append(RerunRecording(session, rrd, detector))
+            detector = None
+            if video is not None or recording is not None:
+                detector = RecordingDetector()
+                if video is not None:
+                    rollout = outputs.enter_context(BackgroundRollout(video, session.model, scene_cameras(session)))
+                    watching.append(RolloutVideo(session, rollout, detector))
+                if recording is not None:
+                    rrd = outputs.enter_context(TrialRecording(recording, f"{spec.name}-seed{seed}"))
+                    watching.append(RerunRecording(session, rrd, detector))
             watching += [peak, digest, *observers]
             robot = ObservedRobot(session.robot, watching)
             trial = TrialContext(spec, seed, session)
