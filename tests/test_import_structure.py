@@ -90,3 +90,16 @@ def test_every_package_folder_installs_under_the_import_root():
         for init in (ROOT / folder).rglob("__init__.py"):
             on_disk.add(".".join([package, *init.parent.relative_to(ROOT / folder).parts]))
     assert on_disk == listed
+
+
+def test_nothing_imports_a_layer_by_its_folder_name():
+    """``import twin.cell`` from the repository's folder would load a second copy of a module beside
+    ``puzzlebox.twin.cell`` (a monkeypatch of one misses the other): every import goes through the root."""
+    bare = []
+    for path in [*ROOT.glob("tests/**/*.py"), *_modules().values()]:
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else []
+            if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                names = [node.module]
+            bare += [f"{path.relative_to(ROOT)}: {n}" for n in names if n.split(".")[0] in MAY_IMPORT]
+    assert bare == []

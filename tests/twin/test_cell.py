@@ -121,13 +121,13 @@ def test_realistic_draws_the_box_hardware_per_cell_and_only_jitter_per_trial():
 def test_registering_a_kind_changes_no_paper_kinds_hardware(monkeypatch):
     """A kind beyond the paper's draws its factors from a stream of its own: the paper kinds' factors are the ones
     a registry of the paper's kinds alone draws, and each new kind's do not depend on which others exist."""
-    import twin.cell
+    import puzzlebox.twin.cell as cell
 
     realistic = PRESETS["realistic"]
     full = draw_cell(realistic, CAMERAS).kinds
-    monkeypatch.setattr(twin.cell, "registered_kinds", lambda: KIND_NAMES)
+    monkeypatch.setattr(cell, "registered_kinds", lambda: KIND_NAMES)
     paper_only = draw_cell(realistic, CAMERAS).kinds
-    monkeypatch.setattr(twin.cell, "registered_kinds", lambda: (*KIND_NAMES, "lever"))
+    monkeypatch.setattr(cell, "registered_kinds", lambda: (*KIND_NAMES, "lever"))
     with_lever = draw_cell(realistic, CAMERAS).kinds
     for table in ("joint_damping", "joint_friction", "latch_compliance"):
         assert getattr(paper_only, table) == {k: getattr(full, table)[k] for k in KIND_NAMES}
