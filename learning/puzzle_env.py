@@ -94,7 +94,7 @@ class PuzzleEnv(gym.Env[dict[str, Any], np.int64]):
             {
                 "states": spaces.MultiBinary(n),
                 "kinds": spaces.MultiDiscrete(np.full(n, len(self.kind_names))),
-                "poses": _pose_space(self._true_poses.shape),
+                "poses": pose_space(self._true_poses.shape),
                 "goal": spaces.Discrete(n),
             }
         )
@@ -183,7 +183,7 @@ POSITION_BOUND = 100.0
 """Bound of the observed positions [m]: far beyond any table, finite so spaces can be sampled."""
 
 
-def _pose_space(shape: tuple[int, ...]) -> spaces.Box:
+def pose_space(shape: tuple[int, ...]) -> spaces.Box:
     """Positions within +-POSITION_BOUND [m], angles within [-pi, pi] [rad]."""
     n, dim = shape
     per_pose = np.array([POSITION_BOUND] * (dim - 1 if dim == 3 else 3) + [np.pi] * (1 if dim == 3 else 3))
