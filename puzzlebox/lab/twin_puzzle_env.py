@@ -7,8 +7,9 @@ the survey's ArUco perception, the motion primitives, the outcome felt through t
 reality profile with its calibration (:class:`~puzzlebox.lab.TrialConfig`). Observations are what the pipeline
 perceived: each component's kind as told, its closed pose in the world frame ``[x, y, yaw]`` [m, m, rad] as
 seen, its state as sensed; the order is shuffled per episode. ``info`` holds the try's ``outcome`` (``moved``,
-``blocked`` or ``failed``), its ``reason``, ``moved``, ``num_actions`` and the simulated time ``sim_time_s``
-[s]; ``true_moved`` (the simulator's truth) only with ``ground_truth=True``, for evaluation.
+``blocked`` or ``failed``), its ``reason``, ``moved``, ``give_up`` (the pipeline cannot try that part again),
+``num_actions`` and the simulated time ``sim_time_s`` [s]; ``true_moved`` (the simulator's truth) only with
+``ground_truth=True``, for evaluation.
 
 Each ``reset`` opens a new twin session (a seeded cell and, under a profile that places boxes, a new placement)
 and surveys the box: a few seconds of wall time. ``render()`` (``render_mode="rgb_array"``) draws the scene from
@@ -120,7 +121,8 @@ class TwinPuzzleEnv(gym.Env[dict[str, Any], np.int64]):
         terminated = bool(world.observe().solved)
         truncated = not terminated and self.num_actions >= self.max_actions
         info: dict[str, Any] = {"outcome": result.outcome, "reason": result.reason, "moved": result.moved,
-                                "num_actions": self.num_actions, "sim_time_s": self._sim_time()}  # fmt: skip
+                                "give_up": result.give_up, "num_actions": self.num_actions,
+                                "sim_time_s": self._sim_time()}  # fmt: skip
         if self.ground_truth and world.log:
             info["true_moved"] = world.log[-1].true_moved
         return observation, 1.0 if terminated else 0.0, terminated, truncated, info

@@ -66,3 +66,32 @@ def test_what_cannot_run_is_refused_clearly():
     env = TwinPuzzleEnv(SPEC)
     with pytest.raises(gymnasium.error.ResetNeeded):
         env.step(0)
+
+
+def test_an_agent_acting_through_the_environment_makes_the_trials_tries():
+    """The project's dual agent driven through the gymnasium API (observations rebuilt by the world, outcomes
+    from ``info``) tries what ``run_trial`` tries for the same seed, with the same sensed outcomes."""
+    from puzzlebox.lab import run_trial
+    from puzzlebox.learning import make_agent
+    from puzzlebox.learning.belief import CELL_BELIEF
+    from puzzlebox.models import TryResult
+
+    config = TrialConfig(agent="dual", seed=1, max_actions=8)
+    record = run_trial(SPEC, config)
+    env = TwinPuzzleEnv(SPEC, config, max_actions=8)
+    env.reset(seed=1)
+    assert env.world is not None
+    agent = make_agent("dual", SPEC, belief=CELL_BELIEF)
+    scene = env.world.observe()
+    agent.begin_episode(scene, np.random.default_rng(1))
+    tries, done = [], False
+    while not done:
+        action = agent.choose(scene)
+        _, _, terminated, truncated, info = env.step(action)
+        scene = env.world.observe()
+        agent.record(action, TryResult(info["outcome"], info["reason"], info["give_up"]), scene)
+        tries.append((env.world.ground_truth_name(action), info["moved"], info["outcome"], info["reason"]))
+        done = terminated or truncated
+    env.close()
+    assert len(tries) == record.num_actions == 8 and {t[2] for t in tries} == {"moved", "blocked"}
+    assert tries == [(a.component, a.moved, a.outcome, a.reason) for a in record.actions]
