@@ -33,6 +33,7 @@ from typing import Any, cast
 
 import numpy as np
 
+from puzzlebox.lab.cells import profile_of_calibration
 from puzzlebox.lab.trial_task import trial_task
 from puzzlebox.learning import AGENT_NAMES
 from puzzlebox.learning.agents.factory import BELIEF_AGENT_NAMES
@@ -196,6 +197,7 @@ def grid(sweep: dict[str, Any], base: Path) -> tuple[list[Task], dict[str, Cell]
             realities[name] = load_profile(name if name in PRESETS else base / name)
             file = sweep.get("calibrations", {}).get(name)
             calibrations[name] = CellCalibration.load(base / file) if file else None
+            realities[name] = profile_of_calibration(realities[name], calibrations[name])  # the file's cell
     tasks, cells = [], {}
     for i, spec in enumerate(specs):
         poses = _placements(sweep, spec) if twin else [None]

@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from puzzlebox.lab.cells import profile_of_calibration
+from puzzlebox.lab.cells import CellError, load_cell
 from puzzlebox.lab.errors import OutputFileError, TrainingSetupError
 from puzzlebox.learning.dual_controller import DualControllerConfig
 from puzzlebox.learning.errors import LearningError
@@ -51,22 +51,11 @@ def twin_training_for(
     through the calibration file ``calibration`` if given, which must be the one of this cell (profile and box
     height, as ``trial.py`` checks) for every spec (the twin loads only when asked)."""
     from puzzlebox.lab.twin_training import TwinTraining
-    from puzzlebox.models.calibration import CalibrationError, CellCalibration
-    from puzzlebox.twin.errors import TwinError
-    from puzzlebox.twin.reality import load_profile
 
     try:
-        profile = load_profile(reality or "ideal")
-        cell = CellCalibration.load(calibration) if calibration else None
-        profile = profile_of_calibration(profile, cell)  # the cell the calibration was made in
-    except (TwinError, CalibrationError) as err:
+        profile, cell = load_cell(reality or "ideal", calibration, dict(zip(spec_paths, specs, strict=True)))
+    except CellError as err:
         raise TrainingSetupError(str(err)) from err
-    for path, spec in zip(spec_paths, specs, strict=True):
-        if cell is not None and spec.box is not None:  # no box (a disassembly scene): the twin refuses it
-            try:
-                cell.check_cell(profile.name, profile.cell_seed, spec.box.size[2], spec=str(path))
-            except CalibrationError as err:
-                raise TrainingSetupError(f"--calibration {calibration} for spec {spec.name}: {err}") from err
     return TwinTraining(profile, cell)
 
 

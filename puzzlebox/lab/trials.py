@@ -8,6 +8,7 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
+from puzzlebox.lab.errors import TrialConfigError
 from puzzlebox.lab.observers import TrialContext, TrialObserver
 from puzzlebox.lab.trial_config import TrialConfig
 from puzzlebox.lab.trial_record import TrialRecord
@@ -48,8 +49,6 @@ def run_trial(
             None if recording is None else Path(recording), on_action,
         )  # fmt: skip
     if video is not None or recording is not None:
-        from puzzlebox.lab.errors import TrialConfigError
-
         raise TrialConfigError("a video or a recording is of a twin trial (sim='twin')")
     if agent is None:
         checkpoint = None if config.checkpoint is None else str(config.checkpoint)

@@ -19,6 +19,7 @@ the overview camera without touching what the pipeline senses. ``close()`` relea
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 from typing import Any
 
 import gymnasium as gym
@@ -27,11 +28,13 @@ from gymnasium import spaces
 
 from puzzlebox.lab.errors import TrialConfigError
 from puzzlebox.lab.trial_config import TrialConfig
-from puzzlebox.lab.twin_trial import evaluation_world, twin_session, wrong_kind
+from puzzlebox.lab.twin_trial import trial_world, twin_session
+from puzzlebox.learning.errors import InvalidAction
 from puzzlebox.learning.puzzle_env import pose_space
-from puzzlebox.models import PuzzleSpec
+from puzzlebox.models import PuzzleSpec, SceneObservation
 from puzzlebox.models.disassembly_kinds import family_kind_names
 from puzzlebox.skills.robot_world import RobotWorld
+from puzzlebox.twin.session import TwinSession
 
 __all__ = ["TwinPuzzleEnv"]
 
@@ -85,53 +88,54 @@ class TwinPuzzleEnv(gym.Env[dict[str, Any], np.int64]):
         )
         self.world: RobotWorld | None = None
         """The episode's world (perception and primitives over the twin's robot)."""
+        self.session: TwinSession | None = None
+        """The episode's twin session (for evaluation and rendering: never for deciding)."""
         self.num_actions = 0
         self._episode = contextlib.ExitStack()
+        self._episodes = 0
         self._renderer: Any = None
         self._seed = config.seed
-        self._open_session: Any = None
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, Any], dict[str, Any]]:
         super().reset(seed=seed)
-        if seed is None and self.world is not None:  # a later episode without a seed: the next from the generator
-            self._seed = int(self.np_random.integers(2**31 - 1))
-        elif seed is not None:
+        if seed is not None:
             self._seed = int(seed)
+        elif self._episodes:  # a later episode without a seed: the next from the generator
+            self._seed = int(self.np_random.integers(2**31 - 1))
         self._close_episode()
-        config = TrialConfig(**{**self.config.__dict__, "seed": self._seed})
-        session = self._episode.enter_context(twin_session(self.puzzle, config))
-        told = wrong_kind(session.spec, self._seed) if config.misreport_kind else {}
-        self.world = evaluation_world(session, session.robot, config.calibration, self._seed, told)
-        self._open_session = session
+        config = dataclasses.replace(self.config, seed=self._seed)
+        self.session = self._episode.enter_context(twin_session(self.puzzle, config))
+        self.world = trial_world(self.session, config)
+        self._episodes += 1
         self.num_actions = 0
-        return self._observation(), {"num_actions": 0, "sim_time_s": self._sim_time()}
+        return self._observation(self.world.observe()), {"num_actions": 0, "sim_time_s": self.session.time}
 
     def step(self, action: Any) -> tuple[dict[str, Any], float, bool, bool, dict[str, Any]]:
-        world = self.world
-        if world is None:
+        world, session = self.world, self.session
+        if world is None or session is None:
             raise gym.error.ResetNeeded("call reset() before step()")
         n = len(self.puzzle.components)
         if not isinstance(action, int | np.integer) or not 0 <= int(action) < n:
-            raise TrialConfigError(f"action must be an integer in 0..{n - 1}, got {action!r}")
+            raise InvalidAction(f"action must be an integer in 0..{n - 1}, got {action!r}")
         result = world.try_toggle(int(action))
         self.num_actions += 1
-        observation = self._observation()
-        terminated = bool(world.observe().solved)
+        scene = world.observe()
+        terminated = bool(scene.solved)
         truncated = not terminated and self.num_actions >= self.max_actions
         info: dict[str, Any] = {"outcome": result.outcome, "reason": result.reason, "moved": result.moved,
                                 "give_up": result.give_up, "num_actions": self.num_actions,
-                                "sim_time_s": self._sim_time()}  # fmt: skip
+                                "sim_time_s": session.time}  # fmt: skip
         if self.ground_truth and world.log:
             info["true_moved"] = world.log[-1].true_moved
-        return observation, 1.0 if terminated else 0.0, terminated, truncated, info
+        return self._observation(scene), 1.0 if terminated else 0.0, terminated, truncated, info
 
     def render(self) -> np.ndarray | None:
-        if self.render_mode != "rgb_array" or self.world is None:
+        session = self.session
+        if self.render_mode != "rgb_array" or session is None:
             return None
-        session = self._session()
-        if self._renderer is None:
+        if self._renderer is None:  # one per episode: each session compiles its own model (the box placed anew)
             import mujoco
 
             self._renderer = mujoco.Renderer(session.model, *RENDER_SIZE)
@@ -140,25 +144,16 @@ class TwinPuzzleEnv(gym.Env[dict[str, Any], np.int64]):
 
     def close(self) -> None:
         self._close_episode()
+
+    def _close_episode(self) -> None:
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
-
-    def _close_episode(self) -> None:
-        self._open_session = None
+        self.world = self.session = None
         self._episode.close()
         self._episode = contextlib.ExitStack()
 
-    def _session(self) -> Any:
-        return self._open_session
-
-    def _sim_time(self) -> float:
-        assert self.world is not None
-        return float(self.world.robot.time)
-
-    def _observation(self) -> dict[str, Any]:
-        assert self.world is not None
-        scene = self.world.observe()
+    def _observation(self, scene: SceneObservation) -> dict[str, Any]:
         return {
             "states": np.array([c.state for c in scene.components], dtype=np.int8),
             "kinds": np.array([self.kind_names.index(c.kind) for c in scene.components], dtype=np.int64),

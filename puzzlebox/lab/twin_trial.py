@@ -23,6 +23,7 @@ from puzzlebox.learning.memory import MemoryStore
 from puzzlebox.models import PuzzleSpec
 from puzzlebox.models.calibration import CellCalibration
 from puzzlebox.models.kinds import PUZZLE_KINDS
+from puzzlebox.models.robot import Robot
 from puzzlebox.models.scene import SceneConfig
 from puzzlebox.skills import MarkerDetector, SkillError
 from puzzlebox.skills.robot_world import RobotWorld
@@ -32,7 +33,7 @@ from puzzlebox.twin.rerun_log import TrialRecording
 from puzzlebox.twin.rollout_video import BackgroundRollout
 from puzzlebox.twin.session import TwinConfig, TwinSession
 
-__all__ = ["evaluation_world", "open_twin_world", "run_twin_trial", "twin_session", "wrong_kind"]
+__all__ = ["evaluation_world", "open_twin_world", "run_twin_trial", "trial_world", "twin_session", "wrong_kind"]
 
 
 def evaluation_world(
@@ -80,6 +81,13 @@ def twin_session(spec: PuzzleSpec, config: TrialConfig) -> TwinSession:
     )
 
 
+def trial_world(session: TwinSession, config: TrialConfig, robot: Robot | None = None) -> RobotWorld:
+    """The world of a trial of ``config`` on ``session`` (through ``robot``, default the session's): its
+    calibration, seed and, with ``misreport_kind``, one kind told wrong (:func:`evaluation_world`)."""
+    told = wrong_kind(session.spec, config.seed) if config.misreport_kind else {}
+    return evaluation_world(session, robot, config.calibration, config.seed, told)
+
+
 @contextlib.contextmanager
 def open_twin_world(
     spec: PuzzleSpec, config: TrialConfig, observers: Sequence[TrialObserver] = ()
@@ -88,9 +96,7 @@ def open_twin_world(
     through perception and the primitives; ``observers`` see every reading and wait (not the actions: a loop of
     one's own tells no caption). The session closes when the block ends."""
     with twin_session(spec, config) as session:
-        told = wrong_kind(session.spec, config.seed) if config.misreport_kind else {}
-        robot = ObservedRobot(session.robot, observers) if observers else session.robot
-        world = evaluation_world(session, robot, config.calibration, config.seed, told)
+        world = trial_world(session, config, ObservedRobot(session.robot, observers) if observers else None)
         trial = TrialContext(session.spec, config.seed, session, world)
         for observer in observers:
             observer.attach(trial)

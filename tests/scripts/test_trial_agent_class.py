@@ -12,28 +12,16 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 
-AGENTS = """
-class TryInTurn:
-    name = "try-in-turn"
-
-    def begin_episode(self, observation, rng):
-        self.turn = 0
-
-    def choose(self, observation):
-        self.turn += 1
-        return (self.turn - 1) % len(observation.components)
-
-    def record(self, index, result, observation):
-        pass
-
-    def end_episode(self, solved):
-        pass
-
+# a user's agent module: the agent of the Python API tests, and a class that is not an agent
+AGENTS = (
+    (ROOT / "tests/lab/user_agents.py").read_text()
+    + """
 
 class Chooser:
     def choose(self, observation):
         return 0
 """
+)
 
 
 @pytest.fixture
