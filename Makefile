@@ -28,7 +28,7 @@ $(STAMP): pyproject.toml Makefile
 		|| echo "chromium not installed: the browser test will skip"
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check torch==2.13.0
-	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e ".[dev,baselines,cluster,viz]"
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e ".[dev,baselines,cluster,rl,viz]"
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check --no-deps robosuite==1.5.2
 	touch $(STAMP)
 

@@ -14,8 +14,26 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Self
 
-_UMASK = os.umask(0o022)
-os.umask(_UMASK)  # read once: a file written atomically gets the permissions a plain open() would give it
+
+def current_umask() -> int:
+    """The process's umask, read without changing it where Linux tells it (``/proc/self/status``), else by setting
+    and restoring it."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    umask = os.umask(0o022)
+    os.umask(umask)
+    return umask
+
+
+def apply_umask(path: str | Path, mode: int = 0o666) -> None:
+    """Give ``path`` the permissions a plain ``open()`` (``mode``) would have given it under the process's umask:
+    a file made by ``mkstemp`` (0600) and published under its final name is not private."""
+    os.chmod(path, mode & ~current_umask())
 
 
 def write_atomically(path: str | Path, write: Callable[[Path], object]) -> Path:
@@ -27,7 +45,7 @@ def write_atomically(path: str | Path, write: Callable[[Path], object]) -> Path:
     os.close(fd)
     tmp = Path(name)
     try:
-        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes it 0600
+        apply_umask(tmp)  # mkstemp makes it 0600
         write(tmp)
         with open(tmp, "rb+") as f:
             os.fsync(f.fileno())

@@ -26,12 +26,42 @@ import numpy as np
 
 from puzzlebox.models.atomic import write_text_atomically
 from puzzlebox.models.errors import ModelsError
+from puzzlebox.models.json_input import JsonInputError, finite, parse_json, read_input_text
 
 CALIBRATION_FORMAT = "puzzlebox-calibration/1"
 
 
 class CalibrationError(ModelsError):
     """A calibration file that cannot be used, or a camera it does not calibrate."""
+
+
+RIGID_TOLERANCE = 1e-4
+"""Largest deviation of a pose's rotation from orthonormal (``|R^T R - I|``) and of its last row from
+``[0, 0, 0, 1]`` a calibration file may have (files round to ~1e-15; a scaled rotation is off by 0.1 or more)."""
+MAX_TRANSLATION_M = 10.0
+"""Farthest a camera may be from the base or the TCP [m] (a cell is a metre or two across)."""
+MAX_REPROJECTION_PX = 2.0
+"""Largest RMS reprojection error of a usable intrinsic calibration [px] (the twin's: 0.06-0.08 px)."""
+MAX_IMAGE_SIDE = 16384
+"""Largest image side [px]."""
+
+
+def _check_rigid(T: np.ndarray, name: str) -> None:
+    """``T`` is a rigid transform: a rotation (orthonormal, det +1), a bounded translation, the last row
+    ``[0, 0, 0, 1]``. Anything else would aim the arm off where the camera saw a part."""
+    R = T[:3, :3]
+    off = float(np.abs(R.T @ R - np.eye(3)).max())
+    if off > RIGID_TOLERANCE or np.linalg.det(R) < 0:
+        what = "not orthonormal" if off > RIGID_TOLERANCE else "a reflection"
+        raise CalibrationError(
+            f"{name} is not a rigid transform: its rotation is {what} (|R^T R - I| = {off:.3g}, det "
+            f"{np.linalg.det(R):.3g}); refused before the arm moves"
+        )
+    if float(np.abs(T[3] - (0.0, 0.0, 0.0, 1.0)).max()) > RIGID_TOLERANCE:
+        raise CalibrationError(f"{name} is not a rigid transform: its last row is {T[3].tolist()}, not [0, 0, 0, 1]")
+    if float(np.linalg.norm(T[:3, 3])) > MAX_TRANSLATION_M:
+        raise CalibrationError(f"{name} puts the camera {np.linalg.norm(T[:3, 3]):.1f} m away (at most "
+                               f"{MAX_TRANSLATION_M:g} m)")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -71,7 +101,19 @@ class CameraCalibration:
                 T = np.asarray(T, dtype=float)
                 if T.shape != (4, 4) or not np.all(np.isfinite(T)):
                     raise CalibrationError(f"{name} must be a finite 4x4 matrix")
+                _check_rigid(T, name)
                 object.__setattr__(self, name, T)
+        size = self.image_size
+        if (not isinstance(size, tuple | list) or len(size) != 2
+                or not all(isinstance(v, int | np.integer) and not isinstance(v, bool) for v in size)
+                or not all(0 < v <= MAX_IMAGE_SIDE for v in size)):  # fmt: skip
+            raise CalibrationError(f"image_size must be two integers in [1, {MAX_IMAGE_SIDE}] px, got {size!r}")
+        error = self.reprojection_error_px
+        if not (math.isnan(error) or (math.isfinite(error) and 0 <= error <= MAX_REPROJECTION_PX)):
+            raise CalibrationError(
+                f"reprojection_error_px must be in [0, {MAX_REPROJECTION_PX}] px (a calibration worse than that "
+                f"misplaces what the camera sees), got {error!r}"
+            )
         object.__setattr__(self, "K", K)
         object.__setattr__(self, "dist", dist)
         object.__setattr__(self, "image_size", (int(self.image_size[0]), int(self.image_size[1])))
@@ -107,6 +149,9 @@ class CameraCalibration:
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> CameraCalibration:
         known = {"K", "dist", "image_size", "T_base_camera", "T_tcp_camera", "reprojection_error_px", "extra"}
+        if not isinstance(data, dict):
+            raise CalibrationError(f"a camera's calibration must be an object with keys {sorted(known)}, got "
+                                   f"{json.dumps(data)[:40]}")  # fmt: skip
         unknown = set(data) - known
         if unknown:
             raise CalibrationError(f"unknown camera calibration keys {sorted(unknown)}; known: {sorted(known)}")
@@ -115,7 +160,7 @@ class CameraCalibration:
             return cls(
                 K=np.array(data["K"], dtype=float),
                 dist=np.array(data["dist"], dtype=float),
-                image_size=tuple(data["image_size"]),
+                image_size=tuple(data["image_size"]) if isinstance(data["image_size"], list) else data["image_size"],
                 T_base_camera=None if data.get("T_base_camera") is None else np.array(data["T_base_camera"], float),
                 T_tcp_camera=None if data.get("T_tcp_camera") is None else np.array(data["T_tcp_camera"], float),
                 reprojection_error_px=float("nan") if error is None else float(error),
@@ -123,6 +168,17 @@ class CameraCalibration:
             )
         except (KeyError, TypeError, ValueError) as err:
             raise CalibrationError(f"bad camera calibration: {type(err).__name__}: {err}") from None
+
+
+def _check_cell(cell: dict[str, Any]) -> None:
+    """The cell a calibration records: a profile's name, a seed, a box height, each of its type and range."""
+    if "profile" in cell and not isinstance(cell["profile"], str):
+        raise CalibrationError(f"cell 'profile' must be a profile's name, got {cell['profile']!r}")
+    seed = cell.get("cell_seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= 2**32 - 1:
+        raise CalibrationError(f"cell 'cell_seed' must be an integer in [0, {2**32 - 1}], got {seed!r}")
+    if "box_height" in cell and not (finite(cell["box_height"]) and 0 < cell["box_height"] < 10):
+        raise CalibrationError(f"cell 'box_height' must be a finite height in (0, 10) m, got {cell['box_height']!r}")
 
 
 CELL_KEYS = ("profile", "cell_seed", "box_height")
@@ -209,8 +265,14 @@ class CellCalibration:
         cell = data.get("cell", {})
         if not isinstance(cell, dict):
             raise CalibrationError(f"'cell' must map names to values (profile, cell_seed, box_height), got {cell!r}")
-        cameras = {str(k): CameraCalibration.from_dict(v) for k, v in cameras.items()}
-        return cls(cameras, str(data.get("source", "")), dict(cell))
+        _check_cell(cell)
+        checked = {}
+        for name, camera in cameras.items():
+            try:
+                checked[str(name)] = CameraCalibration.from_dict(camera)
+            except CalibrationError as err:
+                raise CalibrationError(f"camera {name!r}: {err}") from None
+        return cls(checked, str(data.get("source", "")), dict(cell))
 
     def save(self, path: str | Path) -> Path:
         return write_text_atomically(path, json.dumps(self.to_dict(), indent=1) + "\n")
@@ -218,14 +280,17 @@ class CellCalibration:
     @classmethod
     def load(cls, path: str | Path) -> CellCalibration:
         try:
-            text = Path(path).read_text(encoding="utf-8")
-        except OSError as err:
-            raise CalibrationError(f"cannot read calibration {path}: {err.strerror or err}") from None
+            text = read_input_text(path)
+        except JsonInputError as err:
+            raise CalibrationError(f"cannot read calibration {path}: {err}") from None
         try:
-            data = json.loads(text)
-        except json.JSONDecodeError as err:
+            data = parse_json(text)
+        except JsonInputError as err:
             raise CalibrationError(f"calibration {path} is not JSON: {err}") from None
-        return cls.from_dict(data)
+        try:
+            return cls.from_dict(data)
+        except CalibrationError as err:
+            raise CalibrationError(f"calibration {path}: {err}") from None
 
 
 __all__ = ["CALIBRATION_FORMAT", "CELL_KEYS", "CalibrationError", "CameraCalibration", "CellCalibration"]

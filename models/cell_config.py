@@ -29,6 +29,7 @@ import cv2
 
 from puzzlebox.models.atomic import write_text_atomically
 from puzzlebox.models.errors import ModelsError
+from puzzlebox.models.json_input import JsonInputError, read_json
 
 CELL_CONFIG_FORMAT = "puzzlebox-cell/1"
 STOP_FORCE_FACTOR = 1.5
@@ -177,11 +178,11 @@ class CellConfig:
 def load_cell_config(path: str | Path) -> CellConfig:
     """Read and validate a cell config file (:class:`CellConfigError` lists every problem)."""
     path = Path(path)
+    if not path.exists():
+        raise CellConfigError([f"no such file: {path}"], str(path))
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise CellConfigError([f"no such file: {path}"], str(path)) from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        data = read_json(path, allow_non_finite=True)  # every field's finiteness is one of the listed problems
+    except JsonInputError as err:
         raise CellConfigError([f"not a readable JSON file: {err}"], str(path)) from None
     return CellConfig.from_dict(data, source=str(path))
 

@@ -24,8 +24,12 @@ turned into triangles at its pose. Parts:
 Every part is **one watertight solid**: the union (manifold3d) of its geoms' closed meshes, so overlapping or
 touching geoms (a hinge pin half in its plate, a drawer's rails against its housing) leave no inner faces nor
 edges of more than two faces, also once an STL loader has welded its vertices; faces keep the colour (geom
-rgba) of the geom they come from. To that end each geom grows by 10 nm on every side before the union and
-edges under 0.1 µm are collapsed after it. The merged ``<name>.stl`` is the parts side by side.
+rgba) of the geom they come from. To that end each geom grows by 50 nm on every side before the union and
+edges under 0.1 µm are collapsed after it: steps of the union's surface stay several float32 steps long, so an STL
+(float32 coordinates) welded by its loader (trimesh merges vertices within 10 nm) stays one closed surface — at
+10 nm a lever's arm against its bracket left steps of 10-20 nm that welding pinched into edges of four faces, that
+part's STL and the merged one open. A part that does not survive that round trip (:func:`watertight_as_stl`) is
+named in an :class:`OpenMeshWarning`. The merged ``<name>.stl`` is the parts side by side.
 
 Frame and units: the **lid frame** (origin at the centre of the lid's top face, x along the box length, z
 up; the shell spans ``z`` from ``-height`` to 0), in **metres** — wherever ``spec.box.pose`` puts the box.
@@ -69,8 +73,9 @@ SAGITTA = 1e-5
 MECHANISM_TAGS = {"interlock": "interlocks", "latch": "latches"}
 """A geom whose name holds ``:<tag>:`` is a mechanism geom; its part's name says ``-<value>-`` there."""
 _MIN_SECTIONS = 8
-_GROW = 1e-8
-"""Each geom's mesh grows by this [m] on every side before a part's union (:func:`_solid`)."""
+_GROW = 5e-8
+"""Each geom's mesh grows by this [m] on every side before a part's union (:func:`_solid`): several float32 steps
+(1.5e-8 m at 0.2 m), so that the steps it leaves survive an STL round trip."""
 _WELD = 1e-7
 """Edges shorter than this [m] collapse in a part's union: trimesh welds vertices nearer than 1e-8 m (STL
 loading), which would pinch a sliver of the union into edges of four faces."""
@@ -245,10 +250,18 @@ def _parts(spec: PuzzleSpec, lock_features: bool, locks: LockMode) -> list[_Part
                         break
         except MeshExportError as err:
             raise MeshExportError(f"spec {spec.name!r}, part {name!r}: {err}") from None
-        if not mesh.is_watertight:
+        if not watertight_as_stl(mesh):
             warnings.warn(f"spec {spec.name!r}: part {name!r} is not watertight", OpenMeshWarning, stacklevel=3)
         parts.append(_Part(name, stems[name], mesh))
     return parts
+
+
+def watertight_as_stl(mesh: trimesh.Trimesh) -> bool:
+    """Whether ``mesh`` is watertight as an STL loader sees it: its coordinates in float32 and its vertices welded
+    (trimesh's tolerance, 10 nm)."""
+    loaded = trimesh.Trimesh(np.asarray(mesh.vertices, dtype=np.float32)[mesh.faces].reshape(-1, 3),
+                             np.arange(3 * len(mesh.faces)).reshape(-1, 3))  # fmt: skip
+    return bool(loaded.is_watertight)
 
 
 def _split(group: str) -> tuple[str, str, str, list[str]]:

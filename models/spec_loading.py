@@ -4,11 +4,11 @@ a circle."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 from puzzlebox.models.errors import SpecError, SpecProblem
+from puzzlebox.models.json_input import JsonInputError, parse_json, read_input_text
 from puzzlebox.models.spec import PuzzleSpec, build_from_valid_data
 from puzzlebox.models.validation import validate_data
 
@@ -37,11 +37,10 @@ def _refuse_duplicate_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
 
 def spec_from_json(text: str, source: str | None = None) -> PuzzleSpec:
     """Parse and validate JSON text."""
-    try:
-        data = json.loads(text, object_pairs_hook=_refuse_duplicate_keys)
-    except json.JSONDecodeError as err:
-        problem = SpecProblem("file", f"not valid JSON: {err.msg} at line {err.lineno} column {err.colno}")
-        raise SpecError([problem], source) from None
+    try:  # bounded depth: a value nested thousands deep is one problem, not a RecursionError
+        data = parse_json(text, object_pairs_hook=_refuse_duplicate_keys, allow_non_finite=True)
+    except JsonInputError as err:
+        raise SpecError([SpecProblem("file", str(err))], source) from None
     except _DuplicateKey as err:
         raise SpecError([SpecProblem("file", f"duplicate key {err.args[0]!r} in one JSON object")], source) from None
     return spec_from_dict(data, source)
@@ -51,7 +50,7 @@ def load_spec(path: str | Path) -> PuzzleSpec:
     """Read, parse and validate a spec file."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as err:
+        text = read_input_text(path)
+    except JsonInputError as err:
         raise SpecError([SpecProblem("file", f"cannot read: {err}")], str(path)) from None
     return spec_from_json(text, str(path))

@@ -25,6 +25,7 @@ from puzzlebox.models.kinds import get_kind, registered_kinds
 from puzzlebox.models.kinds.template import KindTemplate
 from puzzlebox.models.lock_table import LockTable
 from puzzlebox.models.markers import MAX_MARKER_ID
+from puzzlebox.models.names import name_problem
 from puzzlebox.models.spec import SPEC_FORMAT, build_from_valid_data
 
 MAX_COMPONENTS = 62
@@ -125,8 +126,9 @@ def validate_data(data: Any) -> list[SpecProblem]:
     elif data["format"] != SPEC_FORMAT:
         problem("format", f"unsupported format {data['format']!r}; this version reads {SPEC_FORMAT!r}")
 
-    if not isinstance(data.get("name"), str):
-        problem("name", "missing or not a string")
+    name_issue = name_problem(data.get("name"))  # the one rule for names (models.names): any such name is keyed
+    if name_issue is not None:
+        problem("name", name_issue)
 
     components = data.get("components")
     valid_components: dict[str, dict[str, Any]] = {}  # name -> component, for components without problems
@@ -145,10 +147,11 @@ def validate_data(data: Any) -> list[SpecProblem]:
             continue
         ok = True
         name = comp.get("name")
-        if not isinstance(name, str) or not name:
-            problem(f"{where}.name", "missing or not a non-empty string")
+        if name_problem(name) is not None:
+            problem(f"{where}.name", str(name_problem(name)))
             ok = False
         else:
+            assert isinstance(name, str)
             where = f"component {name!r}"
             if name in names:
                 problem(where, f"duplicate name {name!r} (names must be unique)")

@@ -1,6 +1,6 @@
 """Speed figures, measured in one run on this machine (ratios matter more than absolutes here).
 
-    python scripts/bench.py --out FILE [--quick] [--scale-trials T]
+    python scripts/bench.py --out FILE [--quick] [--scale-trials T] [--only manipulation]
 
 - agent decision latency: median and 90th percentile milliseconds per dual-controller decision on
   random lock graphs of N = 5, 10, 16, 32 components (beliefs as they evolve during real episodes;
@@ -16,6 +16,9 @@
   first in the process (renderer, scene and IK model built) and a second one (kept from the first);
 - twin trial outputs: wall time of the same oracle trial plain, with ``--video`` and with ``--record``, in turn
   (medians of 3), and the ratios to plain; the rollout views' box visibility over every frame of 5 trials;
+- manipulation (``puzzlebox/lab/manipulation_speed.py``): ``BoxManipulation-v0`` control steps per second (state
+  observations) beside bare ``mj_step`` replaying the same run (the same simulated time), with their ratio, and
+  ``make_vec`` async with 2 workers against 1 (``--only manipulation``: these figures alone);
 - scale (``puzzlebox/lab/bench_scale.py``): each executor's overhead per no-op task, and twin trials per hour of
   the same T oracle trials on one worker, on a local pool (one worker per core) and on a local Ray cluster,
   one after the other in this run, with each one's speed-up over one worker: start-up included, and warm
@@ -33,8 +36,18 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import argparse  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from puzzlebox.lab.bench_figures import bench_header, default_scale_trials, measured_figures, scale_figures  # noqa: E402
-from puzzlebox.lab.cli import fail, write_json  # noqa: E402
+from puzzlebox.lab.bench_figures import (  # noqa: E402
+    bench_header,
+    default_scale_trials,
+    manipulation_figures,
+    measured_figures,
+    scale_figures,
+)
+from puzzlebox.lab.cli import fail, one_line, write_json  # noqa: E402
+from puzzlebox.lab.errors import RunStoreError  # noqa: E402
+from puzzlebox.lab.out_lock import OutputLock  # noqa: E402
+
+MAX_SCALE_TRIALS = 10_000
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -45,16 +58,22 @@ def main(argv: list[str] | None = None) -> int:
         "--scale-trials", type=int, default=None,
         help="twin trials per executor for the scale figures (default 40; --quick 4; 0 skips them)",
     )  # fmt: skip
+    parser.add_argument("--only", choices=("manipulation",), help="measure these figures alone")
     args = parser.parse_args(argv)
-    if args.scale_trials is not None and args.scale_trials < 0:
-        fail(f"--scale-trials must be >= 0, got {args.scale_trials}")
+    if args.scale_trials is not None and not 0 <= args.scale_trials <= MAX_SCALE_TRIALS:
+        fail(f"--scale-trials must be >= 0 and <= {MAX_SCALE_TRIALS}, got {args.scale_trials}")
+    try:  # owned before the work (minutes): a directory there, a read-only place or another writer is refused now
+        lock = OutputLock(Path(args.out), directory=False)
+    except RunStoreError as err:
+        fail(one_line(err))
     results = bench_header()
-    for figure in measured_figures(args.quick):
+    for figure in manipulation_figures(args.quick) if args.only else measured_figures(args.quick):
         figure.keep(results)
         for line in figure.lines:
             print(line)
     path = write_json(Path(args.out), results)  # what is measured so far is kept if the scale part fails
     trials = args.scale_trials if args.scale_trials is not None else default_scale_trials(args.quick)
+    trials = 0 if args.only else trials
     if trials:
         for figure in scale_figures(trials, args.quick):
             figure.keep(results)
@@ -62,6 +81,7 @@ def main(argv: list[str] | None = None) -> int:
                 print(line)
         path = write_json(Path(args.out), results)
     print(f"-> {path}")
+    lock.release()
     return 0
 
 

@@ -30,6 +30,9 @@ import time
 from pathlib import Path
 
 from puzzlebox.lab.cli import fail, one_line, versions, write_json
+from puzzlebox.lab.errors import RunStoreError
+from puzzlebox.lab.inputs import MAX_SEED, MAX_VIEWS
+from puzzlebox.lab.out_lock import OutputLock
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -46,8 +49,12 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
         fail(f"--overview-views must be at least 6, got {args.overview_views}")
     if args.wrist_views < 6:
         fail(f"--wrist-views must be at least 6, got {args.wrist_views}")
-    if args.cell_seed is not None and args.cell_seed < 0:
-        fail(f"--cell-seed must be >= 0, got {args.cell_seed}")
+    for flag, seed in (("--cell-seed", args.cell_seed), ("--seed", args.seed)):
+        if seed is not None and not 0 <= seed <= MAX_SEED:
+            fail(f"{flag} must be >= 0 and <= {MAX_SEED}, got {seed}")
+    for flag, views in (("--overview-views", args.overview_views), ("--wrist-views", args.wrist_views)):
+        if views > MAX_VIEWS:
+            fail(f"{flag} must be at most {MAX_VIEWS}, got {views}")
     if args.out.exists() and args.out.is_dir():
         fail(f"--out {args.out} is a directory; give a file name")
     return args
@@ -76,6 +83,10 @@ def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     spec, profile = load_inputs(args)
     start = time.perf_counter()
+    try:  # before the work: a file that cannot be written there, or that another process writes, is refused now
+        lock = OutputLock(args.out, directory=False)
+    except RunStoreError as err:
+        fail(one_line(err))
 
     from puzzlebox.lab.calibration_run import CellCalibrationError, calibrate_cell
 
@@ -103,6 +114,7 @@ def main(argv: list[str] | None = None) -> int:
             f"{f['truth_principal_error_px'][1]:+.2f} px"
         )
     print(f"wrote {path} (settings in {path.name}.config.json) in {wall:.1f} s")
+    lock.release()
     return 0
 
 

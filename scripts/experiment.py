@@ -11,6 +11,7 @@ the reality gap in the twin.
     python scripts/experiment.py disassembly --agents memory,dual,dqn,model-based --out DIR [--quick] [--runs R]
                                  [--seeds S] [--workers W | --ray ...] [--validation] [--no-holding-rule]
     python scripts/experiment.py kinds --out DIR [--quick] [--runs R] [--workers W]
+    python scripts/experiment.py manipulation --out DIR [--quick] [--seeds N] [--steps N] [--algo ppo|sac]
 
 Writes ``DIR/<protocol>.json`` (every point, mean and std over training seeds and each seed's value,
 the settings), ``DIR/<protocol>.png`` (success and mean actions, like the paper's Fig. 3 panels) and
@@ -19,7 +20,7 @@ protocols (sharing the deep agents' training) and adds ``DIR/all.md`` with the e
 table and the wall time of every part.
 
 The deep agents (``dqn``, ``model-based``, ``mt-dqn``, ``mt-model-based``; torch) train as jobs, one
-per agent, training seed and training-variant count, as tasks of ``learning.runner``: ``--workers`` at
+per agent, training seed and training-variant count, as tasks of ``puzzlebox.lab.runner``: ``--workers`` at
 a time (default: one per core; ``--ray auto|ADDRESS``: on Ray). Every finished job is saved in
 ``DIR/jobs/`` at once: run the same command again after an
 interruption and it resumes, reusing every finished job.
@@ -53,6 +54,10 @@ drawer, lever): every five-kind chain and 100 random boxes symbolically, and 3 h
 twin under ``ideal`` and ``realistic``, by the memory agent trained on the other chains:
 ``DIR/kinds.{json,md,png}``; every step resumes.
 
+``manipulation`` (``puzzlebox/lab/manipulation_experiment.py``; ``pip install puzzlebox[rl]``) trains PPO (or SAC)
+from scratch on ``BoxManipulation-v0``, a free slide and a free wheel, ``--seeds`` seeds of ``--steps`` env steps each:
+``DIR/manipulation.{json,png,md}``, success against env steps (a point appended at each evaluation).
+
 ``faults`` (``puzzlebox/lab/faults.py``) runs each fault class on purpose in real processes — ``trial.py``
 SIGKILLed at random moments and resumed (``--runs`` runs in the twin; ``--quick``: symbolic), concurrent
 trainers on one memory, a memory truncated at every page, the ordinary command-line mistakes — and writes
@@ -62,11 +67,13 @@ trainers on one memory, a memory truncated at every page, the ordinary command-l
 from __future__ import annotations
 
 import argparse
+import sys
 
 from puzzlebox.lab.cli import fail
 from puzzlebox.lab.errors import ExperimentStepFailed, LabError
 from puzzlebox.lab.experiment_flags import AGENTS, PROTOCOL_NAMES, ExperimentFlags
 from puzzlebox.lab.experiment_protocols import run_experiment
+from puzzlebox.lab.interrupt import AbortOnSignal, Interrupted
 from puzzlebox.learning.agents.factory import POSE_ENCODINGS
 
 
@@ -97,13 +104,20 @@ def main(argv: list[str] | None = None) -> int:
         "--no-holding-rule", action="store_true",
         help="disassembly: the belief agents may believe a removed part holds another (the paper's hypotheses)",
     )  # fmt: skip
+    parser.add_argument("--steps", type=int, default=None, help="manipulation: env steps per run (default 60000)")
+    parser.add_argument("--algo", default=None, help="manipulation: ppo (default) or sac")
     args = parser.parse_args(argv)
-    try:
-        run_experiment(ExperimentFlags(**vars(args)))
+    try:  # SIGINT or SIGTERM, whatever this process inherited: stop now, in one line; every saved job is kept
+        with AbortOnSignal():
+            run_experiment(ExperimentFlags(**vars(args)))
     except ExperimentStepFailed as err:  # the command it ran said why itself
         return err.returncode
     except LabError as err:
         fail(str(err))
+    except (Interrupted, KeyboardInterrupt) as err:
+        name = err.signal_name if isinstance(err, Interrupted) else "SIGINT"
+        print(f"{name}: stopped; every finished job is kept in {args.out}: the same command resumes", file=sys.stderr)
+        return 130
     return 0
 
 

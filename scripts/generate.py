@@ -53,6 +53,7 @@ from tqdm import tqdm
 from puzzlebox.lab.box_exports import export_box_meshes, export_mjcf
 from puzzlebox.lab.cli import fail, write_json
 from puzzlebox.lab.errors import LabError, SpecFilesInvalid
+from puzzlebox.lab.inputs import check_seed
 from puzzlebox.lab.spec_files import load_box_specs, validation_lines, write_spec_file
 from puzzlebox.lab.spec_generators import chain_settings, generate_spec, random_settings
 from puzzlebox.models import ModelsError
@@ -61,7 +62,7 @@ from puzzlebox.models.mechanism_mjcf import LOCK_MODES
 
 
 def _paper(args: argparse.Namespace) -> None:
-    for spec in paper_family(args.split, seed=args.seed):
+    for spec in paper_family(args.split, seed=check_seed(args.seed)):
         _print(write_spec_file(spec, Path(args.out) / f"{spec.name}.json", args.plot))
 
 

@@ -6,8 +6,9 @@ alone with its lock features (twin.gallery).
     python scripts/render.py SPEC --out DIR [--views] [--turntable [--frames N] [--fps F]]
 
 Writes ``DIR/<camera>.png`` (and ``DIR/sweep.mp4``, ``DIR/sweep.json``); or ``DIR/top.png``,
-``DIR/three-quarter.png``, ``DIR/component-<name>.png`` (--views) and ``DIR/turntable.mp4`` (--turntable);
-always ``DIR/render.config.json``.
+``DIR/three-quarter.png``, ``DIR/component-<name>.png``, the annotated ``DIR/top-annotated.png`` and
+``DIR/three-quarter-annotated.png`` (parts labelled, the goal marked, lock features in their locker's colour, a
+legend of the lock rules below) (--views) and ``DIR/turntable.mp4`` (--turntable); always ``DIR/render.config.json``.
 """
 
 from __future__ import annotations
@@ -19,6 +20,9 @@ from pathlib import Path
 import imageio.v3 as iio
 
 from puzzlebox.lab.cli import fail, one_line, versions, write_json
+from puzzlebox.lab.errors import RunStoreError
+from puzzlebox.lab.inputs import MAX_IMAGE_SIDE, MAX_VIEWS, check_count, check_seed
+from puzzlebox.lab.out_lock import OutputLock
 from puzzlebox.models import ModelsError, SpecError, load_spec
 from puzzlebox.twin.errors import TwinError
 from puzzlebox.twin.rendering import RenderConfig, Renderer
@@ -45,12 +49,16 @@ def main(argv: list[str] | None = None) -> int:
     gallery = args.views or args.turntable
     if gallery and (args.video or args.camera is not None):
         fail("--camera and --video render the twin's scene; run them apart from --views/--turntable")
-    if args.turntable and (args.frames < 1 or not args.fps > 0):
-        fail(f"--frames must be >= 1 and --fps > 0, got {args.frames} and {args.fps}")
+    if args.turntable and (args.frames < 1 or not 0 < args.fps <= 1000):
+        fail(f"--frames must be >= 1 and --fps in (0, 1000], got {args.frames} and {args.fps}")
     if args.turntable and (args.width % 2 or args.height % 2):
         fail(f"--turntable needs an even --width and --height (H.264 yuv420p), got {args.width}x{args.height}")
     args.camera = args.camera or "overview"
     try:
+        for flag, value, bound in (("--width", args.width, MAX_IMAGE_SIDE), ("--height", args.height, MAX_IMAGE_SIDE),
+                                   ("--frames", args.frames, MAX_VIEWS)):  # fmt: skip
+            check_count(value, flag, bound)
+        check_seed(args.seed)
         config = RenderConfig(width=args.width, height=args.height, shadows=args.shadows)
         spec = load_spec(args.spec)
     except (ValueError, SpecError) as err:
@@ -58,9 +66,15 @@ def main(argv: list[str] | None = None) -> int:
     if gallery and spec.box is None:
         fail(f"spec {spec.name!r} is a disassembly scene (no box): --views and --turntable render puzzle boxes")
     out = Path(args.out)
-    write_json(out / "render.config.json", {"command": "render", **vars(args), "versions": versions()})
+    try:  # owned before any work: a file there, a read-only place or another writer is refused now
+        lock = OutputLock(out)
+        write_json(out / "render.config.json", {"command": "render", **vars(args), "versions": versions()})
+    except RunStoreError as err:
+        fail(one_line(err))
+    except OSError as err:
+        fail(f"--out {out}: cannot write there ({err.strerror or err})")
     if gallery:
-        return _gallery(spec, out, config, args)
+        return _gallery(spec, out, config, args, lock)
     try:
         with TwinSession(spec, seed=args.seed) as session, Renderer(session.model, config) as renderer:
             png = out / f"{args.camera.replace('/', '_')}.png"
@@ -76,22 +90,24 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"wrote {video}: opened {opened} in {session.time:.1f} s simulated")
     except (ModelsError, TwinError) as err:
         fail(str(err))
+    lock.release()
     return 0
 
 
-def _gallery(spec, out: Path, config: RenderConfig, args: argparse.Namespace) -> int:
+def _gallery(spec, out: Path, config: RenderConfig, args: argparse.Namespace, lock: OutputLock) -> int:
     from puzzlebox.twin.gallery import Gallery
 
     try:
         with Gallery(spec, config) as gallery:
             if args.views:
-                paths = gallery.write_views(out)
+                paths = gallery.write_views(out) + gallery.write_annotated(out)
                 print(f"wrote {len(paths)} views to {out}: {', '.join(p.name for p in paths)}")
             if args.turntable:
                 video = gallery.write_turntable(out / "turntable.mp4", frames=args.frames, fps=args.fps)
                 print(f"wrote {video}: {args.frames} frames at {args.fps:g} frames/s")
     except (ModelsError, TwinError) as err:
         fail(one_line(err))
+    lock.release()
     return 0
 
 

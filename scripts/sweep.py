@@ -6,7 +6,7 @@ aggregate it.
 The sweep file's format is in ``puzzlebox/lab/sweep_grid.py``. Writes ``DIR/results.json`` (the contract of
 ``trial.py``: success rate, mean actions, every run; plus ``cells``, one summary per spec, placement, agent
 and profile), ``DIR/cells.md`` (the per-cell table) and ``DIR/cells.png`` (success and mean actions per
-cell). Every trial is a task of ``learning.runner``, its record in ``DIR/runs/`` the moment it ends: a
+cell). Every trial is a task of ``puzzlebox.lab.runner``, its record in ``DIR/runs/`` the moment it ends: a
 kill keeps every finished trial, and the same command with ``--resume`` computes only what is missing.
 """
 
@@ -22,9 +22,9 @@ from puzzlebox.lab.cli import fail, one_line
 from puzzlebox.lab.errors import RunStoreError
 from puzzlebox.lab.interrupt import StopRequests
 from puzzlebox.lab.run_store import Periodic, RunStore
+from puzzlebox.lab.runner import RunnerError, make_executor, run_tasks
 from puzzlebox.lab.sweep_grid import Cell, SweepError, grid, load_sweep
 from puzzlebox.learning import LearningError, summarise
-from puzzlebox.learning.runner import RunnerError, make_executor, run_tasks
 from puzzlebox.models import ModelsError
 from puzzlebox.twin.errors import TwinError
 
@@ -94,7 +94,7 @@ def main(argv: list[str] | None = None) -> int:
         tasks, cells = grid(sweep, path.resolve().parent)
         executor = make_executor(args.workers, args.ray)
     except (SweepError, ModelsError, LearningError, TwinError, OSError) as err:  # a calibration's is a ModelsError
-        fail(f"{path}: {err}" if not str(err).startswith(("sweep", "cannot read")) else str(err))
+        fail(f"{path}: {one_line(err)}" if not str(err).startswith(("sweep", "cannot read")) else one_line(err))
     out = Path(args.out)
     try:
         store = RunStore(out, {"command": "sweep", "sweep": sweep, "sweep_file": str(path)}, args.resume, args.force)
@@ -117,17 +117,20 @@ def main(argv: list[str] | None = None) -> int:
         rewrite()
 
     try:
-        with StopRequests("trial") as stop, executor:
+        with store.keeping(), StopRequests("trial") as stop, executor:  # a full disk: one line, what is kept
             report = run_tasks(tasks, store.records, executor, stop=lambda: stop.requested, on_record=keep,
                                postfix=lambda r: f"solved {sum(x['solved'] for x in r.values())}/{len(r)}",
                                desc=f"sweep {path.stem}")  # fmt: skip
+        found.update(report.records)
+        summary = results()
+        store.write_results(summary)
+        with store.keeping():
+            (out / "cells.md").write_text(cells_table(summary["cells"]), encoding="utf-8")
+            cells_plot(summary["cells"], out / "cells.png")
     except RunnerError as err:
         fail(str(err))
-    found.update(report.records)
-    summary = results()
-    store.write_results(summary)
-    (out / "cells.md").write_text(cells_table(summary["cells"]), encoding="utf-8")
-    cells_plot(summary["cells"], out / "cells.png")
+    except RunStoreError as err:
+        fail(one_line(err))
     n_cells = len(set(cells.values()))
     print(f"{len(report.records)} of {len(tasks)} trials ({len(report.reused)} reused) in {n_cells} cells: "
           f"success {summary['success_rate']:.1%}, mean actions {summary['mean_actions']:.2f} -> {out}")  # fmt: skip

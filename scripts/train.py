@@ -38,8 +38,15 @@ from pathlib import Path
 from puzzlebox.lab.cli import fail, versions
 from puzzlebox.lab.deep_training import train_deep
 from puzzlebox.lab.errors import LabError
+from puzzlebox.lab.inputs import MAX_ACTIONS, MAX_EPISODES, check_count, check_seed
 from puzzlebox.lab.memory_training import MemoryTraining, training_command
-from puzzlebox.lab.training_setup import check_writable, load_training_specs, memory_controller, twin_training_for
+from puzzlebox.lab.training_setup import (
+    check_writable,
+    hold_output_file,
+    load_training_specs,
+    memory_controller,
+    twin_training_for,
+)
 from puzzlebox.learning import DEEP_AGENT_NAMES
 
 
@@ -61,11 +68,10 @@ def main(argv: list[str] | None = None) -> int:
     )  # fmt: skip
     parser.add_argument("--resume", action="store_true", help="continue the latest run of this same command")
     args = parser.parse_args(argv)
-    if args.episodes < 1 or args.max_actions < 1:
-        fail("--episodes and --max-actions must be >= 1")
-    if args.seed < 0:
-        fail(f"--seed must be >= 0, got {args.seed}")
     try:
+        check_count(args.episodes, "--episodes", MAX_EPISODES)
+        check_count(args.max_actions, "--max-actions", MAX_ACTIONS)
+        check_seed(args.seed, count=args.episodes)  # episode e uses seed + e
         return _train(args)
     except LabError as err:
         fail(str(err))
@@ -83,11 +89,12 @@ def _train(args: argparse.Namespace) -> int:
             fail("--sim twin trains the memory agent only (deep agents train in the symbolic simulator)")
         if args.checkpoint is None or args.memory is not None:
             fail(f"--agent {args.agent} trains a network: give --checkpoint FILE (and no --memory)")
-        check_writable(Path(args.checkpoint), "--checkpoint")
+        lock = hold_output_file(Path(args.checkpoint), "--checkpoint")  # one trainer writes a checkpoint
         command = {"command": "train", **vars(args), "versions": versions()}
         solved = train_deep(args.agent, specs, seed=args.seed, episodes=args.episodes, max_actions=args.max_actions,
                             checkpoint=args.checkpoint, command=command)  # fmt: skip
         print(f"trained {args.agent} for {args.episodes} episode(s), {solved} solved -> {args.checkpoint}")
+        lock.release()
         return 0
     if args.memory is None:
         fail("the memory agent needs --memory MEM.sqlite")

@@ -28,10 +28,10 @@ from puzzlebox.lab.cells import CellError, load_cell
 from puzzlebox.lab.cli import fail, one_line
 from puzzlebox.lab.errors import AgentClassError, ArmTrialFailed, ArmTrialRefused, RunStoreError, TrialConfigError
 from puzzlebox.lab.run_store import RunStore
-from puzzlebox.lab.trial_batch import TrialBatch, run_batch, summary_lines
+from puzzlebox.lab.runner import RunnerError, make_executor
+from puzzlebox.lab.trial_batch import InputError, TrialBatch, check_batch_numbers, run_batch, summary_lines
 from puzzlebox.learning import AGENT_NAMES, LearningError, make_agent
 from puzzlebox.learning.memory import MemoryStore
-from puzzlebox.learning.runner import RunnerError, make_executor
 from puzzlebox.models import SpecError, load_spec
 
 SIMS, ROBOTS = ("symbolic", "twin"), ("twin", "xarm")
@@ -133,10 +133,10 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
         return _arm_main(args, arm)
     if args.ip is not None or args.cell is not None:
         fail("--ip and --cell go with --robot xarm")
-    if args.runs < 1 or args.max_actions < 1:
-        fail("--runs and --max-actions must be >= 1")
-    if args.seed < 0:
-        fail(f"--seed must be >= 0, got {args.seed}")
+    try:  # run r uses seed S + r: the last seed too is a seed; sizes bounded (a typo is one line, not MemoryError)
+        check_batch_numbers(len(args.specs), args.runs, args.seed, args.max_actions, args.workers)
+    except InputError as err:
+        fail(str(err))
     if args.workers is not None and (args.workers < 1 or args.ray is not None):
         fail("--workers must be >= 1, and goes without --ray" if args.workers < 1 else "give --workers or --ray")
     if ":" in args.agent and os.getcwd() not in sys.path:  # as `python -m` would: an agent module beside the user

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import collections
 import collections.abc
+import functools
 import math
 import time
 from dataclasses import dataclass, field
@@ -57,6 +58,8 @@ from puzzlebox.skills.kinematics import ArmKinematics, top_down
 from puzzlebox.skills.toggle_result import ToggleResult
 
 SLIPPED_OFF = "latched: held until the grasp slipped"
+HELD_PART_WAY = "latched: held part-way"
+"""Reason prefix of a part that stalled against the pull past ``blocked_progress`` (``PrimitiveConfig.stall_force``)."""
 INCOMPLETE_TRAVEL = "IncompleteTravel"
 """Reason prefix of a motion that ran its course short of ``moved_fraction`` (no latch read)."""
 STOPPED = "motion stopped"
@@ -178,6 +181,21 @@ class PrimitiveConfig:
     blocked_magnitude: float = 35.0
     """Force magnitude (any direction) that, with little progress, also means a latch [N]: a latched wheel
     or a part pulled along a slightly wrong direction loads the grasp sideways more than along the path."""
+    back_off_force: float = 35.0
+    """The force guard's threshold while a held handle is taken back to where it was grasped [N]; above it the arm
+    backs off along the load instead: a wheel pulled as a door (a misread kind) was dragged there with 49 N true."""
+    stall_force: float = 20.0
+    """Force opposing the motion that, past ``blocked_progress`` within the travel and with the part stalled
+    (``stall_progress`` over ``stall_window``), means it is held part-way [N]: a lock's pins leave play (a part
+    held open moves up to ~30 % of its travel before they meet), and a slide closed into it was driven on to the
+    60 N guard (63 N true; its retry then descended onto the post it had left part-way: 65 N). Stopped there, the
+    handle is taken back along its path to where it was grasped; one stalled past ``moved_fraction`` is at its
+    stop, and pushed no further."""
+    stall_progress: float = 0.01
+    """Least progress (fraction of the travel) over ``stall_window`` of a part that has not stalled: a free part
+    covers ~2 % in that time; a slide met by a pin crept 0.6 % in 0.15 s as the load rose 10 N a tick."""
+    stall_window: float = 0.05
+    """Time over which a stall is measured [s] (longer by :attr:`Toggler.slowdown` with the motions)."""
     door_overtravel: float = 0.15
     """How far past the far end of a door's travel the grasp point is driven (fraction of the travel), at half
     the pace of the arc: a handle pivoting between the pads lags the fingers by up to ~15 mm along an 85 deg
@@ -236,6 +254,11 @@ class PrimitiveConfig:
     """How far the arm backs off along the load after a force stop, before letting go [m]."""
     push: DoorPushConfig = field(default_factory=DoorPushConfig)
     """How doors are pushed (:mod:`skills.door_push`)."""
+    careful_pace: float = 0.5
+    """Pace of every motion in contact (descent, closing, actuation, pushes) of a careful toggle
+    (``toggle(careful=True)``: a part tried as a kind it was not told, whose path may meet a post or a stop where
+    none was expected), as a fraction of the usual [-]: a force rising against it builds half as fast during the
+    filtered reading's delay."""
     force_limit: float = 60.0
     """Safety limit on the filtered wrist force, whatever the motion [N]. A toggle needs 8-9 N, a latch is
     felt at 20 N (``blocked_force``); UFACTORY publishes no newton threshold for its collision detection
@@ -287,6 +310,18 @@ class PrimitiveConfig:
                 f"need lift_slow_height >= 0 [m] and lift_slow_time >= tick [s], got {self.lift_slow_height}, "
                 f"{self.lift_slow_time}"
             )
+        if not (0.0 < self.stall_force < self.force_limit and self.stall_progress >= 0.0 and self.stall_window > 0.0):
+            raise ValueError(
+                "need 0 < stall_force < force_limit [N], stall_progress >= 0 and stall_window > 0 [s], got "
+                f"{self.stall_force}, {self.stall_progress}, {self.stall_window}"
+            )
+        if not self.blocked_force < self.back_off_force <= self.force_limit:
+            raise ValueError(
+                "need blocked_force < back_off_force <= force_limit [N], got "
+                f"{self.blocked_force}, {self.back_off_force}, {self.force_limit}"
+            )
+        if not 0.0 < self.careful_pace <= 1.0:
+            raise ValueError(f"need 0 < careful_pace <= 1, got {self.careful_pace}")
         if not 0.0 < self.cautious_contact_force < self.force_limit:
             raise ValueError(
                 "need 0 < cautious_contact_force < force_limit [N], got "
@@ -343,6 +378,8 @@ class Toggler(DoorPushing):
         """The force guard's threshold now [N]: ``force_limit``, or ``cautious_contact_force`` in a cautious descent."""
         self.cautious = False
         """Whether the toggle in progress descends cautiously (``toggle(cautious=True)``)."""
+        self.careful = False
+        """Whether the toggle in progress moves in contact at ``careful_pace`` (``toggle(careful=True)``)."""
         self.slowdown = 1.0
         """How much slower than configured the motions in contact of the toggle in progress run [-]: the
         running median's length over ``force_filter_samples`` (1 below 7.2 N of F/T noise)."""
@@ -493,6 +530,7 @@ class Toggler(DoorPushing):
         raised: bool = False,
         cautious: bool = False,
         lean: np.ndarray | None = None,
+        careful: bool = False,
     ) -> ToggleResult:
         """Try to move the component of joint model ``jm`` to its other state (see the module docstring).
         ``where_is`` looks at the part and tells the fraction of its travel at which it stands now (0 closed,
@@ -505,9 +543,11 @@ class Toggler(DoorPushing):
         ``cautious_descend_time`` and stopped at ``cautious_contact_force``. ``lean``: a horizontal vector (base
         frame) in whose direction a pinch's gripper leans by ``lean_angle`` times its length (at most 1) about its
         closing axis, away from what may stand over the part (:func:`skills.door_clearance.lean_away`); it
-        descends and lifts along its tilted axis."""
+        descends and lifts along its tilted axis. ``careful``: every motion in contact at ``careful_pace`` (a part
+        tried as a kind it was not told)."""
         wall = time.perf_counter()
         self.cautious = cautious
+        self.careful = careful
         self.lean = lean
         start_time = self.robot.time
         self.reset_force_watch()
@@ -520,6 +560,7 @@ class Toggler(DoorPushing):
             result = self._push_on(jm, opening, 0.0 if covered is None else covered, where_is)
         else:
             result = self._attempt(lambda: self._toggle(jm, 1.0 if opening else -1.0))
+            empty = result.reason.startswith(GraspFailure.__name__)
             if pushable and opening and result.outcome == "moved" and not result.end_stop_felt and c.push.top_up:
                 self._attempt(lambda: self._top_up_door(jm))  # best effort: the pinch's verdict stands
             if pushable and result.reason.startswith(PADS_LOST_HOLD):
@@ -529,6 +570,7 @@ class Toggler(DoorPushing):
                     result = self._push_on(jm, opening, covered, where_is)
                 elif result.progress < c.moved_fraction:  # (past it, the world looks whether it moved)
                     result.reason += "; the door stands part-way where it cannot be seen: not pushed"
+            result.closed_on_nothing = empty
         result.peak_force = self.peak_force  # over the whole try, withdrawal included
         result.sim_time = self.robot.time - start_time
         result.wall_time = time.perf_counter() - wall
@@ -610,7 +652,7 @@ class Toggler(DoorPushing):
         # older samples were taken with another zero; the window is as long as this noise needs
         samples = self.filter_samples(self.rest_noise)
         self._force_window = collections.deque(maxlen=samples)
-        self.slowdown = samples / c.force_filter_samples
+        self.slowdown = samples / c.force_filter_samples / (c.careful_pace if self.careful else 1.0)
         self.phase = "descending"
         if not self.cautious:
             self.move_to(target, c.descend_time * self.slowdown)
@@ -665,6 +707,8 @@ class Toggler(DoorPushing):
         across = np.zeros(3)  # the path's offset across itself, yielding to the load there [m, base frame]
         yields = jm.handling.swings_up  # (slides and wheels yielding too were read latched while free)
         returning = 1.0 - c.tick / c.comply_return_time  # the offset kept per tick past the travel
+        window = max(2, round(c.stall_window * self.slowdown / c.tick))
+        recent: collections.deque[float] = collections.deque(maxlen=window)  # progress over the last stall_window
         self.ik.set_joints(self.robot.joint_positions())
         for k in range(1, last_tick + 1):
             paced = pace * c.breakaway_pace * k if k <= slow else c.breakaway_fraction + pace * (k - slow)
@@ -697,9 +741,19 @@ class Toggler(DoorPushing):
             if s > 1.0 and magnitude > c.overtravel_force:  # past the travel and pushing hard: stop here
                 end = max(1.0, min(progress, s))
             if (opposing > c.blocked_force or magnitude > c.blocked_magnitude) and progress < c.blocked_progress:
-                self.move_to(at_grasp, 0.5)  # back off to where the handle was grasped
+                self._take_back(functools.partial(self.move_to, at_grasp, 0.5))  # back to where the handle was grasped
                 return ToggleResult(
                     "blocked", "latched: force rose without progress", progress, max(forces), forces=forces
+                )
+            recent.append(progress)
+            stalled = len(recent) == recent.maxlen and progress - recent[0] < c.stall_progress
+            if stalled and opposing > c.stall_force and s <= 1.0 and progress >= c.moved_fraction:
+                end = max(progress, 0.0)  # at its stop short of the perceived travel: pushed no further
+                break
+            if stalled and opposing > c.stall_force and s <= 1.0:  # (progress >= blocked_progress: tested above)
+                self._take_back(functools.partial(self._return_along, jm, sign, begin, progress, at_grasp, across))
+                return ToggleResult(
+                    "blocked", f"{HELD_PART_WAY} ({progress:.0%} of the travel)", progress, max(forces), forces=forces
                 )
         for _ in range(round(2 * c.settle_time / c.tick)):  # let the part catch up with the end target
             progress = self.progress = self._progress(jm, sign, begin)
@@ -715,8 +769,38 @@ class Toggler(DoorPushing):
         result = self._verdict(self._progress(jm, sign, begin), forces, "latched: pulled without progress")
         result.end_stop_felt = in_end_stop
         if result.outcome == "blocked":
-            self.move_to(at_grasp, 0.5)
+            self._take_back(functools.partial(self.move_to, at_grasp, 0.5))
         return result
+
+    def _take_back(self, motion: collections.abc.Callable[[], None]) -> None:
+        """Run ``motion``, a held handle's way back to where it was grasped, under ``back_off_force``: stopped there,
+        the arm backs off along the load instead (the try's verdict stands)."""
+        limit = self.limit
+        self.limit = min(limit, self.config.back_off_force)
+        try:
+            motion()
+        except ForceLimitExceeded:
+            self.guard = False
+            try:
+                self._relieve()
+            finally:
+                self.guard = True
+        finally:
+            self.limit = limit
+
+    def _return_along(
+        self, jm: JointModel, sign: float, begin: float, covered: float, at_grasp: np.ndarray, across: np.ndarray
+    ) -> None:
+        """Take a handle held part-way, ``covered`` of the travel from ``begin``, back along its path to where it
+        was grasped (``at_grasp``; ``across``: the path's offset, let go on the way) over ``release_time`` per 10 %
+        of the travel: a straight line cuts a hinge's arc."""
+        c = self.config
+        ticks = max(1, round(c.release_time * max(covered, 0.0) / 0.1 / c.tick))
+        for k in range(1, ticks + 1):
+            left = 1.0 - k / ticks
+            target = self._pose_along(jm, begin + sign * covered * left, at_grasp, begin)
+            target[:3, 3] += across * left
+            self._tick(target)
 
     def _yield_across(self, across: np.ndarray, direction: np.ndarray) -> np.ndarray:
         """The path's offset ``across`` [m] moved along the filtered force's component across the direction of

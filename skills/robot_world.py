@@ -20,6 +20,24 @@ that marker at the start, else close up from the wrist camera — (a marker that
 vanished, as a door's does when it stands open, moved; one still at its closed pose after a "moved"
 means the handle slipped out of the pads: with a weak grip a latched door's did, with hardly any force).
 
+A part that will not move as its kind says (a misread marker: the pipeline was told its kind wrong) is tried as the
+other kinds its perceived geometry allows, in the same try (:meth:`RobotWorld._try_other_kinds`). The rule: a part not
+yet moved as the kind in use is tried as other kinds (i) when the world would give it up (every attempt failed: as that
+kind the fingers closed on nothing, or the path carried nothing), or (ii) when it is blocked as that kind a second time.
+A first blocked try is never second-guessed: the pull of a wrong kind's path reads exactly as a lock does, and a lock is
+what the agent learns from it. From the second on, the other kinds are tried after the kind in use held (robot time, not
+an action), and the outcome stays ``blocked`` unless one of them moves the part: a locked part is held whatever path
+pulls it, so the agent still learns its locks from every blocked try. The candidates: registered kinds whose ``lift``
+fits the marker's perceived height above the lid and whose handle is not where a grasp on the part closed on nothing;
+those of the family of the kinds the world was told (the paper's, when all are) first, then — after a grasp that held
+the handle — those with their handle where the kind in use has it, then in registration order; at most
+``WorldConfig.other_kinds`` a try, one attempt each, every motion in contact at half pace
+(``Toggler.toggle(careful=True)``: the path may meet a post where none was expected), in at most ``other_kind_rounds``
+tries of a part. A kind that moves the part is kept for every later try of it and observed (:meth:`RobotWorld.observe`,
+:attr:`RobotWorld.found_kinds`); one whose grasp held where the kind in use closed on nothing, or that carried a door
+part of the way, is used (and observed) from then on; if none moves it, the outcome is ``blocked`` when any grasp felt
+the part held, else the first outcome.
+
 :attr:`RobotWorld.log` records each try as sensed and — only when an evaluator passes
 ``ground_truth`` — the simulator's truth beside it, for scoring.
 """
@@ -34,8 +52,9 @@ import numpy as np
 
 from puzzlebox.models import ComponentObservation, SceneObservation, TryResult
 from puzzlebox.models.calibration import CellCalibration
+from puzzlebox.models.disassembly_kinds import family_kind_names
 from puzzlebox.models.geometry import wrap_angle
-from puzzlebox.models.kinds import get_kind
+from puzzlebox.models.kinds import get_kind, registered_kinds
 from puzzlebox.models.robot import Robot
 from puzzlebox.skills.door_clearance import lean_away, near_open_door
 from puzzlebox.skills.joint_model import JointModel, joint_model
@@ -77,6 +96,17 @@ class WorldConfig:
     """A grasp point this close to where an open door may overhang (:mod:`skills.door_clearance`) is descended
     onto cautiously [m]: the fingers, 42 mm apart and 30 mm wide, reach ~30 mm from it, and the door's pose
     is known to ~5 mm."""
+    other_kinds: int = 2
+    """Most other kinds a part that will not move as its kind says is tried as, in one try (module docstring);
+    0: never."""
+    other_kind_rounds: int = 2
+    """Most tries of one part in which it is tried as other kinds."""
+    lift_tolerance: float = 0.012
+    """A kind fits a marker perceived this close to the kind's ``lift`` above the lid [m] (a lever's marker stands
+    30 mm up; close up, markers are measured within ~1 mm)."""
+    same_handle: float = 0.015
+    """Two kinds whose grasp points at a marker's perceived pose lie this close grasp the same handle [m] (the
+    handle post is 12 mm wide; other kinds' handles stand 70 mm apart)."""
     survey: SurveyConfig = field(default_factory=SurveyConfig)
     primitives: PrimitiveConfig = field(default_factory=PrimitiveConfig)
     """The primitives' config (force limit, latch threshold...): a real cell's comes from its cell config
@@ -100,6 +130,8 @@ class ActionLog:
     sim_time: float
     wall_time: float
     true_moved: bool | None = None
+    tried_kinds: tuple[str, ...] = ()
+    """The other kinds the part was tried as in this try, in order (``kind`` is the one in use after it)."""
 
 
 @dataclass
@@ -128,6 +160,18 @@ class RobotWorld:
     that also keeps what it found, so a video shows the pipeline's own detections."""
 
     def __post_init__(self) -> None:
+        self.kinds = dict(self.marker_map)
+        """Marker id -> the kind its part is handled as: the told kind until another moved it (module docstring)."""
+        self.found_kinds: dict[int, str] = {}
+        """Marker id -> the kind that moved its part, where that is not the kind the world was told."""
+        self.moved_as: set[int] = set()
+        """Markers whose part moved as the kind in use: never tried as another."""
+        self.blocked_as: set[int] = set()
+        """Markers whose part was blocked as the kind in use."""
+        self.other_kind_rounds: dict[int, int] = {}
+        """Marker id -> tries in which its part was tried as other kinds."""
+        self.empty_handles: dict[int, list[np.ndarray]] = {}
+        """Marker id -> grasp points [m] where a grasp on its part closed on nothing: no handle stands there."""
         self.detector = self.detector or MarkerDetector()
         self.toggler = Toggler(self.robot, self.config.primitives)
         lifts = {m: get_kind(kind).lift for m, kind in self.marker_map.items()}  # a lever's marker stands higher
@@ -139,17 +183,25 @@ class RobotWorld:
         order = np.random.default_rng(self.seed).permutation(sorted(self.marker_map))
         self.markers = [int(m) for m in order]
         self.closed_poses = {m: found[m].planar_pose for m in self.markers}
+        self.marker_heights = {m: float(found[m].T_base_marker[2, 3]) - self.lid_height for m in self.markers}
+        """Marker id -> its marker's perceived height above the lid [m] (a kind's ``lift``: what kinds it can be)."""
         self.seen_by_overview = set(self.survey.overview_trusted)
         self.joint_models: dict[int, JointModel] = {m: self._joint_model(m) for m in self.markers}
         self.states = np.zeros(len(self.markers), dtype=np.int64)
 
-    def _joint_model(self, marker: int) -> JointModel:
-        return joint_model(kind_of(self.marker_map, marker), upright_pose(self.closed_poses[marker], self.lid_height))
+    def _joint_model(self, marker: int, kind: str | None = None) -> JointModel:
+        """``marker``'s joint as ``kind`` (default: the kind in use) at its perceived closed pose."""
+        kind = kind or kind_of(self.kinds, marker)
+        return joint_model(kind, upright_pose(self.closed_poses[marker], self.lid_height))
 
     def observe(self) -> SceneObservation:
+        """The parts as perceived at the start, each of the kind it is handled as: the kind the world was told, or
+        the one that moved it where another did (:attr:`found_kinds`), or whose grasp held where the told kind's
+        closed on nothing."""
+        kinds = [kind_of(self.kinds, m) for m in self.markers]
         components = tuple(
-            ComponentObservation(kind_of(self.marker_map, m), self.closed_poses[m].copy(), int(s))
-            for m, s in zip(self.markers, self.states, strict=True)
+            ComponentObservation(kind, self.closed_poses[m].copy(), int(s))
+            for kind, m, s in zip(kinds, self.markers, self.states, strict=True)
         )
         return SceneObservation(components, goal_index=self.markers.index(self.goal_marker), goal_state=self.goal_state)
 
@@ -171,6 +223,7 @@ class RobotWorld:
         overhanging = self._doors_overhanging(marker, opening)
         jm = self.joint_models[marker]
         lean = lean_away([self.joint_models[d] for d in overhanging], *(jm.grasp_point_at(f) for f in (0.0, 1.0)))
+        empty = False  # a grasp closed on nothing where the kind in use has its handle
         for attempt in range(1 + self.config.max_retries):
             attempts = attempt + 1
             result: ToggleResult = self.toggler.toggle(
@@ -187,6 +240,7 @@ class RobotWorld:
                 sim_time + result.sim_time,
                 wall_time + result.wall_time,
             )
+            empty = empty or result.closed_on_nothing
             if result.outcome == "failed" and result.progress >= self.toggler.config.moved_fraction:
                 # stopped (force limit, slip) after carrying the handle most of the way: look before retrying
                 # (a door's marker must be seen where an open door's is: one the pads let go part-way hides
@@ -236,18 +290,118 @@ class RobotWorld:
             outcome = self._sensed_outcome(result, marker, opening)
             if self._door_stayed_shut(outcome, marker):
                 outcome = TryResult("blocked", HELD_UNDER_PINCH_AND_PUSH)
+        tried: tuple[str, ...] = ()
+        if self._other_kinds_due(marker, outcome, reasons):
+            outcome, other, tried = self._try_other_kinds(marker, opening, outcome, empty)
+            attempts += len(tried)
+            if other is not None:
+                result, peak = other, max(peak, other.peak_force)
+                sim_time, wall_time = sim_time + other.sim_time, wall_time + other.wall_time
         if outcome.moved:
             self.states[index] ^= 1
+            self.moved_as.add(marker)
+            if self.kinds[marker] != kind_of(self.marker_map, marker):  # (a kind used since a grasp held as it)
+                self.found_kinds[marker] = self.kinds[marker]
+        elif outcome.outcome == "blocked":
+            self.blocked_as.add(marker)
         if outcome.outcome == "failed" and len(reasons) > self.config.max_retries:
             outcome = TryResult("failed", f"{outcome.reason} ({attempts} attempts)", give_up=True)
         after = self.ground_truth(marker) if self.ground_truth else None
         self.log.append(
             ActionLog(
-                index, marker, kind_of(self.marker_map, marker), outcome.outcome, outcome.reason, outcome.moved,
+                index, marker, kind_of(self.kinds, marker), outcome.outcome, outcome.reason, outcome.moved,
                 result.progress, peak, attempts, sim_time, wall_time, None if before is None else bool(before != after),
+                tried,
             )
         )  # fmt: skip
         return outcome
+
+    def _other_kinds_due(self, marker: int, outcome: TryResult, reasons: list[str]) -> bool:
+        """Whether ``marker``'s part, just tried as the kind in use with ``outcome`` (``reasons``: its failed
+        attempts'), is now tried as other kinds (the rule in the module docstring)."""
+        c = self.config
+        if not c.other_kinds or marker in self.moved_as or self.other_kind_rounds.get(marker, 0) >= c.other_kind_rounds:
+            return False
+        if outcome.outcome == "failed":
+            return len(reasons) > c.max_retries  # the world would give it up
+        return outcome.outcome == "blocked" and marker in self.blocked_as  # blocked again
+
+    def _other_kinds(self, marker: int, held: bool) -> list[str]:
+        """The kinds other than the one in use that ``marker``'s part may be, most plausible first: registered
+        kinds whose ``lift`` fits the marker's perceived height above the lid and whose handle is not where a grasp
+        on it closed on nothing; those of the family of the kinds the world was told first (the paper's, when all
+        are), then (``held``: the grasp held the handle) those whose handle stands where the kind in use has it,
+        then in registration order."""
+        c = self.config
+        in_use = self.joint_models[marker]
+        family = set(family_kind_names(tuple(self.marker_map.values())))
+        empty = self.empty_handles.get(marker, [])
+        ranked = []
+        for order, name in enumerate(registered_kinds()):
+            if name == in_use.kind or abs(self.marker_heights[marker] - get_kind(name).lift) > c.lift_tolerance:
+                continue
+            grasp = self._joint_model(marker, name).grasp_point
+            if any(np.linalg.norm(grasp - e) < c.same_handle for e in empty):
+                continue
+            elsewhere = bool(np.linalg.norm(grasp - in_use.grasp_point) >= c.same_handle)
+            ranked.append((name not in family, held and elsewhere, order, name))
+        return [name for *_, name in sorted(ranked)]
+
+    def _try_other_kinds(
+        self, marker: int, opening: bool, first: TryResult, empty: bool
+    ) -> tuple[TryResult, ToggleResult | None, tuple[str, ...]]:
+        """Try ``marker``'s part as up to ``other_kinds`` other kinds (:meth:`_other_kinds`), one careful attempt
+        each, after ``first``, its outcome as the kind in use (``empty``: a grasp of it closed on nothing). Gives the
+        try's outcome, the last toggle's result with the effort of them all (None if no other kind fits) and the
+        kinds tried. A kind that moves the part is kept (:attr:`found_kinds`); one whose grasp held where the kind in
+        use closed on nothing, or that carried the part past ``blocked_progress``, is used from then on."""
+        c = self.config
+        in_use = self.joint_models[marker]
+        if empty:
+            self.empty_handles.setdefault(marker, []).append(in_use.grasp_point)
+        candidates = self._other_kinds(marker, held=first.outcome == "blocked")[: c.other_kinds]
+        if not candidates:
+            return first, None, ()
+        self.other_kind_rounds[marker] = self.other_kind_rounds.get(marker, 0) + 1
+        total: ToggleResult | None = None
+        blocked = [first] if first.outcome == "blocked" else []
+        adopt: JointModel | None = None
+        tried: list[str] = []
+        for kind in candidates:
+            tried.append(kind)
+            self.joint_models[marker] = jm = self._joint_model(marker, kind)
+            self.kinds[marker] = kind
+            result = self.toggler.toggle(jm, opening, where_is=lambda: self._fraction_open(marker), careful=True)
+            if result.outcome == "failed" and result.progress >= self.toggler.config.moved_fraction:
+                if self._overview_verdict(marker, opening, unseen_moved=not jm.handling.swings_up).moved:
+                    result.outcome, result.reason = "moved", ""
+            outcome = self._sensed_outcome(result, marker, opening)
+            if total is not None:
+                result.peak_force = max(result.peak_force, total.peak_force)
+                result.sim_time, result.wall_time = result.sim_time + total.sim_time, result.wall_time + total.wall_time
+            total = result
+            if outcome.moved:  # (try_toggle keeps it in found_kinds)
+                self.blocked_as.discard(marker)
+                return TryResult("moved", f"moved as a {kind}, not a {in_use.kind}"), total, tuple(tried)
+            if result.closed_on_nothing:
+                self.empty_handles.setdefault(marker, []).append(jm.grasp_point)
+            elif adopt is None and (
+                (outcome.outcome == "blocked" and first.outcome == "failed")
+                or (jm.handling.swings_up and result.progress >= self.toggler.config.blocked_progress)
+            ):
+                adopt = jm  # its handle is there (held, or carried part of the way): this kind from now on
+            if outcome.outcome == "blocked":
+                blocked.append(outcome)
+        self.joint_models[marker] = adopt or in_use
+        self.kinds[marker] = (adopt or in_use).kind
+        if adopt is not None:
+            self.blocked_as.discard(marker)
+            if adopt.handling.swings_up and opening:
+                self.unsettled.add(marker)  # the next try of it looks first
+        if blocked:
+            held = ", ".join(tried)
+            return TryResult("blocked", f"{blocked[0].reason} (also tried as {held})"), total, tuple(tried)
+        return first, total, tuple(tried)
 
     def _doors_overhanging(self, marker: int, opening: bool) -> list[int]:
         """The other doors that may stand open (believed open, or left part-way by a failed try) over where
@@ -294,7 +448,7 @@ class RobotWorld:
 
     def _closed_point(self, marker: int) -> np.ndarray:
         """Where ``marker``'s centre is with its part closed, in the base frame [m]."""
-        return np.array([*self.closed_poses[marker][:2], self.lid_height + get_kind(self.marker_map[marker]).lift])
+        return np.array([*self.closed_poses[marker][:2], self.lid_height + get_kind(self.kinds[marker]).lift])
 
     def _remeasure(self, marker: int) -> None:
         """Measure ``marker`` again close up and use it if it is still near its closed pose."""

@@ -24,3 +24,5 @@ class ToggleResult:
     """Largest filtered force magnitude over the whole try [N] (what the safety limit watches)."""
     end_stop_felt: bool = False
     """A door's pinch felt the door reach its end stop (past the travel, ``end_stop_force``)."""
+    closed_on_nothing: bool = False
+    """The gripper closed on nothing where the handle was looked for (whatever the try did next: a door is pushed)."""

@@ -24,10 +24,21 @@ square: ``tan(hfov / 2) = aspect tan(fovy / 2)``). The still views (:func:`frame
 position that holds them, centred on them; the turntable (:func:`orbit_view`) circles the centre of their bounding
 box at one distance, the largest any of its headings needs.
 
+Who locks whom
+--------------
+Every part has a colour of its own (:data:`PART_RGB`, in spec order) and each lock feature is drawn in its
+locker's colour (:func:`part_colours`; the features' own colours, dark red and black, said only what a feature
+is). :meth:`Gallery.annotate` draws on a whole-box view what a reader checks against the spec: each part's outline
+and a label in its colour (name, kind, marker id), the goal ringed, in the top view the lid frame's x and y axes,
+and below the image a legend: the goal, then every lock rule in words ("door-0 (door) closed keeps slide-1 (slide)
+closed"), each beside its locker's colour and the feature that shows it. ``write_annotated`` writes
+``top-annotated.png`` and ``three-quarter-annotated.png`` (``render.py --views`` writes them beside the plain views).
+
 Example::
 
     with Gallery(spec, RenderConfig(width=640, height=480)) as gallery:
         paths = gallery.write_views(out_dir)                       # top.png, three-quarter.png, component-*.png
+        gallery.write_annotated(out_dir)                           # top-annotated.png, three-quarter-annotated.png
         gallery.write_turntable(out_dir / "turntable.mp4", frames=72, fps=24)
 """
 
@@ -38,6 +49,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+import cv2
 import imageio.v3 as iio
 import mujoco
 import numpy as np
@@ -45,9 +57,10 @@ from numpy.typing import ArrayLike
 
 from puzzlebox.models.atomic import write_atomically
 from puzzlebox.models.kinds import get_kind
-from puzzlebox.models.scene import ROBOT, Scene, SceneConfig, build_scene
-from puzzlebox.models.spec import PuzzleSpec
-from puzzlebox.twin.rendering import RenderConfig, Renderer
+from puzzlebox.models.puzzle_box import component_prefixes
+from puzzlebox.models.scene import BOX, ROBOT, Scene, SceneConfig, build_scene
+from puzzlebox.models.spec import LockRule, PuzzleSpec
+from puzzlebox.twin.rendering import RenderConfig, Renderer, presentation_look
 from puzzlebox.twin.video import VideoWriter
 
 __all__ = [
@@ -55,6 +68,7 @@ __all__ = [
     "CLOSE_UP_ELEVATION",
     "FOVY",
     "MARGIN",
+    "PART_RGB",
     "SKY_RGB",
     "THREE_QUARTER_AZIMUTH",
     "THREE_QUARTER_ELEVATION",
@@ -65,6 +79,9 @@ __all__ = [
     "component_view_name",
     "frame_view",
     "orbit_view",
+    "part_colours",
+    "rule_text",
+    "state_name",
 ]
 
 CAMERA = "gallery"
@@ -84,6 +101,33 @@ SKY_RGB = ((0.86, 0.89, 0.93), (0.55, 0.58, 0.62))
 """Colours [0-1] of the gallery's gradient skybox, above and below the horizon."""
 TURNTABLE_ELEVATION = 30.0
 """Height of the turntable's circling camera above the horizon, seen from the box [deg]."""
+PART_RGB = (
+    (0.12, 0.47, 0.71), (0.85, 0.37, 0.01), (0.17, 0.63, 0.17), (0.84, 0.15, 0.16), (0.58, 0.40, 0.74),
+    (0.55, 0.34, 0.29), (0.89, 0.47, 0.76), (0.74, 0.74, 0.13), (0.09, 0.75, 0.81), (0.35, 0.35, 0.35),
+)  # fmt: skip
+"""Colours [0-1] of the parts, in spec order (cycled): their labels' and their lock features' (matplotlib's
+tab10, darkened where pale)."""
+STATE_NAMES = ("closed", "open")
+"""What a component's states 0 and 1 are called in words."""
+
+
+def state_name(state: int) -> str:
+    """``closed`` for state 0, ``open`` for 1 (``state <n>`` otherwise)."""
+    return STATE_NAMES[state] if 0 <= state < len(STATE_NAMES) else f"state {state}"
+
+
+def part_colours(spec: PuzzleSpec) -> dict[str, tuple[float, float, float]]:
+    """Each part's colour [0-1] by spec name (:data:`PART_RGB` in spec order)."""
+    return {c.name: PART_RGB[k % len(PART_RGB)] for k, c in enumerate(spec.components)}
+
+
+def rule_text(spec: PuzzleSpec, rule: LockRule) -> str:
+    """A lock rule in words: ``door-0 (door) closed keeps slide-1 (slide) closed``."""
+    kinds = {c.name: c.kind for c in spec.components}
+    return (
+        f"{rule.locker} ({kinds.get(rule.locker, '?')}) {state_name(rule.locker_state)} keeps "
+        f"{rule.locked} ({kinds.get(rule.locked, '?')}) {state_name(rule.locked_state)}"
+    )
 
 
 @dataclass(frozen=True)
@@ -242,10 +286,28 @@ class Gallery:
         self.spec = spec
         self.config = config
         self.scene, self.model = build_gallery_model(spec, lock_features=lock_features)
+        presentation_look(self.model)  # the box alone, for people: no camera of the pipeline reads this model
+        self.colours = part_colours(spec)
+        """Each part's colour [0-1] by spec name: its label's and its lock features'."""
+        self.features = self._colour_features()
+        """Lock feature geom name -> (locker, locked) spec names."""
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
         self._camera = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_CAMERA, CAMERA)
         self._renderer = Renderer(self.model, config)
+
+    def _colour_features(self) -> dict[str, tuple[str, str]]:
+        """Draw each lock feature (``<locker>:lock:<locked>``) in its locker's colour; returns them by geom name."""
+        prefixes = component_prefixes(self.spec)
+        features = {}
+        for locker in self.spec.components:
+            for locked in self.spec.components:
+                name = f"{BOX}{prefixes[locker.name]}:lock:{prefixes[locked.name]}"
+                geom = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, name)
+                if geom >= 0:
+                    self.model.geom_rgba[geom, :3] = self.colours[locker.name]
+                    features[name] = (locker.name, locked.name)
+        return features
 
     # -- framing ---------------------------------------------------------------------------------------------
 
@@ -356,6 +418,94 @@ class Gallery:
             paths.append(path)
         return paths
 
+    # -- annotations -----------------------------------------------------------------------------------------
+
+    def project(self, view: View, points: ArrayLike) -> np.ndarray:
+        """``(n, 2)`` pixel coordinates (OpenCV: x right, y down, centres at integers) of world ``points`` in
+        ``view``'s image."""
+        matrix = np.empty(9)
+        mujoco.mju_quat2Mat(matrix, np.asarray(view.quat, dtype=float))
+        local = (np.asarray(points, dtype=float).reshape(-1, 3) - view.position) @ matrix.reshape(3, 3)
+        depth = np.maximum(-local[:, 2], 1e-9)  # MuJoCo's camera looks along its -z, y up
+        w, h = self.config.width, self.config.height
+        focal = 0.5 * h / math.tan(math.radians(view.fovy) / 2)
+        return np.column_stack([(w - 1) / 2 + focal * local[:, 0] / depth, (h - 1) / 2 - focal * local[:, 1] / depth])
+
+    def legend(self) -> list[tuple[str, tuple[float, float, float] | None]]:
+        """The legend's lines (text, colour of the chip before it or None): the goal, then each lock rule in
+        words with the feature that shows it (or that none does)."""
+        from puzzlebox.models.lock_features import layout_lock_features  # trimesh only when asked
+
+        spec = self.spec
+        goal = spec.goal
+        kind = next(c.kind for c in spec.components if c.name == goal.component)
+        lines: list[tuple[str, tuple[float, float, float] | None]] = [
+            (f"{spec.name}: goal {goal.component} ({kind}) {state_name(goal.state)}; a lock feature has its "
+             "locker's colour", None),
+        ]  # fmt: skip
+        layout = layout_lock_features(spec)
+        shown = {(f.locker, f.locked): f.kind for f in layout.features}
+        for rule in spec.locks:
+            feature = shown.get((rule.locker, rule.locked))
+            where = f"  [{feature} on {rule.locker}]" if feature and self.features else "  [no visible feature]"
+            lines.append((rule_text(spec, rule) + where, self.colours[rule.locker]))
+        if not spec.locks:
+            lines.append(("no lock rules: every part moves freely", None))
+        return lines
+
+    def annotate(self, view: View, image: np.ndarray) -> np.ndarray:
+        """``image`` of ``view`` with what a reader checks against the spec (module docstring): each part's
+        outline and label (name, kind, marker id) in its colour, the goal ringed, the lid frame's axes in the top
+        view, and the legend in a strip below (the image grows by it)."""
+        out = np.ascontiguousarray(image).copy()
+        taken: list[tuple[int, int, int, int]] = []
+        for c in self.spec.components:
+            colour = tuple(int(255 * v) for v in self.colours[c.name])
+            footprint = get_kind(c.kind).footprint_in_lid(c.pose[:3])
+            outline = self.project(view, self._lid_to_world([[x, y, 0.0] for x, y in footprint]))
+            polygon = [np.round(outline).astype(np.int32)]
+            if c.name == self.spec.goal.component:  # the goal: a thick red rim around its own colour
+                cv2.polylines(out, polygon, True, (220, 20, 20), 7, cv2.LINE_AA)
+            cv2.polylines(out, polygon, True, colour, 2, cv2.LINE_AA)
+            centre = self.project(view, self.data.site(self.scene.names.components[c.name].handle_site).xpos)[0]
+            goal = "  GOAL" if c.name == self.spec.goal.component else ""
+            _chip(out, f"{c.name} ({c.kind}) #{c.marker}{goal}", centre, colour, taken)
+        if view.name == "top":
+            origin, x_axis, y_axis = self.project(view, self._lid_to_world([[0, 0, 0], [0.05, 0, 0], [0, 0.05, 0]]))
+            for end, name in ((x_axis, "x"), (y_axis, "y")):
+                start, tip = (int(origin[0]), int(origin[1])), (int(end[0]), int(end[1]))
+                cv2.arrowedLine(out, start, tip, (20, 20, 20), 2, cv2.LINE_AA, tipLength=0.2)
+                cv2.putText(out, name, (tip[0] + 4, tip[1] + 4), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (20, 20, 20), 1,
+                            cv2.LINE_AA)  # fmt: skip
+        return np.concatenate([out, self._legend_strip(out.shape[1])], axis=0)
+
+    def _legend_strip(self, width: int) -> np.ndarray:
+        lines = self.legend()
+        scale = 0.42 if width >= 560 else 0.34
+        step = int(40 * scale) + 6
+        strip = np.full((step * len(lines) + 8 + (step * len(lines) + 8) % 2, width, 3), 250, dtype=np.uint8)
+        for k, (text, colour) in enumerate(lines):
+            y = 6 + step * (k + 1) - 5
+            x = 8
+            if colour is not None:
+                cv2.rectangle(strip, (x, y - step + 8), (x + 14, y + 1), tuple(int(255 * v) for v in colour), -1)
+                x += 20
+            cv2.putText(strip, text, (x, y), cv2.FONT_HERSHEY_SIMPLEX, scale, (30, 30, 30), 1, cv2.LINE_AA)
+        return strip
+
+    def write_annotated(self, out_dir: str | Path) -> list[Path]:
+        """Write the top and three-quarter views annotated (:meth:`annotate`) as ``out_dir/top-annotated.png``
+        and ``out_dir/three-quarter-annotated.png``."""
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        paths = []
+        for view in (self.top_view(), self.three_quarter_view()):
+            path = out / f"{view.name}-annotated.png"
+            image = self.annotate(view, self.render(view))
+            write_atomically(path, lambda tmp, image=image: iio.imwrite(tmp, image, extension=".png"))
+            paths.append(path)
+        return paths
+
     def write_turntable(self, path: str | Path, frames: int = 72, fps: float = 24.0) -> Path:
         """Write the turntable (:meth:`turntable_views`) as an H.264 MP4 at ``fps`` [frames/s], atomically
         (:class:`twin.video.VideoWriter`: width and height must be even)."""
@@ -375,3 +525,23 @@ class Gallery:
 
     def __exit__(self, *exc_info: object) -> None:
         self.close()
+
+
+def _chip(image: np.ndarray, text: str, anchor: np.ndarray, colour: tuple[int, ...], taken: list) -> None:
+    """A label on a chip of ``colour`` near ``anchor`` [px], with a leader line, clear of the rectangles in ``taken``
+    (added to it): tried above-right of the anchor, then further up or down."""
+    font, scale = cv2.FONT_HERSHEY_SIMPLEX, 0.42 if image.shape[1] >= 560 else 0.34
+    (tw, th), _ = cv2.getTextSize(text, font, scale, 1)
+    h, w = image.shape[:2]
+    ax, ay = int(anchor[0]), int(anchor[1])
+    x = int(np.clip(ax + 10, 2, max(w - tw - 8, 2)))
+    for dy in (-18, -40, 16, 38, -62, 60, -84, 82):
+        y = int(np.clip(ay + dy, th + 6, h - 6))
+        box = (x - 4, y - th - 4, x + tw + 4, y + 4)
+        if all(box[2] < t[0] or box[0] > t[2] or box[3] < t[1] or box[1] > t[3] for t in taken):
+            break
+    taken.append(box)
+    dark = sum(colour) < 400
+    cv2.line(image, (ax, ay), (box[0], (box[1] + box[3]) // 2), colour, 1, cv2.LINE_AA)
+    cv2.rectangle(image, box[:2], box[2:], colour, -1)
+    cv2.putText(image, text, (x, y), font, scale, (255, 255, 255) if dark else (20, 20, 20), 1, cv2.LINE_AA)

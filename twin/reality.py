@@ -27,7 +27,6 @@ random; a :class:`ScaleRange` multiplies a nominal value.
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import types
 import typing
@@ -37,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from puzzlebox.models.json_input import JsonInputError, read_json
 from puzzlebox.models.placement import PlacementRange
 from puzzlebox.twin.errors import ProfileError
 
@@ -268,6 +268,10 @@ class PhysicsReality:
         )
 
 
+MAX_CELL_SEED = 2**32 - 1
+"""Largest ``cell_seed`` (a seed of numpy's generators, as every seed of the project)."""
+
+
 @dataclass(frozen=True)
 class RealityProfile:
     """Every way the simulated cell differs from the nominal model (see the module docstring)."""
@@ -282,6 +286,11 @@ class RealityProfile:
     physics: PhysicsReality = field(default_factory=PhysicsReality)
     placement: PlacementRange | None = None
     """Where the box is placed, drawn per trial among reachable poses; None: the spec's own pose."""
+
+    def __post_init__(self) -> None:
+        seed = self.cell_seed
+        ok = isinstance(seed, int | np.integer) and not isinstance(seed, bool) and 0 <= seed <= MAX_CELL_SEED
+        _check(ok, "cell_seed", f"must be an integer in [0, {MAX_CELL_SEED}], got {seed!r}")
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-ready dict; :meth:`from_dict` (and :func:`load_profile`, from a file) reads it back to an
@@ -478,8 +487,8 @@ def load_profile(name_or_path: str | Path | RealityProfile | None) -> RealityPro
     if not path.is_file():
         raise ProfileError(f"no reality profile {text!r}: not a preset ({sorted(PRESETS)}) nor a JSON file")
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        data = read_json(path)
+    except JsonInputError as err:
         raise ProfileError(f"cannot read reality profile {path}: {err}") from None
     if isinstance(data, dict) and "name" not in data:
         data = {**data, "name": path.stem}

@@ -59,6 +59,7 @@ __all__ = [
     "camera_pose_in_world",
     "gl_backend",
     "pinhole_intrinsics",
+    "presentation_look",
     "render_resources_key",
 ]
 
@@ -173,6 +174,32 @@ def _track(renderer: Renderer) -> None:
             atexit.register(_close_open_renderers)
             _atexit_registered = True
         _open_renderers.add(renderer)
+
+
+PRESENTATION_RGBA = {"table": (0.64, 0.63, 0.60, 1.0), "floor": (0.36, 0.37, 0.40, 1.0)}
+"""Colours of the scene's geoms that pictures for people show muted (the white table washed the overview out)."""
+PRESENTATION_LIGHTS = {"headlight_ambient": 0.22, "headlight_diffuse": 0.32, "headlight_specular": 0.08,
+                       "light_diffuse": 0.42, "light_specular": 0.1}  # fmt: skip
+"""Lights [0-1] of pictures for people: the scene's (ambient 0.25, headlight 0.3 with specular 0.5, key light 0.55)
+turned down, specular most, so that the lid, the plates and the markers keep their contrast (the mean luminance of
+the lid's top face in the overview 220+ of 255 before, ~170 after)."""
+
+
+def presentation_look(model: mujoco.MjModel) -> None:
+    """Set on ``model`` the colours and lights of pictures made for people — the rollout video, the gallery —
+    (:data:`PRESENTATION_RGBA`, :data:`PRESENTATION_LIGHTS`). Never on a model whose cameras the pipeline reads:
+    what it senses would change."""
+    for name, rgba in PRESENTATION_RGBA.items():
+        geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
+        if geom >= 0:
+            model.geom_rgba[geom] = rgba
+    lights = PRESENTATION_LIGHTS
+    headlight = model.vis.headlight
+    headlight.ambient[:] = lights["headlight_ambient"]
+    headlight.diffuse[:] = lights["headlight_diffuse"]
+    headlight.specular[:] = lights["headlight_specular"]
+    model.light_diffuse[:] = lights["light_diffuse"]
+    model.light_specular[:] = lights["light_specular"]
 
 
 def pinhole_intrinsics(model: mujoco.MjModel, cam: int, width: int, height: int) -> np.ndarray:

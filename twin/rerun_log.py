@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from puzzlebox.models.atomic import PublishedOnExit
+from puzzlebox.models.atomic import PublishedOnExit, apply_umask
 from puzzlebox.twin.errors import TwinError
 
 
@@ -152,6 +152,7 @@ class TrialRecording(PublishedOnExit):
             self._log("world/tcp_path", self.rr.LineStrips3D([np.array(self._tcp_path)]), static=True)
         self.stream.flush()
         self.stream.disconnect()
+        apply_umask(self._temporary)  # mkstemp made it private; the recording is not
         os.replace(self._temporary, self.path)
         return self.path
 

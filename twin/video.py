@@ -19,7 +19,7 @@ from typing import Any
 import imageio_ffmpeg
 import numpy as np
 
-from puzzlebox.models.atomic import PublishedOnExit
+from puzzlebox.models.atomic import PublishedOnExit, apply_umask
 from puzzlebox.twin.errors import VideoError
 
 __all__ = ["X264_PRESETS", "VideoWriter"]
@@ -179,9 +179,7 @@ class VideoWriter(PublishedOnExit):
             raise VideoError(f"no frames were appended; nothing was written to {self._path}")
         try:
             encoder.close()  # waits for ffmpeg to finish the file
-            umask = os.umask(0)
-            os.umask(umask)
-            os.chmod(temporary, 0o666 & ~umask)  # the temporary file was private; the video is not
+            apply_umask(temporary)  # the temporary file was private; the video is not
             os.replace(temporary, self._path)
         except Exception as exc:
             with contextlib.suppress(OSError):

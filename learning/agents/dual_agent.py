@@ -24,6 +24,9 @@ class DualAgent:
     The belief is over one locker per component and state (``config.max_lockers = 1``, the paper's) or over
     sets of up to ``max_lockers`` (:func:`learning.dual_controller.new_belief`); the prior is given in the
     one-locker form either way (:meth:`initial_prior`), with no mass on lockers that cannot hold (:meth:`holding`).
+    A world that finds a part's kind wrong (a misread marker: ``skills.robot_world``) observes it by the kind that
+    moved it from then on: the belief is then made again from the prior of the kinds observed, and the episode's
+    evidence replayed into it (:meth:`record`).
     """
 
     name = "dual"
@@ -35,6 +38,9 @@ class DualAgent:
         self._rng = np.random.default_rng(0)
         self._states = np.zeros(0, dtype=np.int64)
         self._h_max = 1.0
+        self._kinds: tuple[str, ...] = ()
+        self._evidence: list[tuple[np.ndarray, int, bool]] = []
+        """The episode's informative tries: the joint state before the try, the component, whether it moved."""
 
     def initial_prior(self, observation: SceneObservation) -> np.ndarray:
         """The one-locker prior ``(N, 2, 1 + 2N)`` of a new task."""
@@ -61,6 +67,8 @@ class DualAgent:
         self._h_max = max_entropy_for(len(observation), self.config)
         self._rng = rng
         self.decisions = []
+        self._kinds = observation.kinds
+        self._evidence = []
 
     def choose(self, observation: SceneObservation) -> int:
         assert self.belief is not None, "begin_episode() first"
@@ -81,6 +89,12 @@ class DualAgent:
         assert self.belief is not None
         if result.informative:  # a failed try (no grasp, IK, marker lost) says nothing about locks
             self.belief.update(self._states, index, result.moved)  # the state in which the try was made
+            self._evidence.append((self._states.copy(), index, result.moved))
+        if observation.kinds != self._kinds:  # the world found a part's kind: its prior, the same evidence
+            self._kinds = observation.kinds
+            self.belief = self.initial_belief(observation)
+            for states, component, moved in self._evidence:
+                self.belief.update(states, component, moved)
 
     def end_episode(self, solved: bool) -> None:
         pass
@@ -91,7 +105,8 @@ class MemoryAgent(DualAgent):
 
     With ``learn=True`` every finished episode's learned graph is added to the memory (training), and
     the controller explores more (``MemoryConfig.training_entropy_scale``); evaluation leaves the
-    memory untouched.
+    memory untouched. An episode is stored under the kinds last observed: a part whose kind the world found
+    wrong is remembered as the kind that moved it, never as the misread one (:meth:`DualAgent.record`).
     """
 
     name = "memory"

@@ -23,6 +23,7 @@ from puzzlebox.learning.errors import LearningError
 from puzzlebox.models import PuzzleSpec
 from puzzlebox.models.atomic import write_atomically, write_text_atomically
 from puzzlebox.models.disassembly_kinds import family_kind_names
+from puzzlebox.models.json_input import JsonInputError, read_json
 
 CHECKPOINT_FORMAT = "puzzlebox-baseline/2"
 """/2: GN blocks apply the edge MLP's first layer per part (``GNBlock``); MT-OPT flags in the config."""
@@ -72,10 +73,10 @@ def load_checkpoint(
     if not path.is_file() or not meta_path.is_file():
         raise CheckpointError(f"no checkpoint at {path} (needs {path.name} and {meta_path.name})")
     try:
-        meta = json.loads(meta_path.read_text())
-    except (OSError, json.JSONDecodeError) as err:
+        meta = read_json(meta_path)  # bounded in size and depth; NaN refused (a config holds finite numbers)
+    except JsonInputError as err:
         raise CheckpointError(f"{meta_path} is not readable JSON: {err}") from None
-    if meta.get("format") != CHECKPOINT_FORMAT or meta.get("agent") not in AGENTS:
+    if not isinstance(meta, dict) or meta.get("format") != CHECKPOINT_FORMAT or meta.get("agent") not in AGENTS:
         raise CheckpointError(f"{meta_path} is not a puzzlebox baseline checkpoint (agents: {sorted(AGENTS)})")
     if expected_agent is not None and meta["agent"] != expected_agent:
         raise CheckpointError(f"{path} holds agent {meta['agent']!r}, not {expected_agent!r}")
@@ -96,7 +97,10 @@ def load_checkpoint(
         _network(agent).load_state_dict(state)
     except (RuntimeError, TypeError, ValueError, AttributeError) as err:
         raise CheckpointError(f"{path}: weights do not match the recorded config: {one_line(err)}") from None
-    agent.episodes = int(meta.get("episodes", 0))
+    episodes = meta.get("episodes", 0)
+    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 0:
+        raise CheckpointError(f"{meta_path}: 'episodes' must be a count >= 0, got {episodes!r}")
+    agent.episodes = episodes
     agent.training = False
     return agent
 

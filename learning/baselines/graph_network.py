@@ -21,6 +21,7 @@ so the network must learn relative geometry itself. It exists for planar poses o
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -69,6 +70,10 @@ def family_name(kinds: Sequence[str]) -> str:
     return names.get(tuple(kinds), f"kinds {list(kinds)}")
 
 
+MAX_BLOCKS, MAX_HIDDEN = 64, 4096
+"""Bounds of a network's depth (GN blocks) and width (the authors' release: 5 and 64)."""
+
+
 @dataclass(frozen=True)
 class GraphNetworkConfig:
     """Size of the network, and the scenes it is built for (kind family and pose size)."""
@@ -97,6 +102,13 @@ class GraphNetworkConfig:
             raise ConfigError(f"poses='absolute' needs planar poses (pose_size 3), got pose_size {self.pose_size}")
         if not self.kinds or len(set(self.kinds)) != len(self.kinds):
             raise ConfigError(f"kinds must be distinct and non-empty, got {list(self.kinds)}")
+        for name, bound in (("blocks", MAX_BLOCKS), ("hidden", MAX_HIDDEN)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= bound:
+                raise ConfigError(f"{name} must be an integer in [1, {bound}], got {value!r}")
+        scale = self.position_scale
+        if isinstance(scale, bool) or not isinstance(scale, int | float) or not (math.isfinite(scale) and scale > 0):
+            raise ConfigError(f"position_scale must be a finite length > 0 [m], got {scale!r}")
 
     @classmethod
     def for_spec(cls, spec: PuzzleSpec, **overrides: object) -> GraphNetworkConfig:

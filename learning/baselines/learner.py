@@ -5,16 +5,21 @@ what an example is, and how to learn from a batch."""
 
 from __future__ import annotations
 
+import math
 import random
 from collections import defaultdict, deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any, Generic, Self, TypeVar
 
 import numpy as np
 import torch
 
 from puzzlebox.learning.baselines.graph_network import GraphNetworkConfig, observation_tensors
+from puzzlebox.learning.errors import ConfigError
 from puzzlebox.models import SceneObservation, TryResult
+
+MAX_SIZE = 2**32 - 1
+"""Largest batch, replay buffer, update count or seed of a config."""
 
 
 @dataclass(frozen=True)
@@ -36,6 +41,27 @@ class LearnerConfig:
     balance: bool = False
     """MT-OPT balancing: half of each batch successes, half failures (the agent says which is which)."""
     seed: int = 0
+
+    def __post_init__(self) -> None:
+        """Every number in its range, finite: a checkpoint's metadata is read back into this config, and a value
+        out of range would fail late (a negative width in torch) or silently (``epsilon_eval`` NaN acts greedily
+        at random, every run)."""
+        for name, value in ((f.name, getattr(self, f.name)) for f in fields(self)):
+            if isinstance(value, bool) or name == "network":
+                continue
+            if isinstance(value, float | int) and not math.isfinite(value):
+                raise ConfigError(f"{name} must be finite, got {value!r}")
+        for name in ("epsilon_start", "epsilon_min", "epsilon_eval", "gamma", "tau"):
+            value = getattr(self, name, 0.0)
+            if not 0.0 <= value <= 1.0:
+                raise ConfigError(f"{name} must be in [0, 1], got {value!r}")
+        if not 0.0 < self.epsilon_decay <= 1.0 or not self.learning_rate > 0:
+            raise ConfigError(f"epsilon_decay must be in (0, 1] and learning_rate > 0, got {self.epsilon_decay!r} "
+                              f"and {self.learning_rate!r}")  # fmt: skip
+        for name, low in (("batch_size", 1), ("replay_size", 1), ("updates_per_action", 0), ("seed", 0)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= MAX_SIZE:
+                raise ConfigError(f"{name} must be an integer in [{low}, {MAX_SIZE}], got {value!r}")
 
     @classmethod
     def multitask(cls, **overrides: Any) -> Self:

@@ -10,7 +10,9 @@ episode counts. The protocols share jobs:
 - ``noise``: the k = 9 job at ``converged_episodes``, evaluated under every scene error.
 
 Training and test layouts, world seeds and the success rule are the memory agent's
-(``protocol.py``): every agent meets the same boxes. A finished job is written to
+(``protocol.py``): every agent meets the same boxes. Here a job is defined (:func:`job_settings`), run
+(:func:`run_job_task`) and its records merged into the protocols' points; the composition layer runs the jobs on
+the task runner (``puzzlebox.lab.deep_protocols_run``): a finished job is written to
 ``OUT/jobs/<agent>-v<k>-s<seed>.json`` (with the network as ``.pt`` beside it, loadable by
 ``trial.py --checkpoint``) the moment it ends, so an interrupted run resumes where it stopped; a job
 file made with other settings is recomputed, never mixed in.
@@ -37,7 +39,6 @@ from puzzlebox.learning.experiments.protocol import (
     training_layout,
 )
 from puzzlebox.learning.experiments.symbolic_protocols import CONDITIONS
-from puzzlebox.learning.runner import RecordStore, Task, make_executor, run_tasks
 from puzzlebox.learning.symbolic_world import SymbolicWorld
 from puzzlebox.learning.trial import run_episode
 from puzzlebox.models.generator import TRAIN_INDICES
@@ -119,7 +120,7 @@ def jobs_for(
     return jobs
 
 
-def _settings(job: TrainingJob, config: ProtocolConfig) -> dict[str, Any]:
+def job_settings(job: TrainingJob, config: ProtocolConfig) -> dict[str, Any]:
     """Everything a job's numbers depend on (a cached job must match it exactly to be reused). The
     default pose encoding is left out, as in the files written before the option existed."""
     job_fields = asdict(job)
@@ -168,7 +169,7 @@ def run_job(job: TrainingJob, config: ProtocolConfig, out_dir: str) -> dict[str,
             evaluations.append({"episodes": checkpoint, "condition": condition, **_evaluate(agent, config, condition)})
     save_checkpoint(agent, Path(out_dir) / "jobs" / f"{job.key}.pt")
     return {
-        "settings": _settings(job, config),
+        "settings": job_settings(job, config),
         "evaluations": evaluations,
         "training_solved": int(np.sum(training_solved)),
         "training_episodes": len(training_solved),
@@ -178,7 +179,7 @@ def run_job(job: TrainingJob, config: ProtocolConfig, out_dir: str) -> dict[str,
 
 
 def run_job_task(settings: dict[str, Any], context: dict[str, Any]) -> dict[str, Any]:
-    """:func:`run_job` as a runner task: ``settings`` is :func:`_settings`'s (as JSON), ``context`` the
+    """:func:`run_job` as a runner task: ``settings`` is :func:`job_settings`'s (as JSON), ``context`` the
     output directory."""
     fields = dict(settings["job"])
     fields["evaluate_at"] = tuple(fields["evaluate_at"])
@@ -186,50 +187,6 @@ def run_job_task(settings: dict[str, Any], context: dict[str, Any]) -> dict[str,
     config = ProtocolConfig(runs_per_variant=settings["runs_per_variant"], success_actions=settings["success_actions"],
                             max_actions=settings["max_actions"])  # fmt: skip
     return json.loads(json.dumps(run_job(job, config, context["out_dir"])))  # tuples -> lists, as stored
-
-
-def job_task(job: TrainingJob, config: ProtocolConfig, out_dir: Path) -> Task:
-    """The runner task of ``job``: its record is ``OUT/jobs/<key>.json``, its network ``<key>.pt``."""
-    settings = json.loads(json.dumps(_settings(job, config)))
-    return Task(job.key, run_job_task, settings, context={"out_dir": str(out_dir)})
-
-
-def cached_record(job: TrainingJob, config: ProtocolConfig, out_dir: Path) -> dict[str, Any] | None:
-    """The finished record of ``job`` in ``out_dir`` if it was made with the same settings."""
-    return RecordStore(Path(out_dir) / "jobs").get(job_task(job, config, out_dir))
-
-
-def run_jobs(
-    jobs: Sequence[TrainingJob],
-    config: ProtocolConfig,
-    out_dir: Path,
-    workers: int | None = None,
-    ray: str | None = None,
-) -> tuple[dict[str, dict[str, Any]], dict[str, Any]]:
-    """Run (or reuse) every job on the task runner — ``workers`` processes (default: one per core; 1:
-    in-process) or Ray (``ray``: ``auto`` or an address) — longest first. Returns the records by job key
-    and a summary (reused, computed, wall time).
-
-    Raises:
-        LearningError: a job failed (after every other job finished and was kept).
-    """
-    unique = sorted(
-        {job.key: job for job in jobs}.values(), key=lambda j: (-j.episodes, j.agent.startswith("model"), j.key)
-    )
-    tasks = [job_task(job, config, out_dir) for job in unique]
-    with make_executor(workers, ray) as executor:
-        report = run_tasks(
-            tasks, RecordStore(Path(out_dir) / "jobs"), executor, desc=f"deep agents ({len(tasks)} jobs)"
-        )
-    report.raise_for_failures("deep job")
-    summary = {
-        "jobs": len(tasks),
-        "reused": len(report.reused),
-        "computed": len(report.computed),
-        "workers": executor.workers,
-        "wall_time_s": report.wall_time_s,
-    }
-    return report.records, summary
 
 
 def _score(records: Sequence[dict[str, Any]], episodes: int, condition: str) -> dict[str, Any] | None:

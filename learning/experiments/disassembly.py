@@ -13,8 +13,9 @@ pose jittered): ``runs_per_test`` seeded runs on each, success = the motherboard
 - ``dqn``, ``model-based``: the deep baselines (:mod:`learning.experiments.disassembly_deep`; dense rewards for
   the model-free agent, as the paper had to), trained for each of ``deep_episodes``.
 
-Each (agent, training seed) is one task of :mod:`learning.runner` whose record (every point, per test scene)
-is written the moment it ends, so an interrupted run resumes where it stopped. :func:`summarise` pools the
+Each (agent, training seed) is one job (:func:`jobs_for`); the composition layer runs each as a task of the task
+runner (``puzzlebox.lab.disassembly_run``) whose record (every point, per test scene) is written the moment it
+ends, so an interrupted run resumes where it stopped. :func:`summarise` pools the
 seeds: success rate and mean actions (unsolved runs count the budget) per training-episode count, mean and
 standard deviation over training seeds, and the mean optimum (the oracle's shortest solution) of the tests.
 """
@@ -22,10 +23,10 @@ standard deviation over training seeds, and the mean optimum (the oracle's short
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
-from dataclasses import asdict, dataclass, field, replace
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -35,7 +36,6 @@ from puzzlebox.learning.dual_controller import DualControllerConfig
 from puzzlebox.learning.errors import ConfigError
 from puzzlebox.learning.experiments.scene_evaluation import TEST_SEED, evaluate_on_scenes
 from puzzlebox.learning.memory.store import MemoryStore
-from puzzlebox.learning.runner import RecordStore, Task, make_executor, run_tasks
 from puzzlebox.learning.symbolic_world import SymbolicWorld
 from puzzlebox.learning.trial import run_episode
 from puzzlebox.models import LockTable, PuzzleSpec, load_spec, spec_from_dict
@@ -193,10 +193,18 @@ def curve_name(agent: str, max_lockers: int) -> str:
     return agent if max_lockers == 1 else f"{agent}-k{max_lockers}"
 
 
-def tasks_for(
+class Job(NamedTuple):
+    """One (curve, training seed) of the experiment: ``function(settings)`` is its record, kept as ``KEY.json``."""
+
+    key: str
+    function: Callable[[dict[str, Any]], dict[str, Any]]
+    settings: dict[str, Any]
+
+
+def jobs_for(
     agents: Sequence[str], config: DisassemblyConfig, scenes_: tuple[PuzzleSpec, list[PuzzleSpec]] | None = None
-) -> list[Task]:
-    """Every (curve, training seed) task of the experiment (``scenes_``: :func:`scenes` of ``config``, if made)."""
+) -> list[Job]:
+    """Every (curve, training seed) job of the experiment (``scenes_``: :func:`scenes` of ``config``, if made)."""
     unknown = [a for a in agents if a not in AGENTS]
     if unknown or not agents:
         raise ConfigError(f"unknown disassembly agents {unknown or list(agents)}; available: {list(AGENTS)}")
@@ -211,7 +219,7 @@ def tasks_for(
         "train_max_actions": config.train_max_actions,
     }
     deep = {**common, "episodes": list(config.deep_episodes), "runs": config.deep_runs_per_test}
-    tasks = []
+    jobs = []
     for agent in agents:
         lockers = config.memory_max_lockers if agent == "memory" else (1,)  # the dual agent decides alike at k = 2
         seeds = 1 if agent == "dual" else config.training_seeds  # the dual agent learns nothing across runs
@@ -224,23 +232,8 @@ def tasks_for(
                 if agent == "memory":
                     settings["position_scale"] = config.position_scale(k)
                     settings["entropy_scale"] = config.entropy_scale(k)
-                tasks.append(Task(f"{curve_name(agent, k)}-s{seed}", function, settings))
-    return tasks
-
-
-def run_disassembly(out: Path, agents: Sequence[str], config: DisassemblyConfig, workers: int | None = None,
-                    ray: str | None = None) -> dict[str, Any]:  # fmt: skip
-    """Run (or resume) the experiment into ``out``; returns the summary (also ``out/disassembly.json``)."""
-    start = time.perf_counter()
-    train, tests = scenes(config)
-    tasks = tasks_for(agents, config, (train, tests))
-    with make_executor(workers, ray) as executor:
-        report = run_tasks(tasks, RecordStore(out / "records"), executor, desc="disassembly")
-    report.raise_for_failures()
-    summary = summarise(report.records, config, tests)
-    summary.update({"wall_time_s": time.perf_counter() - start, "config": asdict(config), "agents": list(agents),
-                    "tasks": {"computed": len(report.computed), "reused": len(report.reused)}})  # fmt: skip
-    return summary
+                jobs.append(Job(f"{curve_name(agent, k)}-s{seed}", function, settings))
+    return jobs
 
 
 def _shortest(spec: PuzzleSpec) -> int:

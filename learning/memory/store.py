@@ -32,7 +32,10 @@ schema raised, in one transaction — the first time they are trained further (o
 
 A file that is not a puzzlebox memory (not SQLite, another application's database, a newer schema)
 or that is damaged (truncated, failed integrity check, malformed rows) raises
-:class:`~learning.errors.MemoryFileError`; it is never read as an empty memory.
+:class:`~learning.errors.MemoryFileError`; it is never read as an empty memory. Nor is a file whose schema is not
+exactly the project's (:func:`check_schema`: a trigger, a view, an unknown table, index or column): a trigger
+would run its own SQL on our writes, so the check runs when the file is opened and again inside every write
+transaction.
 """
 
 from __future__ import annotations
@@ -58,6 +61,7 @@ from puzzlebox.learning.memory.keys import (
     SPATIAL_KEY_SIZE,
     se3_key_from_legacy,
 )
+from puzzlebox.models.atomic import apply_umask
 from puzzlebox.models.disassembly_kinds import kind_family
 
 MEMORY_FORMAT = "puzzlebox-memory"
@@ -99,6 +103,55 @@ CREATE TABLE independence_entries (
     + _LOG_SCHEMA
     + _PROVENANCE_SCHEMA
 )
+
+_COLUMNS = {
+    "meta": {"key", "value"},
+    "episodes": {"id", "spec", "solved", "num_actions", "created"},
+    "pair_entries": {"episode", "kind_i", "kind_j", "key", "value"},
+    "independence_entries": {"episode", "kind", "value"},
+}
+"""Every table of a schema 1 file and its columns."""
+_LOG_COLUMNS, _PROVENANCE_COLUMNS = {"seed", "training_run"}, {"source", "profile", "robot_time"}
+_INDEXES = {"sqlite_autoindex_meta_1"}
+"""Every index a memory file holds (SQLite's own, of meta's primary key)."""
+
+
+def expected_objects(schema: str) -> dict[tuple[str, str], set[str]]:
+    """What ``sqlite_master`` of a schema ``schema`` memory holds, exactly: ``(type, name)`` -> the table's
+    columns (an index: none). No trigger, no view, nothing else."""
+    columns = {name: set(cols) for name, cols in _COLUMNS.items()}
+    if schema != "1":
+        columns["training_runs"] = {"id", "started", "config"}
+        columns["episodes"] |= _LOG_COLUMNS | (_PROVENANCE_COLUMNS if schema != "2" else set())
+    return {**{("table", name): cols for name, cols in columns.items()}, **{("index", i): set() for i in _INDEXES}}
+
+
+def check_schema(conn: sqlite3.Connection, path: Path | str, schema: str) -> None:
+    """Refuse (:class:`MemoryFileError`) a file whose ``sqlite_master`` is not exactly the project's for
+    ``schema``: a trigger runs code on every write (it passes ``PRAGMA integrity_check``), a view or an unknown
+    table or index is not ours. Run when a file is opened and inside every write transaction."""
+    found = {(kind, name) for kind, name in conn.execute("SELECT type, name FROM sqlite_master")}
+    expected = expected_objects(schema)
+    extra = sorted(found - set(expected))
+    if extra:
+        shown = ", ".join(f"{kind} {name!r}" for kind, name in extra[:5])
+        raise MemoryFileError(
+            f"{path} holds what a puzzlebox memory never does ({shown}{', ...' if len(extra) > 5 else ''}): "
+            "refused, nothing run on it"
+        )
+    missing = sorted(set(expected) - found)
+    if missing:
+        raise MemoryFileError(f"{path} lacks {', '.join(f'{k} {n!r}' for k, n in missing)} of a schema {schema} "
+                              "puzzlebox memory")  # fmt: skip
+    for (kind, name), columns in expected.items():
+        if kind == "table":
+            got = {row[1] for row in conn.execute(f"PRAGMA table_info({name})")}
+            if got != columns:
+                raise MemoryFileError(
+                    f"{path}: table {name!r} has columns {sorted(got)}, not a schema {schema} memory's "
+                    f"{sorted(columns)}"
+                )
+
 
 BUSY_TIMEOUT = 120.0
 """How long a writer waits for another trainer's transaction on the same file [s]."""
@@ -182,6 +235,7 @@ class MemoryStore:
                     ],
                 )
             conn.close()
+            apply_umask(name)  # mkstemp made it private; the memory file is not
             with contextlib.suppress(FileExistsError):
                 os.link(name, path)
         finally:
@@ -220,6 +274,7 @@ class MemoryStore:
                 f"{path} has memory schema {meta.get('schema_version')}; this version reads {list(READABLE_SCHEMAS)}"
             )
         self._schema = meta["schema_version"]
+        check_schema(conn, path, self._schema)
         self.position_scale = _meta_number(meta, "position_scale", path, "a finite length > 0", positive=True)
         if self._schema in LEGACY_KEY_SCHEMAS:
             self.rotation_weight = DEFAULT_ROTATION_WEIGHT  # what the conversion of its compact keys uses
@@ -258,6 +313,13 @@ class MemoryStore:
             _check_probabilities(value_arr, f"{path} has an independence entry ({kind})")
             self._independence[kind].append(value_arr)
 
+    def _write_transaction(self) -> None:
+        """Begin a write transaction (holding the file's write lock) and check, inside it, that the file is still
+        exactly a memory (:func:`check_schema`): what is written is written only through that check."""
+        assert self._conn is not None and self.path is not None
+        self._conn.execute("BEGIN IMMEDIATE")
+        check_schema(self._conn, self.path, self._schema)
+
     def close(self) -> None:
         if self._conn is not None:
             self._conn.close()
@@ -280,6 +342,7 @@ class MemoryStore:
         conn.execute("BEGIN IMMEDIATE")  # hold the write lock: another trainer may be upgrading too
         try:
             schema = conn.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()[0]
+            check_schema(conn, path, schema)  # nothing of another's runs on our write
             missing = {"1": _LOG_SCHEMA + _PROVENANCE_SCHEMA, "2": _PROVENANCE_SCHEMA}.get(schema, "")
             for statement in filter(str.strip, missing.split(";")):
                 conn.execute(statement)
@@ -306,6 +369,7 @@ class MemoryStore:
             return None
         self.migrate()
         with self._conn:
+            self._write_transaction()
             cursor = self._conn.execute(
                 "INSERT INTO training_runs (started, config) VALUES (?, ?)",
                 (time.time(), json.dumps(config, sort_keys=True)),
@@ -388,6 +452,7 @@ class MemoryStore:
         if self._conn is not None:
             self.migrate()
             with self._conn:  # one transaction: the episode (log row included) is stored whole or not at all
+                self._write_transaction()
                 cursor = self._conn.execute(
                     "INSERT INTO episodes (spec, solved, num_actions, created, seed, training_run, source, profile, "
                     "robot_time) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)",

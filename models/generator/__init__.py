@@ -1,4 +1,4 @@
-"""Procedural puzzle generators: the paper's family, chains of any kinds, random lock graphs.
+"""Procedural puzzle generators: the paper's family, chains of any kinds, random lock graphs, one-part boxes.
 
 Every generator is a pure function of its parameters and seed: the same call gives byte-identical
 JSON.
@@ -15,6 +15,7 @@ from puzzlebox.models.generator.paper import (
     paper_variant_name,
 )
 from puzzlebox.models.generator.random_graph import MAX_RANDOM_COMPONENTS, RandomGraphConfig, generate_random
+from puzzlebox.models.generator.single import single_part
 
 __all__ = [
     "MAX_RANDOM_COMPONENTS",
@@ -30,4 +31,5 @@ __all__ = [
     "paper_sequences",
     "paper_variant",
     "paper_variant_name",
+    "single_part",
 ]

@@ -2,6 +2,7 @@
 together, to run trials (:func:`run_trial`, :func:`open_world`), sweeps, datasets, calibrations, reports and the
 twin experiments (DESIGN.md, "Layers")."""
 
+from puzzlebox.lab.cells import CellError, RealCell, TwinCell
 from puzzlebox.lab.errors import AgentClassError, LabError, RunStoreError, TrialConfigError
 from puzzlebox.lab.observers import ObservedRobot, PeakWristForce, SensedDigest, TrialContext, TrialObserver
 from puzzlebox.lab.trial_config import TrialConfig
@@ -10,9 +11,11 @@ from puzzlebox.lab.trials import open_world, run_trial
 
 __all__ = [
     "AgentClassError",
+    "CellError",
     "LabError",
     "ObservedRobot",
     "PeakWristForce",
+    "RealCell",
     "RunStoreError",
     "SensedDigest",
     "TrialConfig",
@@ -20,6 +23,7 @@ __all__ = [
     "TrialContext",
     "TrialObserver",
     "TrialRecord",
+    "TwinCell",
     "open_world",
     "run_trial",
 ]

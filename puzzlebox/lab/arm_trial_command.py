@@ -11,14 +11,18 @@ from pathlib import Path
 from typing import Any
 
 from puzzlebox.lab.agent_class import check_agent, make_agent_object
+from puzzlebox.lab.cells import RealCell
 from puzzlebox.lab.cli import one_line, write_json
 from puzzlebox.lab.errors import ArmTrialFailed, ArmTrialRefused
-from puzzlebox.lab.real_trial import cell_configs, run_real_trial
+from puzzlebox.lab.real_trial import cell_configs
 from puzzlebox.lab.run_store import RunStore
+from puzzlebox.lab.trial_config import TrialConfig
+from puzzlebox.lab.trials import run_trial
 from puzzlebox.learning import LearningError, make_agent, summarise
 from puzzlebox.learning.memory import MemoryStore
 from puzzlebox.models import SpecError, load_spec
 from puzzlebox.models.cell_config import CellConfig
+from puzzlebox.models.names import name_slug
 
 __all__ = ["ArmTrialRequest", "reach_arm", "run_arm_trial"]
 
@@ -91,7 +95,7 @@ def run_arm_trial(request: ArmTrialRequest, arm: Callable[[str, Any], Any] | Non
                   "checkpoint": request.checkpoint, "seed": request.seed, "max_actions": request.max_actions,
                   "max_lockers": request.max_lockers}  # fmt: skip
     store = RunStore(request.out, experiment, force=request.force)
-    key = f"000-{spec.name}-seed{request.seed}"
+    key = f"000-{name_slug(spec.name)}-seed{request.seed}"
 
     def write(record: dict) -> None:  # the record as it grows: a stop or a crash keeps every action done
         write_json(store.records.path(key), {"key": key, "record": record})
@@ -99,9 +103,11 @@ def run_arm_trial(request: ArmTrialRequest, arm: Callable[[str, Any], Any] | Non
 
     try:
         with (arm or XArmRobot)(request.ip, cell) as robot:
-            record = run_real_trial(robot, calibration, spec, cell, request.agent, request.seed, request.max_actions,
-                                    memory=memory, checkpoint=request.checkpoint, on_record=write,
-                                    max_lockers=request.max_lockers, agent=agent)  # fmt: skip
+            config = TrialConfig(agent=request.agent, seed=request.seed, max_actions=request.max_actions,
+                                 checkpoint=None if request.checkpoint is None else Path(request.checkpoint),
+                                 max_lockers=request.max_lockers)  # fmt: skip
+            record = run_trial(spec, config, agent=agent, memory=memory, cell=RealCell(robot, cell, calibration),
+                               on_record=write).to_dict()  # fmt: skip
     except RealError as err:  # the arm refused or failed a call mid-trial (a stop is in the record instead)
         raise ArmTrialFailed(f"{one_line(err)}; what was done is kept in {request.out}") from err
     store.write_results({**summarise([record], request.max_actions), "runs_done": 1, "runs_planned": 1})

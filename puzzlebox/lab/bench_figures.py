@@ -1,6 +1,7 @@
 """The figures ``bench.py`` measures, in the order it measures them, each with where it goes in the results file
 and the lines it prints: the symbolic figures (``puzzlebox.lab.symbolic_speed``), the twin's
-(``puzzlebox.lab.twin_speed``), then the scale figures (``puzzlebox.lab.bench_scale``). Each figure is measured
+(``puzzlebox.lab.twin_speed``), the manipulation environment's (``puzzlebox.lab.manipulation_speed``), then the
+scale figures (``puzzlebox.lab.bench_scale``). Each figure is measured
 when its generator is advanced, so a caller can print and keep it before the next one starts."""
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from puzzlebox.lab.cli import versions
+from puzzlebox.lab.manipulation_speed import step_figures, vector_figures
 from puzzlebox.lab.symbolic_speed import (
     SIZES,
     decision_latency,
@@ -97,6 +99,31 @@ def measured_figures(quick: bool) -> Iterator[Figure]:
     yield Figure(("box_visibility",), seen, [
         f"rollout views: over {seen['frames']} frames of {seen['trials']} trials the best view showed at least "
         f"{seen['worst_frame_best_view']:.1%} of the box ({seen['frames_below_0.9']} frames below 90 %)"
+    ])  # fmt: skip
+    yield from manipulation_figures(quick)
+
+
+def manipulation_figures(quick: bool) -> Iterator[Figure]:
+    """``BoxManipulation-v0`` against bare ``mj_step`` over the same simulated time, and two async workers against
+    one (``puzzlebox.lab.manipulation_speed``)."""
+    from puzzlebox.models.generator import paper_family
+
+    for key, spec in (("step", None), ("step_paper_test_0", paper_family("test")[0])):
+        step = step_figures(quick, spec)
+        per_call = step["bare_mj_step_per_call_control_steps_per_s"]
+        nstep = step["bare_mj_step_nstep_control_steps_per_s"]
+        yield Figure(("manipulation", key), step, [
+            f"BoxManipulation-v0 (state obs, ideal, {step['spec']}): {step['env_step_control_steps_per_s']:,.0f} "
+            f"steps/s at 20 Hz; bare mj_step over the same simulated time {per_call:,.0f}/s per call, {nstep:,.0f}/s "
+            f"nstep (env x{step['env_over_bare_per_call']:.2f}, x{step['env_over_bare_nstep']:.2f}; in CPU time "
+            f"x{step['env_over_bare_per_call_cpu']:.2f}, x{step['env_over_bare_nstep_cpu']:.2f}; load "
+            f"{step['load_average_1min'][0]:.1f})"
+        ])  # fmt: skip
+    vector = vector_figures(quick)
+    yield Figure(("manipulation", "vector"), vector, [
+        f"BoxManipulation-v0 make_vec async: 1 worker {vector['async_1_steps_per_s']:,.0f} steps/s, 2 workers "
+        f"{vector['async_2_steps_per_s']:,.0f} steps/s (x{vector['async_2_over_async_1']:.2f}; one env in-process "
+        f"{vector['one_env_steps_per_s']:,.0f}/s, x{vector['async_2_over_one_env']:.2f})"
     ])  # fmt: skip
 
 

@@ -9,8 +9,8 @@ import time
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from puzzlebox.lab.runner import Executor, InlineExecutor, PoolExecutor, RayExecutor, Task
 from puzzlebox.lab.trial_task import trial_task
-from puzzlebox.learning.runner import Executor, InlineExecutor, PoolExecutor, RayExecutor, Task
 
 
 def noop(settings: Mapping[str, Any]) -> dict[str, Any]:

@@ -36,8 +36,9 @@ def one_line(err: Exception) -> str:
 
 
 def fail(message: str, code: int = 2) -> NoReturn:
-    """Print ``error: message`` on stderr and exit (no traceback for a user's mistake)."""
-    print(f"error: {message}", file=sys.stderr)
+    """Print ``error: message`` on stderr, on one line (a message of several lines, e.g. every problem of a spec, is
+    joined), and exit (no traceback for a user's mistake)."""
+    print(f"error: {' '.join(line.strip() for line in message.splitlines() if line.strip())}", file=sys.stderr)
     raise SystemExit(code)
 
 

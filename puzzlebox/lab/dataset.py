@@ -11,12 +11,13 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from puzzlebox.learning.runner import Task
+from puzzlebox.lab.runner import Task
 from puzzlebox.models import LockTable
 from puzzlebox.models.atomic import write_text_atomically
 from puzzlebox.models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random
 from puzzlebox.models.kinds import family_named
 from puzzlebox.models.lock_table import ReachabilityUndecided
+from puzzlebox.models.names import name_slug
 
 MANIFEST = "manifest.json"
 
@@ -46,7 +47,7 @@ def make_spec(settings: Mapping[str, Any]) -> dict[str, Any]:
     except ReachabilityUndecided:
         shortest = "undecided (search too large)"
     entry = {
-        "name": spec.name, "seed": settings["seed"], "file": f"{spec.name}.json",
+        "name": spec.name, "seed": settings["seed"], "file": f"{name_slug(spec.name)}.json",
         "sha256": hashlib.sha256(text.encode()).hexdigest(), "components": len(spec.components),
         "shortest_solution": shortest,
     }  # fmt: skip

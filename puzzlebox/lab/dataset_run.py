@@ -1,7 +1,8 @@
 """Making a dataset of specs (``generate.py random|chain ... --count N --out DIR``): the specs of seeds
 S..S+N-1 generated in parallel as runner tasks (``puzzlebox.lab.dataset``), each written the moment it is made
 (with its top view if asked), and the manifest written once every spec is there. A stop request (Ctrl-C,
-SIGTERM) ends the run after the current spec, without a manifest."""
+SIGTERM) ends the run after the current spec, without a manifest. The directory is owned by one run at a time
+(``DIR/.lock``: another run into it is refused, naming it)."""
 
 from __future__ import annotations
 
@@ -13,8 +14,10 @@ from tqdm import tqdm
 
 from puzzlebox.lab.dataset import spec_task, write_manifest, write_spec
 from puzzlebox.lab.errors import DatasetError
+from puzzlebox.lab.inputs import MAX_COUNT, check_count, check_seed
 from puzzlebox.lab.interrupt import StopRequests
-from puzzlebox.learning.runner import RunnerError, make_executor
+from puzzlebox.lab.out_lock import OutputLock
+from puzzlebox.lab.runner import RunnerError, make_executor
 from puzzlebox.models import load_spec
 
 
@@ -46,9 +49,12 @@ def make_dataset(
     runner that cannot run."""
     if count < 1:
         raise DatasetError(f"--count must be >= 1, got {count}")
+    check_count(count, "--count", MAX_COUNT)
+    check_seed(seed, "--seed", count)  # spec i from seed S + i
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise DatasetError(f"--out {out} is a file; with --count it names a directory")
+    lock = OutputLock(out)  # one dataset run writes a directory at a time
     generator = {**generator, "name": name, "anywhere": anywhere, "seed": seed}
     tasks = [spec_task(f"s{seed + i}", {**generator, "seed": seed + i}) for i in range(count)]
     entries = []
@@ -70,6 +76,8 @@ def make_dataset(
     except RunnerError as err:
         raise DatasetError(str(err)) from err
     if len(entries) < len(tasks):
+        lock.release()
         return DatasetRun(out, len(entries), len(tasks), None)
     manifest = write_manifest(out, {**generator, "seed": seed, "count": count}, entries)
+    lock.release()
     return DatasetRun(out, len(entries), len(tasks), manifest)

@@ -12,10 +12,12 @@ __all__ = [
     "ExperimentSettingsError",
     "ExperimentStepFailed",
     "LabError",
+    "ManipulationEnvError",
     "NotABoxSpec",
     "OutputFileError",
     "OutputHoldsAnotherConfig",
     "OutputHoldsResults",
+    "OutputInUse",
     "OutputNotADirectory",
     "OutputNotWritable",
     "ResumeAndForce",
@@ -62,6 +64,10 @@ class OutputHoldsAnotherConfig(RunStoreError, ValueError):
 
 class OutputNotWritable(RunStoreError, PermissionError):
     """The output directory cannot be written."""
+
+
+class OutputInUse(RunStoreError, BlockingIOError):
+    """Another process holds the output (its lock): the message names its pid and command."""
 
 
 class SpecFileError(LabError, ValueError):
@@ -125,3 +131,8 @@ class ArmTrialRefused(LabError, ValueError):
 
 class ArmTrialFailed(LabError, RuntimeError):
     """The arm refused or failed a call mid-trial (what was done is kept)."""
+
+
+class ManipulationEnvError(LabError, ValueError):
+    """``puzzlebox/BoxManipulation-v0`` asked for what it does not offer (an observation or reward mode, a reality
+    profile, a box, an action): the message names the argument, what was given and the valid choices."""

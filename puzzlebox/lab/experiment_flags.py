@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 from puzzlebox.lab.cli import versions, write_json
 from puzzlebox.lab.errors import ExperimentSettingsError
+from puzzlebox.lab.out_lock import OutputLock
 from puzzlebox.learning.experiments import PROTOCOLS, SYMBOLIC_AGENTS
 from puzzlebox.learning.experiments.deep_protocols import DEEP_AGENTS
 
@@ -22,11 +23,15 @@ FAULTS = "faults"
 TWIN_LEARNING = "twin-learning"
 SYSID = "sysid"
 KINDS = "kinds"
+MANIPULATION = "manipulation"
 ALL = "all"
-PROTOCOL_NAMES = (*PROTOCOLS, ALL, REALITY, FAULTS, TWIN_LEARNING, SYSID, DISASSEMBLY, KINDS)
+PROTOCOL_NAMES = (*PROTOCOLS, ALL, REALITY, FAULTS, TWIN_LEARNING, SYSID, DISASSEMBLY, KINDS, MANIPULATION)
 """Every protocol ``experiment.py`` runs: the paper's symbolic ones, all three of them, and the twin's."""
 AGENTS = (*SYMBOLIC_AGENTS, *DEEP_AGENTS)
 """The agents of the paper's symbolic protocols."""
+
+MAX_RUNS, MAX_SEEDS, MAX_WORKERS = 100_000, 1000, 1024
+"""Bounds of ``--runs``, ``--seeds`` and ``--workers``: far above any experiment's, below what exhausts memory."""
 
 Config = TypeVar("Config", bound="DataclassInstance")  # a protocol's config, a dataclass (see with_runs)
 
@@ -48,13 +53,21 @@ class ExperimentFlags:
     cells: str | None = None
     validation: bool = False
     no_holding_rule: bool = False
+    steps: int | None = None
+    algo: str | None = None
 
     def check(self) -> None:
-        """The flags that belong to one protocol only are not given to another."""
+        """The flags that belong to one protocol only are not given to another; sizes are bounded."""
+        for flag, value, bound in (("--runs", self.runs, MAX_RUNS), ("--seeds", self.seeds, MAX_SEEDS),
+                                   ("--workers", self.workers, MAX_WORKERS)):  # fmt: skip
+            if value is not None and value > bound:
+                raise ExperimentSettingsError(f"{flag} must be <= {bound}, got {value}")
         if self.cells is not None and self.protocol != SYSID:
             raise ExperimentSettingsError("--cells goes with the sysid protocol")
         if (self.validation or self.no_holding_rule) and self.protocol != DISASSEMBLY:
             raise ExperimentSettingsError("--validation and --no-holding-rule go with the disassembly protocol")
+        if (self.steps is not None or self.algo is not None) and self.protocol != MANIPULATION:
+            raise ExperimentSettingsError("--steps and --algo go with the manipulation protocol")
 
     def agent_names(self, available: tuple[str, ...]) -> list[str]:
         """The ``--agents`` of a protocol that needs them, each one of ``available``."""
@@ -74,6 +87,8 @@ class ExperimentFlags:
         """``--workers``, if given, is at least 1 (``show``: the message shows the value given)."""
         if self.workers is not None and self.workers < 1:
             raise ExperimentSettingsError("--workers must be >= 1" + (f", got {self.workers}" if show else ""))
+        if self.workers is not None and self.workers > MAX_WORKERS:
+            raise ExperimentSettingsError(f"--workers must be <= {MAX_WORKERS}, got {self.workers}")
 
     def with_runs(self, config: Config, field: str, minimum: int, why: str = "") -> Config:
         """``config`` with ``--runs`` in ``field`` (unchanged without it); at least ``minimum`` (``why`` says
@@ -82,6 +97,8 @@ class ExperimentFlags:
             return config
         if self.runs < minimum:
             raise ExperimentSettingsError(f"--runs must be >= {minimum}{why}, got {self.runs}")
+        if self.runs > MAX_RUNS:
+            raise ExperimentSettingsError(f"--runs must be <= {MAX_RUNS}, got {self.runs}")
         return replace(config, **{field: self.runs})
 
     def with_seeds(self, config: Config, field: str, as_range: bool = False) -> Config:
@@ -89,8 +106,8 @@ class ExperimentFlags:
         0..N-1; unchanged without it."""
         if self.seeds is None:
             return config
-        if self.seeds < 1:
-            raise ExperimentSettingsError(f"--seeds must be >= 1, got {self.seeds}")
+        if not 1 <= self.seeds <= MAX_SEEDS:
+            raise ExperimentSettingsError(f"--seeds must be >= 1 and <= {MAX_SEEDS}, got {self.seeds}")
         return replace(config, **{field: tuple(range(self.seeds)) if as_range else self.seeds})
 
     def only(self, allowed: str, *names: str) -> None:
@@ -99,8 +116,8 @@ class ExperimentFlags:
         if given:
             raise ExperimentSettingsError(f"the {self.protocol} protocol takes only {allowed}, got {' '.join(given)}")
 
-    def out_dir(self, directory_only: bool = False) -> Path:
-        """``--out`` as a path (``directory_only``: refused if it is a file)."""
+    def out_dir(self, directory_only: bool = True) -> Path:
+        """``--out`` as a path: a directory (a file there is refused before any work)."""
         out = Path(self.out)
         if directory_only and out.exists() and not out.is_dir():
             raise ExperimentSettingsError(f"--out {out} is a file, not a directory")
@@ -108,6 +125,25 @@ class ExperimentFlags:
 
     def write_config(self, out: Path, name: str, **settings: Any) -> None:
         """``DIR/<name>.config.json``: the command line, the resolved settings and the versions, beside the
-        results."""
+        results; written under the directory's lock (:func:`hold_output`), which every protocol takes here,
+        before its work."""
+        hold_output(out)
         write_json(out / f"{name}.config.json", {"command": "experiment", **asdict(self), **settings,
                                                   "versions": versions()})  # fmt: skip
+
+
+_HELD: list[OutputLock] = []
+
+
+def hold_output(out: Path) -> None:
+    """Own ``--out`` until :func:`release_outputs` (or the process's end): a directory another process writes, a
+    file, or a place that cannot be written is refused (a :class:`~puzzlebox.lab.errors.RunStoreError`)."""
+    if out.exists() and not out.is_dir():
+        raise ExperimentSettingsError(f"--out {out} is a file, not a directory")
+    _HELD.append(OutputLock(out))
+
+
+def release_outputs() -> None:
+    """Release every output :func:`hold_output` took."""
+    while _HELD:
+        _HELD.pop().release()

@@ -1,9 +1,10 @@
 """Every protocol of ``experiment.py`` from its settings (:class:`ExperimentFlags`): the paper's symbolic ones
 (``puzzlebox.lab.paper_protocols``) and the twin's — ``reality`` (``reality_sweep``), ``twin-learning``,
-``kinds`` (``kinds_experiment``), ``sysid``, ``disassembly`` (``learning.experiments.disassembly``) and
-``faults``. Each checks the flags it takes, writes ``DIR/<name>.config.json``, runs (resuming what a previous run
-of the same command finished) and hands its report (``DIR/<name>.md``) and wall time to ``echo``. A mistake in the
-settings is an :class:`ExperimentSettingsError`; the learning layer's refusal an :class:`ExperimentFailed`."""
+``kinds`` (``kinds_experiment``), ``manipulation`` (``manipulation_experiment``), ``sysid``, ``disassembly``
+(``disassembly_run``) and ``faults``. Each checks the flags it takes, writes ``DIR/<name>.config.json``, runs
+(resuming what a previous run of the same command finished) and hands its report (``DIR/<name>.md``) and wall time
+to ``echo``. A mistake in the settings is an :class:`ExperimentSettingsError`; the learning layer's refusal an
+:class:`ExperimentFailed`."""
 
 from __future__ import annotations
 
@@ -18,10 +19,12 @@ from puzzlebox.lab.experiment_flags import (
     DISASSEMBLY,
     FAULTS,
     KINDS,
+    MANIPULATION,
     REALITY,
     SYSID,
     TWIN_LEARNING,
     ExperimentFlags,
+    release_outputs,
 )
 from puzzlebox.lab.paper_protocols import run_paper_protocols
 from puzzlebox.learning.errors import LearningError
@@ -34,8 +37,11 @@ def run_experiment(flags: ExperimentFlags, echo: Echo = print) -> None:
     """Check ``flags`` and run its protocol."""
     flags.check()
     runs = {REALITY: run_reality, FAULTS: run_faults, TWIN_LEARNING: run_twin_learning, SYSID: run_sysid,
-            DISASSEMBLY: run_disassembly, KINDS: run_kinds}  # fmt: skip
-    runs.get(flags.protocol, run_paper_protocols)(flags, echo)
+            DISASSEMBLY: run_disassembly, KINDS: run_kinds, MANIPULATION: run_manipulation}  # fmt: skip
+    try:
+        runs.get(flags.protocol, run_paper_protocols)(flags, echo)
+    finally:
+        release_outputs()  # the --out each protocol holds from its config on
 
 
 def run_reality(flags: ExperimentFlags, echo: Echo = print) -> None:
@@ -135,8 +141,9 @@ def cell_seeds(cells: str) -> tuple[int, ...]:
 
 def run_disassembly(flags: ExperimentFlags, echo: Echo = print) -> None:
     """The disassembly domain: train on one measured computer, test on another and its variants."""
+    from puzzlebox.lab.disassembly_run import run_disassembly
     from puzzlebox.learning.experiments.disassembly import AGENTS as DISASSEMBLY_AGENTS
-    from puzzlebox.learning.experiments.disassembly import DisassemblyConfig, run_disassembly
+    from puzzlebox.learning.experiments.disassembly import DisassemblyConfig
     from puzzlebox.learning.experiments.disassembly_report import plot as plot_disassembly
     from puzzlebox.learning.experiments.disassembly_report import table as disassembly_table
 
@@ -157,6 +164,24 @@ def run_disassembly(flags: ExperimentFlags, echo: Echo = print) -> None:
     plot_disassembly(summary, out / f"{DISASSEMBLY}.png")
     (out / f"{DISASSEMBLY}.md").write_text(f"# Disassembly\n\n{disassembly_table(summary)}")
     report(out, DISASSEMBLY, summary, echo)
+
+
+def run_manipulation(flags: ExperimentFlags, echo: Echo = print) -> None:
+    """PPO or SAC from scratch on ``BoxManipulation-v0``: a free slide, a free wheel (learning curves)."""
+    from puzzlebox.lab.manipulation_experiment import ALGOS, ManipulationConfig, require_sb3, run_manipulation
+
+    flags.only("--out, --quick, --seeds, --steps and --algo", "agents", "runs", "workers", "ray", "memory")
+    config = ManipulationConfig().quick() if flags.quick else ManipulationConfig()
+    if flags.algo is not None and flags.algo not in ALGOS:
+        raise ExperimentSettingsError(f"--algo must be one of {list(ALGOS)}, got {flags.algo!r}")
+    if flags.steps is not None and not 1 <= flags.steps <= 100_000_000:
+        raise ExperimentSettingsError(f"--steps must be >= 1 and <= 100000000 (env steps per run), got {flags.steps}")
+    config = flags.with_seeds(config, "seeds")
+    config = replace(config, algo=flags.algo or config.algo, steps=flags.steps or config.steps)
+    out = flags.out_dir()
+    require_sb3()
+    flags.write_config(out, MANIPULATION, manipulation=asdict(config))
+    report(out, MANIPULATION, run_manipulation(out, config), echo)
 
 
 def run_faults(flags: ExperimentFlags, echo: Echo = print) -> None:

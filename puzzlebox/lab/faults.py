@@ -16,6 +16,8 @@ Classes so far:
   ``SimulationDiverged`` named, its record kept, and the trial goes on to the next run.
 - the twin's faults (:data:`TWIN_FAULTS`): frames dropped, occluded, noised; F/T noise; parts that jam;
   handles that slip — one oracle trial each, which must end with its reason named (or solve anyway).
+- the second round (:func:`second_round`, :mod:`puzzlebox.lab.input_faults`): two writers into one ``--out``,
+  names of every kind, malformed inputs, crafted memories, ``experiment.py`` stopped by a signal.
 
 Writes ``DIR/faults.json`` and ``DIR/faults.md`` (one table; the measured one is in docs/faults.md).
 """
@@ -62,10 +64,12 @@ class FaultsConfig:
     """Trials in which one worker is SIGKILLed (each at a random moment)."""
     seed: int = 0
     """Seeds the kill moments."""
+    races: int = 20
+    """Races of two writers into one ``--out``, of ``trial.py`` and of ``sweep.py`` each."""
 
     def quick(self) -> FaultsConfig:
         return FaultsConfig(sim="symbolic", trial_runs=60, kills=3, trainer_episodes=2, worker_runs=400,
-                            worker_kills=1, seed=self.seed)  # fmt: skip
+                            worker_kills=1, seed=self.seed, races=2)  # fmt: skip
 
 
 @dataclass
@@ -224,10 +228,11 @@ def physics_divergence(out: Path, runs: int = 3) -> FaultRow:
     """A twin trial of ``runs`` runs in which the physics of every run blows up at :data:`DIVERGE_AT_S`."""
     spec = _specs(out) / "paper-test-0.json"
     target = out / "diverged"
-    result = subprocess.run(
-        [sys.executable, "-c", _DIVERGING_TRIAL, "--specs", str(spec), "--sim", "twin", "--agent", "oracle", "--runs",
-         str(runs), "--seed", "0", "--max-actions", "6", "--workers", "1", "--out", str(target), "--force"],
-        capture_output=True, text=True, timeout=1800,
+    result = subprocess.run(  # in DIR: MuJoCo may log the warnings to MUJOCO_LOG.TXT in its working directory
+        [sys.executable, "-c", _DIVERGING_TRIAL, "--specs", str(spec.resolve()), "--sim", "twin", "--agent", "oracle",
+         "--runs", str(runs), "--seed", "0", "--max-actions", "6", "--workers", "1", "--out", str(target.resolve()),
+         "--force"],
+        capture_output=True, text=True, timeout=1800, cwd=out.resolve(),
     )  # fmt: skip
     path = target / "results.json"
     got = json.loads(path.read_text()) if path.exists() else {}
@@ -345,6 +350,58 @@ def cli_mistakes(out: Path) -> FaultRow:
     )
 
 
+def second_round(out: Path, config: FaultsConfig) -> list[FaultRow]:
+    """The classes of issue 37 (:mod:`puzzlebox.lab.input_faults`): two writers into one ``--out``, names of
+    every kind, malformed inputs, crafted memories, ``experiment.py`` stopped by a signal (the full suite only)."""
+    from puzzlebox.lab import input_faults
+
+    spec = _specs(out) / "paper-test-0.json"
+    rows = []
+    for kind in ("trial", "sweep"):
+        f = input_faults.writer_races(out / "races", kind, config.races, spec)
+        rows.append(FaultRow(
+            f"two {kind}.py into one --out, started together", f["races"],
+            f"{f['second_refused']}/{f['races']} second writers refused in one line ({f['refused_by_lock']} by the "
+            f"lock, {f['refused_holding_results']} finding the first's results)",
+            f"{f['races'] * 2 - f['tracebacks']}/{f['races'] * 2} without a traceback",
+            f"{f['summaries_lost']} summaries lost", "symbolic, different seeds, exit codes "
+            + ", ".join("/".join(map(str, r["codes"])) for r in f["rows"]),
+        ))  # fmt: skip
+    planned, done, clean = input_faults.names_run(out, spec)
+    rows.append(FaultRow(
+        "names with spaces, unicode, HTML, / and ..", len(input_faults.NAMES), f"{done}/{planned} runs done",
+        f"{len(input_faults.NAMES) if clean else 0}/{len(input_faults.NAMES)} without a traceback",
+        f"{done}/{planned} runs recorded", "record keys are slugs of the names plus a short hash",
+    ))  # fmt: skip
+    verdicts = input_faults.malformed_inputs(out, spec)
+    bad = [name for name, ok in verdicts.items() if not ok]
+    rows.append(FaultRow(
+        "malformed inputs", len(verdicts), f"{len(verdicts) - len(bad)}/{len(verdicts)} one line, exit 2",
+        f"{len(verdicts) - len(bad)}/{len(verdicts)} without a traceback", "nothing run",
+        ", ".join(verdicts) + (f"; NOT one line: {bad}" if bad else ""),
+    ))  # fmt: skip
+    crafted = input_faults.crafted_memories(out, spec)
+    rows.append(FaultRow(
+        "memory with a trigger, a view, an extra table", len(crafted),
+        f"{sum(crafted.values())}/{len(crafted)} refused in one line (exit 2)",
+        f"{sum(crafted.values())}/{len(crafted)} without a traceback",
+        f"{sum(crafted.values())}/{len(crafted)} files unchanged: nothing ran on them", ", ".join(crafted),
+    ))  # fmt: skip
+    if config.sim == "symbolic":  # the quick suite: tests/scripts/test_experiment_signals.py stops it instead
+        return rows
+    stopped = input_faults.experiment_stopped(out)
+    stops = stopped["stops"]
+    rows.append(FaultRow(
+        "experiment.py sent SIGTERM, SIGINT (inherited ignored)", len(stops),
+        f"{sum(s['one_line'] for s in stops.values())}/{len(stops)} said so in one line, exits "
+        f"{[s['exit'] for s in stops.values()]}",
+        f"{sum(s['one_line'] for s in stops.values())}/{len(stops)} without a traceback",
+        f"jobs kept after each stop: {[s['jobs_kept'] for s in stops.values()]}; rerun exit {stopped['final_exit']}",
+        "; ".join(stopped["reused"]),
+    ))  # fmt: skip
+    return rows
+
+
 TWIN_FAULTS: dict[str, dict[str, dict[str, Any]]] = {
     "camera: every frame dropped": {"camera": {"dropped_frame_probability": 1.0}},
     "every free part jams on every try": {"physics": {"jam_probability": 1.0}},
@@ -405,6 +462,7 @@ def run_faults(out: Path, config: FaultsConfig) -> dict[str, Any]:
         lambda: killed_trial(out, config),
         lambda: killed_worker(out, config),
         lambda: physics_divergence(out),
+        lambda: second_round(out, config),
     ]
     steps.append(lambda: twin_faults(out, config))
     summary: dict[str, Any] = {}

@@ -99,6 +99,14 @@ class MemoryTraining:
                     solved, done = solved + result.solved, done + 1
             except KeyboardInterrupt:
                 pass
+            except LearningError as err:  # the memory refused a write (e.g. its schema changed under the run)
+                raise TrainingError(f"{err}; the {done} episode(s) stored before are kept") from err
+            except (sqlite3.OperationalError, OSError) as err:  # a full disk, a file made read-only mid-run
+                raise TrainingError(
+                    f"--memory {self.memory}: cannot write the next episode ({err}); the {done} episode(s) of this "
+                    "run stored before are kept in it: free space (or fix the file) and rerun the same command "
+                    "with --resume"
+                ) from err
         return done, solved
 
     def finish(self) -> int:
@@ -106,6 +114,10 @@ class MemoryTraining:
         many episodes it holds."""
         # the log is in the memory file, episode by episode; its export is written once, at the end (reading
         # the whole log after every episode made a long training quadratic)
-        write_json(Path(self.memory + ".train.json"), {"memory": self.memory, "runs": self.store.training_log()})
+        try:
+            write_json(Path(self.memory + ".train.json"), {"memory": self.memory, "runs": self.store.training_log()})
+        except OSError as err:  # the memory holds every episode; only its export is missing
+            raise TrainingError(f"cannot write {self.memory}.train.json ({err.strerror or err}); every episode is "
+                                f"kept in {self.memory} (scripts/memory.py shows it)") from err  # fmt: skip
         self.store.close()
         return self.store.num_episodes

@@ -1,6 +1,6 @@
 """The paper's symbolic protocols (variants, episodes, noise, or all three) for every agent asked, as
 ``experiment.py`` runs them: the symbolic agents in this process, the deep agents as resumable training jobs
-(``learning.experiments.deep_protocols``, saved in ``DIR/jobs/``), and per protocol ``DIR/<protocol>.json``,
+(``deep_protocols_run``, saved in ``DIR/jobs/``), and per protocol ``DIR/<protocol>.json``,
 ``.png`` and ``.md`` (our numbers beside the paper's); ``all`` adds ``DIR/all.md`` (episodes to 100 % and the
 wall time of every part)."""
 
@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from puzzlebox.lab.cli import write_json
+from puzzlebox.lab.deep_protocols_run import run_jobs
 from puzzlebox.lab.errors import ExperimentFailed, ExperimentSettingsError
 from puzzlebox.lab.experiment_flags import AGENTS, ALL, ExperimentFlags
 from puzzlebox.learning.errors import LearningError
@@ -24,13 +25,7 @@ from puzzlebox.learning.experiments import (
     plot,
     results_table,
 )
-from puzzlebox.learning.experiments.deep_protocols import (
-    DEEP_AGENTS,
-    DeepSchedule,
-    jobs_for,
-    merge_deep_points,
-    run_jobs,
-)
+from puzzlebox.learning.experiments.deep_protocols import DEEP_AGENTS, DeepSchedule, jobs_for, merge_deep_points
 from puzzlebox.learning.experiments.report import episodes_to_solve_table
 
 

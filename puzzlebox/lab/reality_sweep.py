@@ -7,7 +7,7 @@ box at ``placements`` random reachable placements (seeds ``seed .. seed + placem
 placements at every level). A second sweep raises the F/T force noise alone, to find the noise at which
 outcome agreement drops below 99 %.
 
-Calibrations and trials are tasks of ``learning.runner`` (``--workers K`` processes, default one per
+Calibrations and trials are tasks of ``puzzlebox.lab.runner`` (``--workers K`` processes, default one per
 core, or ``--ray``). Nothing is lost: each calibration and each trial is written to ``DIR/calibrations/``
 and ``DIR/trials/`` as soon as it is made (atomically), and the same command resumes after an
 interruption, reusing them. The summary (``DIR/reality.json``, ``.md``, ``.png``) is rewritten every few
@@ -27,11 +27,11 @@ from typing import Any
 from puzzlebox.lab.calibration_run import calibrate_cell
 from puzzlebox.lab.cli import write_json
 from puzzlebox.lab.run_store import Periodic
+from puzzlebox.lab.runner import RecordStore, Task, make_executor, run_tasks
 from puzzlebox.lab.trial_figures import twin_figures
 from puzzlebox.lab.trial_task import trial_task
 from puzzlebox.learning import MemoryAgent, SymbolicWorld, run_episode, summarise
 from puzzlebox.learning.memory import MemoryStore
-from puzzlebox.learning.runner import RecordStore, Task, make_executor, run_tasks
 from puzzlebox.models.calibration import CellCalibration
 from puzzlebox.models.generator import paper_family
 from puzzlebox.models.spec_loading import spec_from_dict

@@ -8,9 +8,10 @@ script inline, nothing fetched from the network; videos are linked (``<video src
 inlined. Every string that comes from the data is escaped (:func:`html.escape`).
 
 The page holds a summary table (a sweep: one row per cell with its settings), the figures, the videos and every
-run as a row with a compact timeline: one block per action, coloured by the sensed outcome, as wide as the
-action's simulated time (twin runs; symbolic runs have no time: equal blocks), and a mark on each action whose
-sensed outcome (``moved``) disagrees with the simulator's truth (``true_moved``).
+run as a row (a twin run's with its box placement and reality profile) with a compact timeline: one block per
+action, named by the part it tried, coloured by the sensed outcome, as wide as the action's simulated time (twin
+runs; symbolic runs have no time: equal blocks), and a mark on each action whose sensed outcome (``moved``)
+disagrees with the simulator's truth (``true_moved``).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from __future__ import annotations
 import html
 import io
 import json
+import math
 import os
 import re
 from dataclasses import dataclass, field
@@ -27,6 +29,7 @@ from urllib.parse import quote
 
 from puzzlebox.lab.cell_bars import cell_bars
 from puzzlebox.lab.cli import one_line
+from puzzlebox.models.json_input import JsonInputError, read_json
 
 OUTCOME_COLOURS = {"moved": "#2e9d4a", "blocked": "#9aa3ad", "failed": "#d1495b"}
 OTHER_COLOUR = "#8e6bbf"
@@ -55,9 +58,9 @@ class ResultsDir:
 
 
 def _read_json(path: Path) -> Any:
-    try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+    try:  # the shared reader: bounded in size and depth (a file nested thousands deep is one line, not a traceback)
+        return read_json(path, allow_non_finite=True)
+    except JsonInputError as err:
         raise ReportError(f"cannot read {path}: {one_line(err)}") from None
 
 
@@ -259,9 +262,10 @@ def timeline_html(record: dict[str, Any], scale: float) -> str:
             sensed = "moved" if a.get("moved") else "not moved"
             truth = "moved" if a.get("true_moved") else "not moved"
             mark = f'<span class="mark" title="{esc(f"sensed {sensed}, truth {truth}")}">!</span>'
+        name = f'<span class="nm">{esc(a.get("component", ""))}</span>'
         blocks.append(
             f'<span class="act" data-i="{i}" data-outcome="{esc(outcome)}" style="width:{width:.3f}%;'
-            f'background:{colour}" title="{esc("; ".join(tip))}">{mark}</span>'
+            f'background:{colour}" title="{esc("; ".join(tip))}">{name}{mark}</span>'
         )
     return f'<div class="tl" data-actions="{len(actions)}">' + "".join(blocks) + "</div>"
 
@@ -277,6 +281,17 @@ def timeline_scale(runs: list[tuple[str, dict[str, Any]]]) -> tuple[float, float
         else:
             count = max(count, float(len(actions)))
     return sim, count
+
+
+def placement(pose: object) -> str:
+    """A box pose ``[x, y, yaw]`` [m, m, rad] as table text (escaped): ``x 0.338 y -0.046 m, yaw 53°``."""
+    if not isinstance(pose, (list, tuple)) or len(pose) != 3:
+        return "-"
+    try:
+        x, y, yaw = (float(v) for v in pose)
+    except (TypeError, ValueError):
+        return "-"
+    return esc(f"x {x:.3f} y {y:.3f} m, yaw {math.degrees(yaw):.0f}\u00b0")
 
 
 def run_video(record: dict[str, Any], videos: list[Path], base: Path, single: bool) -> Path | None:
@@ -308,6 +323,8 @@ def runs_table(data: ResultsDir, keys: list[str], page: Path) -> str:
         if twin_any:
             mism = sum(disagrees(a) for a in actions)
             row += [
+                placement(r.get("box_pose")) if twin else "-",
+                fmt(r.get("reality")) if twin else "-",
                 fmt(r.get("sim_time_s"), " s", 1),
                 fmt(r.get("peak_true_wrist_force_n"), " N", 1),
                 fmt(mism) if twin else "-",
@@ -316,7 +333,7 @@ def runs_table(data: ResultsDir, keys: list[str], page: Path) -> str:
         rows.append(row)
     head = ["run", "spec", "seed", "solved", "actions", "wall"]
     if twin_any:
-        head += ["sim", "peak F", "disagree"]
+        head += ["placement", "reality", "sim", "peak F", "disagree"]
     head.append("timeline")
     return _table(head, rows, "runs")
 
@@ -335,12 +352,35 @@ def _svg(fig: Any, salt: str) -> str:
     return text[text.index("<svg") :]  # no XML declaration or doctype inside HTML
 
 
+def force_figure(forces: list[tuple[dict[str, Any], float]]) -> Any:
+    """The peak wrist force of each action (all runs, in order) [N], coloured by its sensed outcome, circled where
+    the sensed outcome disagrees with the truth; the actions on integer ticks."""
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
+
+    fig, ax = plt.subplots(figsize=(5, 2.6))
+    for outcome in sorted({str(a.get("outcome")) for a, _ in forces}):
+        pts = [(i, f) for i, (a, f) in enumerate(forces) if str(a.get("outcome")) == outcome]
+        ax.scatter([p[0] for p in pts], [p[1] for p in pts], s=14, label=outcome,
+                   color=OUTCOME_COLOURS.get(outcome, OTHER_COLOUR))  # fmt: skip
+    bad = [(i, f) for i, (a, f) in enumerate(forces) if disagrees(a)]
+    if bad:
+        ax.scatter([p[0] for p in bad], [p[1] for p in bad], s=60, facecolors="none", edgecolors="black",
+                   label="sensed != truth")  # fmt: skip
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))  # actions are counted, never halved
+    ax.set_xlabel("action (all runs, in order)")
+    ax.set_ylabel("peak wrist force [N]")
+    ax.legend(fontsize=7)
+    return fig
+
+
 def figures(data: ResultsDir) -> list[tuple[str, str]]:
     """(caption, inline SVG) of each figure the data allows."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     out = []
     counts = [int(r.get("num_actions", 0)) for _, r in data.runs]
@@ -352,6 +392,7 @@ def figures(data: ResultsDir) -> list[tuple[str, str]]:
         ax.hist([c for c, s in zip(counts, solved, strict=True) if s], bins=bins, color="#2e9d4a", label="solved")
         ax.hist([c for c, s in zip(counts, solved, strict=True) if not s], bins=bins, color="#d1495b",
                 label="unsolved", alpha=0.8)  # fmt: skip
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.set_xlabel("actions per run")
         ax.set_ylabel("runs")
         ax.legend(fontsize=8)
@@ -362,18 +403,7 @@ def figures(data: ResultsDir) -> list[tuple[str, str]]:
     timeline = [a for _, r in data.runs for a in actions_of(r)[0] if actions_of(r)[1]]
     forces = [(a, float(a["peak_force"])) for a in timeline if a.get("peak_force") is not None]
     if forces:
-        fig, ax = plt.subplots(figsize=(5, 2.6))
-        for outcome in sorted({str(a.get("outcome")) for a, _ in forces}):
-            pts = [(i, f) for i, (a, f) in enumerate(forces) if str(a.get("outcome")) == outcome]
-            ax.scatter([p[0] for p in pts], [p[1] for p in pts], s=14, label=outcome,
-                       color=OUTCOME_COLOURS.get(outcome, OTHER_COLOUR))  # fmt: skip
-        bad = [(i, f) for i, (a, f) in enumerate(forces) if disagrees(a)]
-        if bad:
-            ax.scatter([p[0] for p in bad], [p[1] for p in bad], s=60, facecolors="none", edgecolors="black",
-                       label="sensed != truth")  # fmt: skip
-        ax.set_xlabel("action (all runs, in order)")
-        ax.set_ylabel("peak wrist force [N]")
-        ax.legend(fontsize=7)
+        fig = force_figure(forces)
         out.append(("Peak wrist force per action", _svg(fig, "forces")))
     return out
 
@@ -387,7 +417,9 @@ table{border-collapse:collapse;margin:.5em 0}th,td{border:1px solid #ddd;padding
 vertical-align:middle;white-space:nowrap}th{background:#f4f4f4}table.runs td:last-child{width:60%;white-space:normal}
 table.summary td,.ended{white-space:normal}
 .tl{display:flex;height:16px;background:#f7f7f7;border:1px solid #ccc;overflow:hidden;min-width:300px}
-.act{position:relative;display:inline-block;height:100%;box-sizing:border-box;border-right:1px solid #fff}
+.act{position:relative;display:inline-block;height:100%;box-sizing:border-box;border-right:1px solid #fff;
+overflow:hidden}.nm{display:block;color:#fff;font:10px/16px sans-serif;padding-left:2px;white-space:nowrap;
+overflow:hidden;text-overflow:clip}
 .mark,.flag{position:absolute;left:0;right:0;top:0;bottom:0;color:#fff;background:repeating-linear-gradient(45deg,
 #000 0 2px,transparent 2px 5px);font:bold 11px/16px sans-serif;text-align:center}
 .legend>span{display:inline-block;padding:0 6px;margin-right:6px;color:#fff;border-radius:2px}
@@ -410,7 +442,11 @@ def legend() -> str:
     items = [f'<span style="background:{c}">{esc(o)}</span>' for o, c in OUTCOME_COLOURS.items()]
     items.append(f'<span style="background:{OTHER_COLOUR}">other</span>')
     items.append('<span class="sample"><span class="flag">!</span></span> sensed outcome disagrees with the truth')
-    return '<p class="legend">Blocks: one per action, coloured by the sensed outcome: ' + "".join(items) + "</p>"
+    return (
+        '<p class="legend">Blocks: one per action, named by the part it tried, coloured by the sensed outcome: '
+        + "".join(items)
+        + "</p>"
+    )
 
 
 def build_page(data: ResultsDir, page: Path) -> str:

@@ -14,47 +14,56 @@ from typing import Any
 import numpy as np
 
 from puzzlebox.lab.observers import TrialContext, TrialObserver
+from puzzlebox.models.kinds import get_kind
 from puzzlebox.skills import MarkerDetector
 from puzzlebox.twin.rerun_log import TrialRecording
-from puzzlebox.twin.rollout_video import BackgroundRollout, Caption, RolloutFrame, SceneCameras
+from puzzlebox.twin.rollout_video import BackgroundRollout, Caption, Look, RolloutFrame, SceneCameras
 from puzzlebox.twin.session import TwinSession
 
 __all__ = ["RecordingDetector", "RerunRecording", "RolloutVideo", "agent_belief", "scene_cameras"]
 
 
 class RecordingDetector(MarkerDetector):
-    """The pipeline's marker detector, keeping its latest detections per camera for the rollout video (the
-    video shows what the pipeline detected, never detecting again)."""
+    """The pipeline's marker detector, telling its listeners what it detected in every look (the rollout video
+    and the Rerun recording show what the pipeline detected, never detecting again)."""
 
     def __init__(self) -> None:
         super().__init__()
-        self.latest: dict[str, tuple[float, list[tuple[int, np.ndarray]]]] = {}
-        """Camera name -> capture time [s] and detections (marker id, corners [px]) of its latest look."""
         self.listeners: list[Callable[[str, float, list[tuple[int, np.ndarray]]], None]] = []
-        """Called with (camera, capture time, detections) after every look (a Rerun recording's)."""
+        """Called with (camera, capture time [s], detections: marker id and corners [px]) after every look."""
 
     def detect(self, image, camera, T_base_tcp=None):
         found = super().detect(image, camera, T_base_tcp)
         if image is not None:
             seen = [(d.marker_id, d.corners_px.copy()) for d in found]
-            self.latest[image.camera] = (image.time, seen)
             for listener in self.listeners:
                 listener(image.camera, image.time, seen)
         return found
 
 
 def scene_cameras(session: TwinSession) -> SceneCameras:
-    """What the rollout video's views look at in ``session``: its cameras, and its lid for the perspective view."""
-    box = session.spec.box
+    """What the rollout video's views look at in ``session``: its cameras, and its box where it was placed — the
+    shell's corners, each part's footprint on the lid and its handle's top (the views frame them) — and the
+    parts' bodies (the part tried is highlighted)."""
+    spec, scene = session.spec, session.scene
+    box = spec.box
     assert box is not None  # the twin builds puzzle boxes only (models.scene refuses a spec with none)
-    length, width, _ = box.size
-    names, render, lid = session.scene.names, session.config.render, session.scene.T_world_lid[:3, 3]
+    length, width, height = box.size
+    names, render, T = scene.names, session.config.render, scene.T_world_lid
+    in_lid = [[sx * length / 2, sy * width / 2, z] for sx in (-1, 1) for sy in (-1, 1) for z in (0.0, -height)]
+    for c in spec.components:
+        in_lid += [[x, y, 0.0] for x, y in get_kind(c.kind).footprint_in_lid(c.pose[:3])]
+    points = np.asarray(in_lid) @ T[:3, :3].T + T[:3, 3]
+    tops = [session.data.site(names.components[c.name].handle_site).xpos for c in spec.components]
+    lid = T[:3, 3]
     return SceneCameras(
         overview=names.overview_camera,
         wrist=names.wrist_camera,
         lid_centre=(float(lid[0]), float(lid[1]), float(lid[2])),
         lid_diagonal=float(np.hypot(length, width)),
         capture_size=(render.width, render.height),
+        box_points=tuple((float(x), float(y), float(z)) for x, y, z in [*points, *tops]),
+        parts={c.name: names.components[c.name].body for c in spec.components},
     )
 
 
@@ -66,18 +75,35 @@ def agent_belief(agent: Any) -> np.ndarray | None:
 
 class RolloutVideo(TrialObserver):
     """Hands a :class:`~puzzlebox.twin.rollout_video.RolloutFrame` to the background drawer every
-    ``RolloutConfig.period`` of simulated time: the joint positions, the caption of the action under way, the
-    pipeline's latest detections (``detector``) and the recent wrist force the primitives sensed. Drawing happens
-    in the other process."""
+    ``RolloutConfig.period`` of simulated time: the joint positions, the caption of the action under way and the
+    part it tries, the looks the pipeline took since the previous frame (what ``detector`` found, with the state
+    at each capture: the frame draws them on that state, and no later frame draws them) and the recent wrist
+    force the primitives sensed. Drawing happens in the other process."""
 
     def __init__(self, session: TwinSession, rollout: BackgroundRollout, detector: RecordingDetector) -> None:
-        self._session, self._rollout, self._detector = session, rollout, detector
+        self._session, self._rollout = session, rollout
         self._period = rollout.config.period
         self._window = rollout.config.plot_window
         self._next = 0.0
         self._caption = Caption()
+        self._part = ""
+        self._parts = [c.name for c in session.spec.components]
         self._world: Any = None
         self._forces: collections.deque[tuple[float, float]] = collections.deque()
+        self._captured: dict[str, tuple[float, np.ndarray]] = {}
+        """Camera -> time and joint positions of its latest capture."""
+        self._looks: dict[str, Look] = {}
+        """Camera -> its latest look since the last frame."""
+        detector.listeners.append(self._look)
+
+    def sensed(self, what: str, value: Any) -> None:
+        if what.startswith("capture:") and value is not None:
+            self._captured[value.camera] = (value.time, self._session.data.qpos.copy())
+
+    def _look(self, camera: str, time: float, found: list[tuple[int, np.ndarray]]) -> None:
+        captured = self._captured.get(camera)
+        qpos = captured[1] if captured is not None and captured[0] == time else None
+        self._looks[camera] = Look(time, found, qpos)
 
     def attach(self, trial: TrialContext) -> None:
         self._world = trial.world
@@ -94,18 +120,23 @@ class RolloutVideo(TrialObserver):
 
     def action_begins(self, caption: Caption) -> None:
         self._caption = caption
+        # the caption names the part "<spec name> (<kind>)"
+        self._part = next((p for p in self._parts if caption.component.startswith(f"{p} (")), "")
 
-    action_ended = action_begins
+    def action_ended(self, caption: Caption) -> None:
+        self._caption = caption
+        self._part = ""
 
     def finish(self) -> None:
         self._frame(self._session.time)  # the last frame, whatever the time: how the last action ended
 
     def _frame(self, now: float) -> None:
         phase = "surveying" if self._world is None else self._world.toggler.phase
+        looks, self._looks = self._looks, {}  # each look on the first frame after it, and on no other
         self._rollout.add(
             RolloutFrame(
                 time=now, qpos=self._session.data.qpos.copy(), caption=replace(self._caption, phase=phase),
-                detections=dict(self._detector.latest), forces=np.array(self._forces, dtype=float).reshape(-1, 2),
+                looks=looks, forces=np.array(self._forces, dtype=float).reshape(-1, 2), highlight=self._part,
             )
         )  # fmt: skip
 

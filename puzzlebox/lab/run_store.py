@@ -1,5 +1,9 @@
 """A results directory written as it is produced, and resumable.
 
+The directory is owned by one process at a time: the store holds its lock (``DIR/.lock``,
+:class:`~puzzlebox.lab.out_lock.OutputLock`) from before it reads anything there until :meth:`RunStore.close` or the
+process's end, and a second writer is refused (:class:`~puzzlebox.lab.errors.OutputInUse`, naming the holder).
+
 Layout of ``DIR``: ``config.json`` (the experiment's resolved arguments, written first), ``runs/KEY.json``
 (one record per finished run, each written atomically the moment the run ends) and ``results.json``
 (the summary, rewritten from the records every few seconds and at the end, with ``runs_done`` of
@@ -14,11 +18,13 @@ a SIGKILL left (hidden temporaries of records and videos) are removed when the d
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import json
 import shutil
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -30,9 +36,12 @@ from puzzlebox.lab.errors import (
     OutputNotWritable,
     ResumeAndForce,
 )
-from puzzlebox.learning.runner import RecordStore
+from puzzlebox.lab.out_lock import OutputLock
+from puzzlebox.lab.runner import RecordStore
 
 RECORDS = "runs"
+WRITE_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM, errno.EIO, errno.EFBIG}
+"""What a write fails with when the place, not the program, is at fault (full, read-only, failing)."""
 
 
 class RunStore:
@@ -44,10 +53,18 @@ class RunStore:
             raise ResumeAndForce("--resume continues a directory, --force empties it: give one")
         if out.exists() and not out.is_dir():
             raise OutputNotADirectory(f"--out {out} is a file, not a directory")
+        self.lock = OutputLock(out)  # before anything there is read, removed or written
+        try:
+            self._take_up(out, experiment, resume, force)
+        except BaseException:
+            self.lock.release()
+            raise
+
+    def _take_up(self, out: Path, experiment: dict[str, Any], resume: bool, force: bool) -> None:
         self.out, self.experiment = out, experiment
         self.records_dir = out / RECORDS
         self.records = RecordStore(self.records_dir)
-        """Where each finished run's record is kept (``learning.runner``)."""
+        """Where each finished run's record is kept (``puzzlebox.lab.runner``)."""
         config_path = out / "config.json"
         holds = [p for p in (config_path, out / "results.json") if p.exists()] + self._record_paths()
         if holds and not force:
@@ -76,6 +93,16 @@ class RunStore:
         except OSError as err:
             raise OutputNotWritable(f"--out {out}: cannot write there ({err.strerror})") from err
 
+    def close(self) -> None:
+        """Release the directory (another process may take it up); the process's exit does it too."""
+        self.lock.release()
+
+    def __enter__(self) -> RunStore:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
     def _record_paths(self) -> list[Path]:
         return sorted(self.records_dir.glob("*.json")) if self.records_dir.is_dir() else []
 
@@ -83,13 +110,30 @@ class RunStore:
     def _read_config(path: Path) -> dict[str, Any]:
         try:
             config = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, json.JSONDecodeError):
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError):
+            return {}
+        if not isinstance(config, dict):
             return {}
         config.pop("versions", None)
         return config
 
     def write_results(self, results: dict[str, Any]) -> Path:
-        return write_json(self.out / "results.json", results)
+        with self.keeping():
+            return write_json(self.out / "results.json", results)
+
+    @contextlib.contextmanager
+    def keeping(self) -> Iterator[None]:
+        """Turn a failed write (a full disk, a directory made read-only) into one :class:`OutputNotWritable` that
+        says what is kept and how to go on; every record written before is whole (each atomically)."""
+        try:
+            yield
+        except OSError as err:
+            if err.errno not in WRITE_ERRNOS:
+                raise
+            raise OutputNotWritable(
+                f"--out {self.out}: cannot write ({err.strerror or err}); {len(self._record_paths())} finished run(s) "
+                "are kept there: free space (or make it writable) and continue with the same command and --resume"
+            ) from err
 
 
 class Periodic:

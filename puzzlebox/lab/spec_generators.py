@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from puzzlebox.lab.inputs import check_seed
 from puzzlebox.models import PuzzleSpec
 from puzzlebox.models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random
 from puzzlebox.models.kinds import family_named
@@ -27,6 +28,7 @@ def random_settings(components: int, multi_locker: bool, kinds: str) -> dict[str
 def generate_spec(settings: Mapping[str, Any], *, seed: int, name: str | None, anywhere: bool) -> PuzzleSpec:
     """The spec the generator of ``settings`` makes with ``seed`` (named ``name``, else after its settings), where
     the robot reaches every handle unless ``anywhere`` (the default pose, for the symbolic simulator)."""
+    check_seed(seed)
     if settings["generator"] == "random":
         family = family_named(settings["kinds"])
         config = RandomGraphConfig(settings["components"], multi_locker=settings["multi_locker"], family=family)

@@ -29,20 +29,23 @@ import glob
 import json
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, cast
+from typing import Any, TypeGuard, cast
 
 import numpy as np
 
-from puzzlebox.lab.cells import profile_of_calibration
+from puzzlebox.lab.cells import CellError, check_twin_cameras, profile_of_calibration
+from puzzlebox.lab.inputs import MAX_ACTIONS, MAX_COUNT, MAX_TASKS, InputError, check_seed
+from puzzlebox.lab.runner import Task
 from puzzlebox.lab.trial_task import trial_task
 from puzzlebox.learning import AGENT_NAMES
 from puzzlebox.learning.agents.factory import BELIEF_AGENT_NAMES
 from puzzlebox.learning.dual_controller import DualControllerConfig
 from puzzlebox.learning.errors import ConfigError
-from puzzlebox.learning.runner import Task
 from puzzlebox.models import PuzzleSpec, load_spec
 from puzzlebox.models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random
+from puzzlebox.models.json_input import JsonInputError, finite, read_json
 from puzzlebox.models.kinds import KindFamily, UnknownFamilyError, family_named
+from puzzlebox.models.names import name_slug
 from puzzlebox.models.spec import file_precision
 
 KEYS = {"sim", "specs", "generate", "placements", "placement_seed", "seeds", "agents", "profiles", "calibrations",
@@ -50,6 +53,11 @@ KEYS = {"sim", "specs", "generate", "placements", "placement_seed", "seeds", "ag
 
 
 AGENT_KEYS = {"name", "memory", "checkpoint", "label", "max_lockers"}
+
+MAX_PLACEMENTS = 1000
+"""Most placements per spec."""
+MAX_COMPONENTS = 64
+"""Most components of a generated box (the reach allows 28)."""
 
 
 class SweepError(ValueError):
@@ -73,9 +81,11 @@ class Cell:
 
 
 def load_sweep(path: Path) -> dict[str, Any]:
+    """Read and check a sweep file in full before any work: every key's type, range and finiteness, and the
+    grid's size (:data:`~puzzlebox.lab.inputs.MAX_TASKS` trials at most); :class:`SweepError` names the key."""
     try:
-        sweep = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        sweep = read_json(path)
+    except JsonInputError as err:
         raise SweepError(f"cannot read sweep {path}: {err}") from None
     if not isinstance(sweep, dict):
         raise SweepError(f"sweep {path}: must be a JSON object with keys {sorted(KEYS)}")
@@ -88,9 +98,132 @@ def load_sweep(path: Path) -> dict[str, Any]:
         raise SweepError(f"sweep {path}: give 'specs' (globs) or 'generate' (a recipe), one of them")
     if sweep["sim"] == "symbolic" and any(k in sweep for k in ("placements", "profiles", "calibrations")):
         raise SweepError(f"sweep {path}: placements, profiles and calibrations need 'sim': 'twin'")
-    if not isinstance(sweep.get("max_actions"), int) or sweep["max_actions"] < 1:
-        raise SweepError(f"sweep {path}: 'max_actions' must be an integer >= 1")
+    if not _integer(sweep.get("max_actions")) or not 1 <= sweep["max_actions"] <= MAX_ACTIONS:
+        raise SweepError(f"sweep {path}: 'max_actions' must be an integer >= 1 and <= {MAX_ACTIONS}")
+    try:
+        _check_types(sweep)
+    except SweepError as err:
+        raise SweepError(f"sweep {path}: {err}") from None
     return sweep
+
+
+def _integer(value: object) -> TypeGuard[int]:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _strings(value: object, key: str, *, allow_empty: bool = False) -> list[str]:
+    """``value`` is a list of non-empty strings (non-empty unless ``allow_empty``)."""
+    if isinstance(value, str):
+        raise SweepError(f"'{key}' must be a list, got the string {value!r} (write [{json.dumps(value)}])")
+    if not isinstance(value, list) or not all(isinstance(v, str) and v for v in value):
+        raise SweepError(f"'{key}' must be a list of non-empty strings, got {_shown(value)}")
+    if not value and not allow_empty:
+        raise SweepError(f"'{key}' must name at least one, got []")
+    return value
+
+
+def _shown(value: object) -> str:
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _check_types(sweep: dict[str, Any]) -> None:
+    """Every key's type and range (the grid itself is checked by :func:`grid`)."""
+    if "name" in sweep and not isinstance(sweep["name"], str):
+        raise SweepError(f"'name' must be a string, got {_shown(sweep['name'])}")
+    if "specs" in sweep:
+        _strings(sweep["specs"], "specs")
+    if "generate" in sweep:
+        _check_recipe(sweep["generate"])
+    placements = sweep.get("placements")
+    if placements is not None:
+        if _integer(placements):
+            if not 1 <= placements <= MAX_PLACEMENTS:
+                raise SweepError(f"'placements' must be >= 1 and <= {MAX_PLACEMENTS}, got {placements}")
+        elif not (isinstance(placements, list) and placements and len(placements) <= MAX_PLACEMENTS and all(
+                isinstance(p, list) and len(p) == 3 and all(finite(v) for v in p) for p in placements)):  # fmt: skip
+            raise SweepError(
+                f"'placements' must be a count or a non-empty list of [x, y, yaw] finite numbers, got "
+                f"{_shown(placements)}"
+            )
+    if "placement_seed" in sweep:
+        _seed(sweep["placement_seed"], "'placement_seed'")
+    seeds = sweep.get("seeds", {"start": 0, "count": 1})
+    if isinstance(seeds, dict):
+        if set(seeds) - {"start", "count"}:
+            raise SweepError(f"'seeds' takes 'start' and 'count', got {sorted(seeds)}")
+        count = seeds.get("count", 1)
+        if not _integer(count) or not 1 <= count <= MAX_TASKS:
+            raise SweepError(f"'seeds': 'count' must be an integer >= 1 and <= {MAX_TASKS}, got {_shown(count)}")
+        _seed(seeds.get("start", 0), "'seeds': 'start'", count)
+    elif isinstance(seeds, list) and seeds and len(seeds) <= MAX_TASKS:
+        for seed in seeds:
+            _seed(seed, "'seeds'")
+    else:
+        raise SweepError(f"'seeds' must be non-negative integers, got {_shown(seeds)}")
+    agents = sweep.get("agents", ["memory"])
+    if not isinstance(agents, list) or not agents:
+        raise SweepError(f"'agents' must be a non-empty list of names or objects, got {_shown(agents)}")
+    for entry in agents:
+        if isinstance(entry, str):
+            continue
+        if not isinstance(entry, dict):
+            raise SweepError(f"'agents': each is a name or an object with 'name', got {_shown(entry)}")
+        for key in ("name", "memory", "checkpoint", "label"):
+            if key in entry and not (isinstance(entry[key], str) and (entry[key] or key != "name")):
+                raise SweepError(f"'agents': '{key}' must be a string, got {_shown(entry[key])}")
+        if "max_lockers" in entry and not _integer(entry["max_lockers"]):
+            raise SweepError(f"'agents': 'max_lockers' must be an integer, got {_shown(entry['max_lockers'])}")
+    if "profiles" in sweep:
+        profiles = _strings(sweep["profiles"], "profiles")
+        if len(set(profiles)) != len(profiles):
+            raise SweepError(f"'profiles' must be distinct, got {profiles}")
+    calibrations = sweep.get("calibrations", {})
+    if not isinstance(calibrations, dict) or not all(isinstance(v, str) and v for v in calibrations.values()):
+        raise SweepError(f"'calibrations' must map profile names to files, got {_shown(calibrations)}")
+    others = sorted(set(calibrations) - set(sweep.get("profiles", ["ideal"])))
+    if others:
+        raise SweepError(f"'calibrations' names profile(s) {others} the sweep does not run")
+
+
+def _seed(value: object, key: str, count: int = 1) -> None:
+    try:
+        check_seed(value, key, count)
+    except InputError as err:
+        raise SweepError(str(err)) from None
+
+
+RECIPE_KEYS = {"generator", "components", "multi_locker", "seed", "count", "kinds", "anywhere"}
+
+
+def _check_recipe(recipe: object) -> None:
+    if not isinstance(recipe, dict):
+        raise SweepError(f"'generate' must be an object (a recipe), got {_shown(recipe)}")
+    unknown = sorted(set(recipe) - RECIPE_KEYS)
+    if unknown:
+        raise SweepError(f"'generate': unknown key(s) {unknown}; known: {sorted(RECIPE_KEYS)}")
+    count = recipe.get("count", 1)
+    if not _integer(count) or not 1 <= count <= MAX_COUNT:
+        raise SweepError(f"'generate': 'count' must be an integer >= 1 and <= {MAX_COUNT}, got {_shown(count)}")
+    _seed(recipe.get("seed", 0), "'generate': 'seed'", count)
+    for key in ("multi_locker", "anywhere"):
+        if key in recipe and not isinstance(recipe[key], bool):
+            raise SweepError(f"'generate': '{key}' must be true or false, got {_shown(recipe[key])}")
+    if recipe.get("generator") == "random":
+        components = recipe.get("components")
+        if not _integer(components) or not 2 <= components <= MAX_COMPONENTS:
+            raise SweepError(
+                f"'generate': 'components' must be an integer >= 2 and <= {MAX_COMPONENTS}, got {_shown(components)}"
+            )
+        if "kinds" in recipe and not isinstance(recipe["kinds"], str):
+            kinds = _shown(recipe["kinds"])
+            raise SweepError(f"'generate': 'kinds' of a random recipe is 'paper' or 'all', got {kinds}")
+    elif recipe.get("generator") == "chain":
+        _strings(recipe.get("kinds"), "generate': 'kinds")
+        if len(recipe["kinds"]) > MAX_COMPONENTS:
+            raise SweepError(f"'generate': a chain has at most {MAX_COMPONENTS} kinds, got {len(recipe['kinds'])}")
+    else:
+        raise SweepError(f"'generate': 'generator' must be 'random' or 'chain', got {_shown(recipe.get('generator'))}")
 
 
 def _specs(sweep: dict[str, Any], base: Path) -> list[PuzzleSpec]:
@@ -181,13 +314,25 @@ def _placements(sweep: dict[str, Any], spec: PuzzleSpec) -> list[tuple[float, fl
     return [cast("tuple[float, float, float]", file_precision(tuple(float(v) for v in pose))) for pose in chosen]
 
 
+def _check_size(planned: int) -> None:
+    if planned > MAX_TASKS:
+        raise SweepError(f"the grid has {planned} trials; at most {MAX_TASKS} in one sweep (split it)")
+
+
 def grid(sweep: dict[str, Any], base: Path) -> tuple[list[Task], dict[str, Cell]]:
     """Every task of the sweep and the cell each belongs to (by task key)."""
     from puzzlebox.models.placement import placed
 
-    specs, seeds, agents = _specs(sweep, base), _seeds(sweep), _agents(sweep, base)
+    seeds, agents = _seeds(sweep), _agents(sweep, base)
     twin = sweep["sim"] == "twin"
     profiles = sweep.get("profiles", ["ideal"]) if twin else ["-"]
+    chosen = sweep.get("placements") if twin else None
+    placements = 1 if chosen is None else chosen if isinstance(chosen, int) else len(chosen)
+    per_spec = placements * len(agents) * len(profiles) * len(seeds)
+    if "generate" in sweep:  # before generating the specs
+        _check_size(sweep["generate"].get("count", 1) * per_spec)
+    specs = _specs(sweep, base)
+    _check_size(len(specs) * per_spec)
     realities, calibrations = {}, {}
     if twin:
         from puzzlebox.models.calibration import CellCalibration
@@ -197,6 +342,11 @@ def grid(sweep: dict[str, Any], base: Path) -> tuple[list[Task], dict[str, Cell]
             realities[name] = load_profile(name if name in PRESETS else base / name)
             file = sweep.get("calibrations", {}).get(name)
             calibrations[name] = CellCalibration.load(base / file) if file else None
+            if calibrations[name] is not None:
+                try:  # the twin's cameras, checked before any trial (else every trial fails on it)
+                    check_twin_cameras(calibrations[name], f"'calibrations': {file}")
+                except CellError as err:
+                    raise SweepError(str(err)) from None
             realities[name] = profile_of_calibration(realities[name], calibrations[name])  # the file's cell
     tasks, cells = [], {}
     for i, spec in enumerate(specs):
@@ -213,8 +363,10 @@ def grid(sweep: dict[str, Any], base: Path) -> tuple[list[Task], dict[str, Cell]
                         assert reality is not None  # a calibration is only loaded for a twin profile, as its reality
                         calibration.check_cell(reality.name, reality.cell_seed, spec.box.size[2], spec=spec.name)
                     cell = Cell(spec.name, None if pose is None else p, pose, agent["label"], profile)
+                    where = "-" if profile == "-" else name_slug(profile)  # "-": no profile (symbolic)
+                    slugs = f"{name_slug(spec.name)}-p{p}-{name_slug(agent['label'])}-{where}"
                     for seed in seeds:
-                        key = f"{i:03d}-{spec.name}-p{p}-{agent['label']}-{profile}-seed{seed}"
+                        key = f"{i:03d}-{slugs}-seed{seed}"
                         tasks.append(trial_task(
                             key, box, seed, sim=sweep["sim"], agent=agent["name"], max_actions=sweep["max_actions"],
                             memory=agent.get("memory"), checkpoint=agent.get("checkpoint"),

@@ -18,7 +18,7 @@ The replay is given the robot's timing (command latency, the F/T sensor's rate a
 friction at the grip force set) from the datasheets (REALITY_NOTES.md Presets: the numbers the ``realistic``
 profile uses too): properties of the robot, not of the box, and not identified here.
 
-Everything is a task of ``learning.runner`` (``--workers K``): calibrations, recorded trials, fits (one per cell
+Everything is a task of ``puzzlebox.lab.runner`` (``--workers K``): calibrations, recorded trials, fits (one per cell
 and kind) and evaluations (one per cell); each record is written atomically as it ends (``DIR/records/``), with
 a progress bar per stage on a terminal, and the same command resumes, reusing them (Ctrl-C keeps what finished).
 The summary is ``DIR/sysid.{json,md,png}``.
@@ -37,8 +37,8 @@ import numpy as np
 
 from puzzlebox.lab.cli import write_json
 from puzzlebox.lab.reality_sweep import calibration_task
+from puzzlebox.lab.runner import RecordStore, Task, make_executor, run_tasks
 from puzzlebox.learning import make_agent, run_episode
-from puzzlebox.learning.runner import RecordStore, Task, make_executor, run_tasks
 from puzzlebox.models.calibration import CellCalibration
 from puzzlebox.models.generator import paper_family
 from puzzlebox.models.kinds import KIND_NAMES

@@ -2,7 +2,7 @@
 the training specs, the memory agent's controller (``--max-lockers``), the twin's episode runner
 (``--sim twin``: reality profile and calibration, the calibration checked against the cell) and that an output
 file can be written. Each mistake is a :class:`TrainingSetupError` or :class:`OutputFileError` whose message
-names the flag."""
+names the flag; an output file is owned by one trainer at a time (:func:`hold_output_file`)."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 from puzzlebox.lab.cells import CellError, load_cell
 from puzzlebox.lab.errors import OutputFileError, TrainingSetupError
+from puzzlebox.lab.out_lock import OutputLock
 from puzzlebox.learning.dual_controller import DualControllerConfig
 from puzzlebox.learning.errors import LearningError
 from puzzlebox.models import PuzzleSpec, SpecError, load_spec
@@ -57,6 +58,13 @@ def twin_training_for(
     except CellError as err:
         raise TrainingSetupError(str(err)) from err
     return TwinTraining(profile, cell)
+
+
+def hold_output_file(path: Path, flag: str) -> OutputLock:
+    """Own the output file ``path`` (given as ``flag``) for the training: refused now if it cannot be written or
+    another process writes it (:class:`OutputInUse` naming it); released by the lock or the process's end."""
+    check_writable(path, flag)
+    return OutputLock(path, directory=False, what=flag)
 
 
 def check_writable(path: Path, flag: str) -> None:

@@ -12,16 +12,18 @@ from typing import Any
 from tqdm import tqdm
 
 from puzzlebox.lab import trial_task
+from puzzlebox.lab.inputs import MAX_ACTIONS, MAX_TASKS, MAX_WORKERS, InputError, check_count, check_seed
 from puzzlebox.lab.interrupt import StopRequests
 from puzzlebox.lab.run_store import Periodic, RunStore
+from puzzlebox.lab.runner import Executor, InlineExecutor, RunReport, run_tasks
 from puzzlebox.lab.trial_figures import twin_figures
 from puzzlebox.learning import summarise
-from puzzlebox.learning.runner import Executor, InlineExecutor, RunReport, run_tasks
 from puzzlebox.models import PuzzleSpec
 from puzzlebox.models.calibration import CellCalibration
+from puzzlebox.models.names import name_slug
 from puzzlebox.twin.reality import RealityProfile
 
-__all__ = ["TrialBatch", "batch_results", "run_batch", "summary_lines"]
+__all__ = ["InputError", "TrialBatch", "batch_results", "check_batch_numbers", "run_batch", "summary_lines"]
 
 
 @dataclass(frozen=True)
@@ -49,20 +51,22 @@ class TrialBatch:
     locks: str = "contact"
 
     def tasks(self, out: Path) -> list:
-        """One runner task per spec and seed, keyed ``<spec index>-<spec>-seed<seed>``."""
+        """One runner task per spec and seed, keyed ``<spec index>-<spec slug>-seed<seed>`` (the slug of a name:
+        :func:`~puzzlebox.models.names.name_slug`; so are the video and recording files named)."""
         tasks = []
         single = len(self.specs) * self.runs == 1
         for i, spec in enumerate(self.specs):
+            slug = name_slug(spec.name)
             for r in range(self.runs):
                 seed = self.seed + r
                 video = record = None
                 if self.video:
-                    video = str((out / ("rollout.mp4" if single else f"rollout-{spec.name}-s{seed}.mp4")).resolve())
+                    video = str((out / ("rollout.mp4" if single else f"rollout-{slug}-s{seed}.mp4")).resolve())
                 if self.record:
                     path = Path(self.record)
-                    record = str(path.resolve() if single else path.with_name(f"{path.stem}-{spec.name}-s{seed}.rrd"))
+                    record = str(path.resolve() if single else path.with_name(f"{path.stem}-{slug}-s{seed}.rrd"))
                 tasks.append(trial_task.trial_task(
-                    f"{i:03d}-{spec.name}-seed{seed}", spec, seed, sim=self.sim, agent=self.agent,
+                    f"{i:03d}-{slug}-seed{seed}", spec, seed, sim=self.sim, agent=self.agent,
                     max_actions=self.max_actions, memory=self.memory, checkpoint=self.checkpoint,
                     reality=self.reality.to_dict() if self.reality is not None else None,
                     calibration=self.calibration.to_dict() if self.calibration is not None else None, video=video,
@@ -70,6 +74,17 @@ class TrialBatch:
                     locks=self.locks,
                 ))  # fmt: skip
         return tasks
+
+
+def check_batch_numbers(specs: int, runs: int, seed: int, max_actions: int, workers: int | None = None) -> None:
+    """``trial.py``'s numbers, before any work: ``runs`` per spec (``specs`` x ``runs`` trials at most
+    :data:`~puzzlebox.lab.inputs.MAX_TASKS`), seeds ``seed``..``seed + runs - 1``, the action budget and the worker
+    count each in its range (:class:`~puzzlebox.lab.inputs.InputError` naming the flag)."""
+    check_count(runs, "--runs", MAX_TASKS // max(specs, 1))
+    check_count(max_actions, "--max-actions", MAX_ACTIONS)
+    check_seed(seed, "--seed", runs)
+    if workers is not None:
+        check_count(workers, "--workers", MAX_WORKERS)
 
 
 def batch_results(runs: Sequence[dict[str, Any]], batch: TrialBatch, planned: int) -> dict[str, Any]:
@@ -118,7 +133,7 @@ def run_batch(batch: TrialBatch, store: RunStore, executor: Executor) -> tuple[R
     def solved(records: dict[str, dict]) -> str:
         return f"solved {sum(r['solved'] for r in records.values())}/{len(records)}"
 
-    with StopRequests("run") as stop, executor:
+    with store.keeping(), StopRequests("run") as stop, executor:  # a full disk: one line, what is kept
         inner = isinstance(executor, InlineExecutor)  # per-action bars only where the trial runs here
         trial_task.set_action_hook(_ActionBar(batch.max_actions) if inner else None)
         report = run_tasks(tasks, store.records, executor, stop=lambda: stop.requested, on_record=keep,

@@ -3,12 +3,18 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 from puzzlebox.learning import ActionRecord, RunResult
 
 __all__ = ["TrialRecord"]
+
+_OPTIONAL = (
+    "sim_time_s", "perceived_position_error_m", "box_pose", "reality", "peak_true_wrist_force_n",
+    "peak_true_wrist_force_during", "sensed_sha256", "told_kinds", "found_kinds", "timeline", "robot_time_s", "stopped",
+    "perceived_closed_poses",
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -31,7 +37,12 @@ class TrialRecord:
         peak_true_wrist_force_during: what the arm was doing then.
         sensed_sha256: SHA-256 over everything the pipeline sensed, in order (the trial's fingerprint).
         told_kinds: component -> the kind the pipeline was told, when one was told wrong.
-        timeline: per try, what was sensed and the simulator's truth, the F/T peak, times (twin).
+        found_kinds: component -> the kind that moved it, where the world found a part's kind other than it was told
+            (``skills.robot_world``; given with ``told_kinds``, and whenever one was found).
+        timeline: per try, what was sensed (and in the twin the simulator's truth), the F/T peak, times.
+        robot_time_s: the arm's own clock over the trial [s] (real cell).
+        stopped: why the arm's safety limits stopped the trial, else empty (real cell).
+        perceived_closed_poses: per component, its closed pose as the survey perceived it (real cell).
     """
 
     spec: str
@@ -49,7 +60,11 @@ class TrialRecord:
     peak_true_wrist_force_during: str | None = None
     sensed_sha256: str | None = None
     told_kinds: dict[str, str] | None = None
+    found_kinds: dict[str, str] | None = None
     timeline: tuple[dict[str, Any], ...] | None = field(default=None, repr=False)
+    robot_time_s: float | None = None
+    stopped: str | None = None
+    perceived_closed_poses: dict[str, list[float]] | None = field(default=None, repr=False)
 
     @classmethod
     def of_run(cls, result: RunResult, **twin: Any) -> TrialRecord:
@@ -59,10 +74,24 @@ class TrialRecord:
         return cls(result.spec, result.seed, result.solved, result.num_actions, actions=tuple(result.actions),
                    ended=result.ended, **fields)  # fmt: skip
 
+    @classmethod
+    def from_dict(cls, entry: dict[str, Any]) -> TrialRecord:
+        """The record of a run entry (:meth:`to_dict`'s layout: a ``results.json`` ``runs[]`` entry or a
+        ``DIR/runs/<key>.json`` record) of a symbolic, twin or real trial; ``from_dict(r.to_dict()) == r``."""
+        known = {f.name for f in fields(ActionRecord)}
+        actions = tuple(ActionRecord(**{k: v for k, v in a.items() if k in known}) for a in entry.get("actions", ()))
+        extra = {k: entry[k] for k in _OPTIONAL if k in entry}
+        if "box_pose" in extra:
+            extra["box_pose"] = tuple(extra["box_pose"])
+        if "timeline" in extra:
+            extra["timeline"] = tuple(dict(a) for a in extra["timeline"])
+        return cls(entry["spec"], entry["seed"], entry["solved"], entry["num_actions"], entry["wall_time_s"],
+                   actions=actions, ended=entry.get("ended", ""), **extra)  # fmt: skip
+
     @property
     def outcome_agreement(self) -> float | None:
-        """Fraction of tries whose sensed outcome (moved or not) agrees with the simulator's truth (twin)."""
-        if self.timeline is None:
+        """Fraction of tries whose sensed outcome (moved or not) agrees with the simulator's truth (twin only)."""
+        if self.timeline is None or self.robot_time_s is not None:  # a real cell has no truth to agree with
             return None
         return sum(a["moved"] == a["true_moved"] for a in self.timeline) / max(len(self.timeline), 1)
 
@@ -75,6 +104,13 @@ class TrialRecord:
                         for a in self.actions],
             "ended": self.ended,
         }  # fmt: skip
+        if self.robot_time_s is not None:  # a real cell: what was sensed, no simulator
+            return out | {
+                "robot_time_s": self.robot_time_s,
+                "stopped": self.stopped,
+                "perceived_closed_poses": dict(self.perceived_closed_poses or {}),
+                "timeline": [dict(a) for a in self.timeline or ()],
+            }
         if self.sim_time_s is None:
             return out
         out |= {
@@ -88,5 +124,7 @@ class TrialRecord:
         }
         if self.told_kinds is not None:
             out["told_kinds"] = dict(self.told_kinds)
+        if self.found_kinds is not None:
+            out["found_kinds"] = dict(self.found_kinds)
         out["timeline"] = [dict(a) for a in self.timeline or ()]
         return out

@@ -1,4 +1,4 @@
-"""One trial as a runner task (``learning.runner.Task``): a pure function of JSON settings — the spec, the
+"""One trial as a runner task (``puzzlebox.lab.runner.Task``): a pure function of JSON settings — the spec, the
 seed, the agent and what it learned (memory or checkpoint, by path and content hash), the simulator, the
 reality profile and calibration, the budget — returning the contract's run entry. The same settings give
 the same record in-process, in a worker pool, on Ray and after a resume (wall times aside).
@@ -14,10 +14,10 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from puzzlebox.lab.agent_class import is_agent_class_name, make_agent_object
+from puzzlebox.lab.runner import Task
 from puzzlebox.lab.trial_config import TrialConfig
 from puzzlebox.lab.trials import run_trial as run_trial_of
 from puzzlebox.learning.memory import MemoryStore
-from puzzlebox.learning.runner import Task
 from puzzlebox.models import PuzzleSpec
 from puzzlebox.models.spec_loading import spec_from_dict
 

@@ -1,13 +1,15 @@
-"""Run a trial from Python: :func:`run_trial` (the agent acts until solved or out of actions; a record comes back)
-and :func:`open_world` (the world, for one's own loop)."""
+"""Run a trial from Python: :func:`run_trial` (the agent acts until solved or out of actions, in the symbolic
+simulator, the twin or a real cell; a record comes back) and :func:`open_world` (the world, for one's own loop)."""
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
+from puzzlebox.lab.cells import RealCell, TwinCell
 from puzzlebox.lab.errors import TrialConfigError
 from puzzlebox.lab.observers import TrialContext, TrialObserver
 from puzzlebox.lab.trial_config import TrialConfig
@@ -29,6 +31,8 @@ def run_trial(
     video: str | Path | None = None,
     recording: str | Path | None = None,
     on_action: Callable[[Any], None] | None = None,
+    cell: TwinCell | RealCell | None = None,
+    on_record: Callable[[dict[str, Any]], None] | None = None,
 ) -> TrialRecord:
     """One trial of ``agent`` on ``spec`` under ``config`` (default :class:`TrialConfig`: the twin, ``ideal``).
 
@@ -37,10 +41,37 @@ def run_trial(
     ``observers`` see every reading, wait and action of a twin trial (:mod:`puzzlebox.lab.observers`) without
     changing it. ``video`` (MP4) and ``recording`` (Rerun ``.rrd``) are written there, twin only.
     ``on_action`` is called after every try with its :class:`~puzzlebox.learning.ActionRecord`.
-    Raises :class:`~puzzlebox.lab.errors.TrialConfigError` for outputs a symbolic trial cannot make."""
+    ``cell``: where the trial runs — a :class:`~puzzlebox.lab.cells.TwinCell` (its profile and calibration
+    replace ``config.reality`` and ``config.calibration``) or a :class:`~puzzlebox.lab.cells.RealCell` (the arm
+    in front of the box ``spec`` describes; the record holds only what was sensed, plus ``robot_time_s`` and
+    ``stopped`` when the arm's safety limits stopped it). ``on_record`` is called with the record so far (its
+    ``to_dict()``) after every try of a real trial and once at the end of any trial: write it as it grows.
+    Raises :class:`~puzzlebox.lab.errors.TrialConfigError` for outputs or faults the chosen cell cannot make."""
     config = config or TrialConfig()
     if memory is None and agent is None and config.memory is not None:
         memory = MemoryStore.open_existing(config.memory)
+    if isinstance(cell, RealCell):
+        return _run_real(spec, config, cell, agent, memory, observers, video, recording, on_action, on_record)
+    if isinstance(cell, TwinCell):
+        if config.sim != "twin":
+            raise TrialConfigError("a TwinCell is the twin's: TrialConfig(sim='twin')")
+        config = dataclasses.replace(config, reality=cell.profile, calibration=cell.calibration)
+    record = _run_sim(spec, config, agent, memory, observers, video, recording, on_action)
+    if on_record is not None:
+        on_record(record.to_dict())
+    return record
+
+
+def _run_sim(
+    spec: PuzzleSpec,
+    config: TrialConfig,
+    agent: Agent | None,
+    memory: MemoryStore | None,
+    observers: Sequence[TrialObserver],
+    video: str | Path | None,
+    recording: str | Path | None,
+    on_action: Callable[[Any], None] | None,
+) -> TrialRecord:
     if config.sim == "twin":
         from puzzlebox.lab.twin_trial import run_twin_trial  # MuJoCo and rendering only when asked
 
@@ -59,6 +90,36 @@ def run_trial(
     for observer in observers:
         observer.finish()
     return TrialRecord.of_run(result)
+
+
+def _run_real(
+    spec: PuzzleSpec,
+    config: TrialConfig,
+    cell: RealCell,
+    agent: Agent | None,
+    memory: MemoryStore | None,
+    observers: Sequence[TrialObserver],
+    video: str | Path | None,
+    recording: str | Path | None,
+    on_action: Callable[[Any], None] | None,
+    on_record: Callable[[dict[str, Any]], None] | None,
+) -> TrialRecord:
+    problems = [
+        *(["a real cell is not simulated: TrialConfig(sim='twin'), the default"] if config.sim != "twin" else []),
+        *(["a video or a recording is of a twin trial"] if video is not None or recording is not None else []),
+        *(["misreport_kind is a twin fault"] if config.misreport_kind else []),
+    ]
+    if problems:
+        raise TrialConfigError("; ".join(problems))
+    from puzzlebox.lab.real_trial import run_real_trial  # the motion primitives only when a real trial is asked
+
+    entry = run_real_trial(
+        cell.robot, cell.calibration, spec, cell.config, config.agent, config.seed, config.max_actions,
+        memory=memory, checkpoint=None if config.checkpoint is None else str(config.checkpoint),
+        on_action=on_action, on_record=on_record, primitives=cell.primitives, max_lockers=config.max_lockers,
+        agent=agent, observers=observers,
+    )  # fmt: skip
+    return TrialRecord.from_dict(entry)
 
 
 @contextlib.contextmanager

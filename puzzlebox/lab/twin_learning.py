@@ -16,7 +16,7 @@ protocols' 650 episodes on the 9 training variants, one network per training see
 the paper's robot figures for them are 5.4 and 21.2 actions. The cell is calibrated from ChArUco
 images first (``lab.calibration_run``); training stores only what the robot sensed (``lab.twin_training``).
 
-Everything is a task of ``learning.runner`` (``--workers K``, or Ray): one training chain per start and
+Everything is a task of ``puzzlebox.lab.runner`` (``--workers K``, or Ray): one training chain per start and
 seed (its memory file grows episode by episode in ``DIR/memories/``, and a copy of it is taken at each
 checkpoint, atomically: a chain killed part-way resumes from its file and its copies), then one trial per
 start, seed, checkpoint, test box and placement (``DIR/trials/``). The same command resumes. The summary
@@ -37,14 +37,16 @@ from pathlib import Path
 from typing import Any, cast
 
 from puzzlebox.lab.cli import write_json
+from puzzlebox.lab.deep_protocols_run import job_task
 from puzzlebox.lab.reality_sweep import calibration_task
+from puzzlebox.lab.runner import RecordStore, Task, make_executor, run_tasks
 from puzzlebox.lab.trial_task import trial_task
 from puzzlebox.lab.twin_training import TwinTraining
 from puzzlebox.learning import MemoryAgent, SymbolicWorld, run_episode, summarise
-from puzzlebox.learning.experiments.deep_protocols import TrainingJob, job_key, job_task
+from puzzlebox.learning.experiments.deep_protocols import TrainingJob, job_key
 from puzzlebox.learning.experiments.protocol import ProtocolConfig
 from puzzlebox.learning.memory import MemoryStore
-from puzzlebox.learning.runner import RecordStore, Task, make_executor, run_tasks
+from puzzlebox.models.atomic import apply_umask
 from puzzlebox.models.calibration import CellCalibration
 from puzzlebox.models.generator import TRAIN_INDICES, paper_family
 from puzzlebox.twin.reality import RealityProfile, load_profile
@@ -105,6 +107,7 @@ def _snapshot(store_path: Path, target: Path) -> None:
     try:
         with sqlite3.connect(store_path) as source, sqlite3.connect(name) as copy:
             source.backup(copy)
+        apply_umask(name)  # mkstemp made it private; the snapshot is not
         os.replace(name, target)
     finally:
         if os.path.exists(name):

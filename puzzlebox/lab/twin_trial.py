@@ -168,6 +168,7 @@ def run_twin_trial(
         box_pose = tuple(session.box_pose)
         reality = session.reality.name
     by_marker = {c.marker: i for i, c in enumerate(spec.components)}
+    found = {spec.components[by_marker[m]].name: kind for m, kind in (world.found_kinds if world else {}).items()}
     timeline = tuple(
         {**asdict(a), "component": spec.components[by_marker[a.marker]].name,
          "pose_error_m": pose_errors.get(spec.components[by_marker[a.marker]].name)}
@@ -184,5 +185,6 @@ def run_twin_trial(
         peak_true_wrist_force_during=peak.peak_during,
         sensed_sha256=digest.hexdigest(),
         told_kinds=told_kinds if config.misreport_kind else None,
+        found_kinds=found if found or config.misreport_kind else None,
         timeline=timeline,
     )

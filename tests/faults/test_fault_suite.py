@@ -4,10 +4,15 @@ Where each fault class of issue 11 is tested:
 - a trial SIGKILLed / SIGTERMed and resumed; an output of another configuration; CLI mistakes:
   ``tests/scripts/test_trial_cli.py``, ``tests/scripts/test_generate_cli.py``;
 - concurrent trainers on one memory, a memory truncated or read-only: ``tests/learning/test_memory_log.py``;
-- a task that raises, a pool worker that dies: ``tests/learning/test_runner.py`` and here (a real worker of a
+- a task that raises, a pool worker that dies: ``tests/lab/test_runner.py`` and here (a real worker of a
   real ``trial.py``);
 - physics that diverges, a video killed in mid-write: here;
 - the twin's faults (frames dropped, F/T noise, jams, slips): ``tests/skills/test_robustness.py`` and the suite.
+
+And those of issue 37: two writers into one ``--out``: ``tests/lab/test_out_lock.py`` and the suite; names of every
+kind: ``tests/scripts/test_spec_names.py``; malformed inputs and a full disk: ``tests/scripts/test_input_checks.py``;
+crafted memories: ``tests/learning/test_memory_schema.py``; ``experiment.py`` stopped by a signal:
+``tests/scripts/test_experiment_signals.py``.
 """
 
 from __future__ import annotations
@@ -44,14 +49,18 @@ def test_the_quick_fault_suite_detects_survives_and_keeps_every_case(tmp_path):
     result = python(ROOT / "scripts/experiment.py", "faults", "--out", out, "--quick")
     assert result.returncode == 0, result.stderr
     rows = {r["fault"]: r for r in json.loads((out / "faults.json").read_text())["rows"]}
-    assert len(rows) == 9  # 7 classes of the tools + the quick suite's 2 twin faults
+    assert len(rows) == 14  # 7 classes of the tools + the quick suite's 2 twin faults + issue 37's 5 (quick)
     for row in rows.values():
         for figure in (row["detected"], row["survived"], row["data_kept"]):
             for done, of in re.findall(r"(\d+)/(\d+)", figure):
                 assert done == of, row
     assert "0 runs lost, 0 duplicated" in rows["trial.py killed (SIGKILL) and resumed"]["data_kept"]
     assert "0 runs lost, 0 duplicated" in rows["a trial.py pool worker killed (SIGKILL)"]["data_kept"]
-    assert (out / "faults.md").read_text().count("\n| ") == 10  # header + 9 rows
+    assert (out / "faults.md").read_text().count("\n| ") == 15  # header + 14 rows
+    for kind in ("trial", "sweep"):
+        race = rows[f"two {kind}.py into one --out, started together"]
+        assert race["data_kept"] == "0 summaries lost" and race["detected"].startswith("2/2 second writers refused")
+    assert rows["memory with a trigger, a view, an extra table"]["detected"] == "3/3 refused in one line (exit 2)"
     blank = rows["twin: camera: every frame dropped"]
     assert blank["detected"].startswith("ended: MarkersNotFound") and blank["data_kept"] == "1/1 run recorded"
     bad = python(ROOT / "scripts/experiment.py", "faults", "--out", out, "--runs", "1")
@@ -85,9 +94,10 @@ def test_a_killed_pool_worker_is_replaced_and_no_run_is_lost(specs, tmp_path):
     assert [r["actions"] for r in got["runs"]] == [r["actions"] for r in want["runs"]]
 
 
-def test_physics_that_diverges_ends_the_run_with_its_name_and_keeps_the_record(specs):
+def test_physics_that_diverges_ends_the_run_with_its_name_and_keeps_the_record(specs, tmp_path, monkeypatch):
     """Velocities made infinite mid-survey: MuJoCo flags it at the next step, the session raises
     SimulationDiverged, and the trial records the run as ended for that reason (no traceback)."""
+    monkeypatch.chdir(tmp_path)  # MuJoCo logs each warning to MUJOCO_LOG.TXT in the working directory
     from puzzlebox.lab import TrialConfig, run_trial
     from puzzlebox.models import load_spec
     from puzzlebox.twin.errors import SimulationDiverged
@@ -145,9 +155,7 @@ def test_a_video_killed_in_mid_write_never_appears_under_its_final_name(specs, t
     assert not list(out.glob(".rollout*"))
     reader = imageio_ffmpeg.read_frames(str(out / "rollout.mp4"))
     meta = next(reader)
-    config = RolloutConfig()
-    width, height = config.view_size
-    assert meta["size"] == (3 * width, height + config.caption_height + config.plot_height)
+    assert meta["size"] == RolloutConfig().frame_size
     assert sum(1 for _ in reader) > 50, "a whole video: every frame decodes"
 
 

@@ -3,6 +3,7 @@ the world, observers see every step without changing the trial, and the README's
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import subprocess
 import sys
@@ -11,7 +12,7 @@ from pathlib import Path
 import pytest
 from user_agents import TryInTurn
 
-from puzzlebox.lab import TrialConfig, TrialConfigError, TrialObserver, open_world, run_trial
+from puzzlebox.lab import TrialConfig, TrialConfigError, TrialObserver, TrialRecord, TwinCell, open_world, run_trial
 from puzzlebox.lab.trial_task import without_timing
 from puzzlebox.models.generator import paper_family
 
@@ -49,6 +50,7 @@ def test_a_users_agent_solves_a_box_in_the_symbolic_sim():
     record = run_trial(SPEC, TrialConfig(sim="symbolic", seed=3, max_actions=60), agent=TryInTurn())
     assert record.solved and record.num_actions >= 5 and record.sim_time_s is None
     assert record.to_dict()["actions"][0]["component"] in {c.name for c in SPEC.components}
+    assert TrialRecord.from_dict(record.to_dict()) == record  # results.json's entries read back
 
 
 def test_observers_see_every_step_of_a_twin_trial_without_changing_it():
@@ -58,9 +60,20 @@ def test_observers_see_every_step_of_a_twin_trial_without_changing_it():
     watched = run_trial(SPEC, config, observers=[watcher])
     assert without_timing(watched.to_dict()) == without_timing(plain.to_dict())
     assert watched.sensed_sha256 == plain.sensed_sha256 and plain.num_actions == 2
+    assert TrialRecord.from_dict(plain.to_dict()) == plain
     counts = watcher.counts
     assert counts["attach"] == counts["finish"] == 1 and counts["begins"] == counts["ended"] == 2
     assert counts["sensed"] > 100 and counts["waited"] > 100  # every reading and every control tick
+
+
+def test_a_twin_cell_is_the_trial_its_profile_and_calibration_make():
+    config = TrialConfig(agent="oracle", seed=4, max_actions=1)
+    by_config = run_trial(SPEC, dataclasses.replace(config, reality="realistic"))
+    in_cell = run_trial(SPEC, config, cell=TwinCell.load("realistic"))
+    assert in_cell.reality == "realistic" and in_cell.sensed_sha256 == by_config.sensed_sha256
+    assert in_cell.sensed_sha256 != run_trial(SPEC, config).sensed_sha256  # the cell is not ignored
+    with pytest.raises(TrialConfigError, match="TwinCell"):
+        run_trial(SPEC, TrialConfig(sim="symbolic"), cell=TwinCell.load("ideal"))
 
 
 def test_a_users_loop_drives_the_twin_through_open_world():

@@ -7,12 +7,7 @@ import pytest
 
 from puzzlebox.learning.errors import ConfigError
 from puzzlebox.learning.experiments import ProtocolConfig
-from puzzlebox.learning.experiments.deep_protocols import (
-    DeepSchedule,
-    cached_record,
-    jobs_for,
-    merge_deep_points,
-)
+from puzzlebox.learning.experiments.deep_protocols import DeepSchedule, job_settings, jobs_for, merge_deep_points
 from puzzlebox.learning.experiments.report import episodes_to_solve
 
 CONFIG = ProtocolConfig(runs_per_variant=2, training_seeds=2)
@@ -41,21 +36,7 @@ def _record(job, config, success):
     if job.conditions_at is not None:
         evaluations += [{"episodes": job.conditions_at, "condition": c, "success_rate": 0.5, "mean_actions": 9.0,
                          "runs": 6} for c in ("wrong kind", "pose noise", "both", "moved box")]  # fmt: skip
-    from puzzlebox.learning.experiments.deep_protocols import _settings
-
-    return {"settings": json.loads(json.dumps(_settings(job, config))), "evaluations": evaluations}
-
-
-def test_a_cached_job_is_reused_only_with_identical_settings(tmp_path):
-    from puzzlebox.learning.experiments.deep_protocols import job_task
-    from puzzlebox.learning.runner import RecordStore
-
-    job = jobs_for("episodes", ["dqn"], CONFIG, SCHEDULE)[0]
-    RecordStore(tmp_path / "jobs").put(job_task(job, CONFIG, tmp_path), _record(job, CONFIG, lambda x: 1.0))
-    assert cached_record(job, CONFIG, tmp_path) is not None
-    assert cached_record(job, ProtocolConfig(runs_per_variant=3, training_seeds=2), tmp_path) is None
-    (tmp_path / "jobs" / f"{job.key}.json").write_text("{truncated")
-    assert cached_record(job, CONFIG, tmp_path) is None
+    return {"settings": json.loads(json.dumps(job_settings(job, config))), "evaluations": evaluations}
 
 
 def test_merged_points_take_each_protocol_value_from_the_right_job_and_count():

@@ -1,6 +1,7 @@
 """The dual controller and the agents built on it: memory beats no memory, runs are reproducible."""
 
 import itertools
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -17,6 +18,7 @@ from puzzlebox.models.generator import (
     TRAIN_INDICES,
     BoxConfig,
     RandomGraphConfig,
+    generate_chain,
     generate_random,
     paper_variant,
 )
@@ -237,3 +239,59 @@ def test_ties_are_broken_at_random_but_reproducibly():
     again = [decide(belief, states, 3, 1, np.random.default_rng(s), config, h_max).action for s in range(40)]
     assert picks == again
     assert set(picks) == {0, 1, 2, 3}  # no component is always favoured
+
+
+class _MisreadUntilMoved:
+    """A world that tells one component's kind wrong until a try moves it, and from then on the kind that moved
+    it — as ``skills.robot_world.RobotWorld`` reports a kind it found."""
+
+    def __init__(self, world: SymbolicWorld, name: str, told: str) -> None:
+        self.world, self.name, self.told, self.found = world, name, told, False
+
+    def _index(self) -> int:
+        return next(i for i in range(len(self.world.observe())) if self.world.ground_truth_name(i) == self.name)
+
+    def observe(self):
+        observation = self.world.observe()
+        if self.found:
+            return observation
+        components = list(observation.components)
+        components[self._index()] = replace(components[self._index()], kind=self.told)
+        return replace(observation, components=tuple(components))
+
+    def try_toggle(self, index: int):
+        result = self.world.try_toggle(index)
+        self.found = self.found or (result.moved and index == self._index())
+        return result
+
+    def ground_truth_name(self, index: int) -> str:
+        return self.world.ground_truth_name(index)
+
+
+@pytest.mark.parametrize("max_lockers", [1, 2])
+def test_the_memory_stores_the_kind_that_moved_a_part_never_the_misread_one(max_lockers):
+    spec = generate_chain(["slide", "door", "slide", "wheel"], seed=2)
+    told = _MisreadUntilMoved(SymbolicWorld(spec, 1), "door-1", "wheel")
+    assert told.observe().kinds.count("wheel") == 2  # the door is told a wheel
+    store = MemoryStore()
+    agent = MemoryAgent(store, DualControllerConfig(max_lockers=max_lockers), learn=True)
+    result = run_episode(agent, told, spec.name, 1, MAX_ACTIONS)
+    assert result.solved and told.found
+    doors, wheels = store.independence_values("door"), store.independence_values("wheel")
+    assert doors is not None and len(doors) == 1 and wheels is not None and len(wheels) == 1
+    assert store.pair_bucket("slide", "door") is not None  # the door's lock, kept under the door's kind
+
+
+def test_a_kind_found_remakes_the_belief_from_its_prior_with_the_evidence_so_far():
+    spec = generate_chain(["slide", "door", "slide", "wheel"], seed=2)
+    trained = train_memory(MemoryStore())
+    told = _MisreadUntilMoved(SymbolicWorld(spec, 1), "door-1", "wheel")
+    agent = MemoryAgent(trained)
+    result = run_episode(agent, told, spec.name, 1, MAX_ACTIONS)
+    assert result.solved and told.found
+    # the same belief as one that started from the true kinds' prior and saw the same tries
+    fresh = MemoryAgent(trained)
+    fresh.begin_episode(told.observe(), np.random.default_rng(1))
+    for states, component, moved in agent._evidence:
+        fresh.belief.update(states, component, moved)
+    np.testing.assert_array_equal(fresh.belief.probs, agent.belief.probs)

@@ -44,6 +44,9 @@ def test_render_writes_the_views_and_the_turntable_of_a_box(tmp_path):
     for name in ["top", "three-quarter", *(f"component-{c}" for c in components)]:
         image = iio.imread(out / f"{name}.png")
         assert image.shape == (240, 320, 3) and image.std() > 10, name
+    for name in ("top-annotated", "three-quarter-annotated"):  # labels on the view, the lock rules' legend below it
+        image = iio.imread(out / f"{name}.png")
+        assert image.shape[1] == 320 and image.shape[0] > 240 + 14 * 9, name  # paper-test-1: 8 rules and the goal
     assert iio.imread(out / "turntable.mp4").shape == (12, 240, 320, 3)
     config = json.loads((out / "render.config.json").read_text())
     assert config["views"] and config["turntable"] and config["frames"] == 12

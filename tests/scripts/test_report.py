@@ -244,6 +244,10 @@ def test_a_twin_trial_report_links_its_video_and_draws_its_timeline(made, tmp_pa
     assert page.stat().st_size < (out / "rollout.mp4").stat().st_size, "the video is linked, not inlined"
     text = page.read_text()
     assert "outcome agreement" in text and "Peak wrist force per action" in text
+    record = next(iter(runs.values()))  # its placement and reality profile, and each block named by its part
+    x, y, _ = record["box_pose"]
+    assert f"x {x:.3f} y {y:.3f} m" in text and f"<td>{record['reality']}</td>" in text
+    assert record["timeline"] and all(f'<span class="nm">{a["component"]}</span>' in text for a in record["timeline"])
     # the same run with its truth flipped on the second action: one mark there, none elsewhere
     key = next(iter(runs))
     crafted = crafted_twin_copy(out, tmp_path / "flipped", {key: {1}})
@@ -252,6 +256,17 @@ def test_a_twin_trial_report_links_its_video_and_draws_its_timeline(made, tmp_pa
     check_timelines(parsed, crafted)
     assert [a["mark"] for a in parsed.timelines[0]["actions"]] == [False, True, False]
     assert [link for tag, link in parsed.links if tag == "video"] == ["../flipped/rollout.mp4"]
+
+
+def test_the_force_plot_counts_actions_on_integer_ticks():
+    from puzzlebox.lab.report_html import force_figure
+
+    fig = force_figure([({"outcome": "moved", "moved": True, "true_moved": True}, 20.0 + i) for i in range(3)])
+    ax = fig.axes[0]
+    fig.canvas.draw()
+    low, high = ax.get_xlim()
+    ticks = [t for t in ax.get_xticks() if low <= t <= high]
+    assert len(ticks) >= 2 and all(float(t).is_integer() for t in ticks), ticks
 
 
 @pytest.mark.parametrize("what", ["missing", "file", "empty", "specs", "bad json", "no runs"])

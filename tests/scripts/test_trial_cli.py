@@ -316,11 +316,11 @@ def test_a_misreported_kind_is_drawn_from_the_seed_and_is_never_the_true_kind():
     assert draws == [wrong_kind(spec, seed) for seed in range(60)]
 
 
-def test_a_twin_trial_told_a_wrong_kind_stays_under_the_force_limit(tmp_path):
-    """The oracle toggles every part on the solution; one of them is told as another kind: its pull follows
-    the wrong path, and the arm must stop, not force it (the true wrist force stays under the 60 N limit)."""
-    from puzzlebox.skills.primitives import PrimitiveConfig
-
+def test_a_twin_trial_told_a_wrong_kind_finds_it_within_the_force_margin(tmp_path):
+    """The oracle toggles every part on the solution; one of them is told as another kind (seed 3: slide-3 told a
+    door): as a door its handle is not where the fingers close, so it is tried as the kinds whose handle stands
+    elsewhere, found a slide and moved; the record names the kind found, and the true wrist force stays within the
+    45 N margin (the limit is 60 N)."""
     specs = tmp_path / "specs"
     assert run(ROOT / "scripts/generate.py", "paper", "--split", "test", "--out", specs).returncode == 0
     out = tmp_path / "out"
@@ -328,6 +328,8 @@ def test_a_twin_trial_told_a_wrong_kind_stays_under_the_force_limit(tmp_path):
                  "oracle", "--runs", 1, "--seed", 3, "--max-actions", 8, "--out", out, "--wrong-kind")  # fmt: skip
     assert result.returncode == 0, result.stderr
     entry = json.loads((out / "results.json").read_text())["runs"][0]
-    (told,) = entry["told_kinds"].items()
-    assert told[0] in {a["component"] for a in entry["timeline"]}  # the misreported part was tried
-    assert entry["peak_true_wrist_force_n"] < PrimitiveConfig().force_limit
+    assert entry["told_kinds"] == {"slide-3": "door"} and entry["found_kinds"] == {"slide-3": "slide"}
+    assert entry["solved"] and entry["num_actions"] == 5
+    (tried,) = [a for a in entry["timeline"] if a["component"] == "slide-3"]
+    assert tried["tried_kinds"] == ["slide"] and tried["moved"] and tried["true_moved"]
+    assert entry["peak_true_wrist_force_n"] <= 45.0

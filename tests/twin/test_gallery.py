@@ -14,7 +14,7 @@ from conftest import SCENE_EXAMPLE
 from puzzlebox.models import spec_from_dict
 from puzzlebox.models.generator import generate_chain, paper_family
 from puzzlebox.models.scene import SceneConfig, SceneError, build_scene
-from puzzlebox.twin.gallery import CAMERA, Gallery, component_view_name, frame_view
+from puzzlebox.twin.gallery import CAMERA, Gallery, component_view_name, frame_view, rule_text
 from puzzlebox.twin.rendering import RenderConfig
 
 WIDTH, HEIGHT = 400, 300
@@ -101,6 +101,43 @@ def test_lock_features_appear_in_the_three_quarter_view(gallery):
     features = [name for name in shares if ":lock:" in name]
     assert gallery.spec.locks and features
     assert all(shares[name] > 0 for name in features), {name: shares[name] for name in features}
+
+
+def test_lock_features_take_their_lockers_colour_and_the_legend_says_who_holds_whom(gallery):
+    spec, model = gallery.spec, gallery.model
+    assert len(gallery.features) == len({(r.locker, r.locked) for r in spec.locks})
+    for name, (locker, _) in gallery.features.items():
+        np.testing.assert_allclose(model.geom_rgba[model.geom(name).id, :3], gallery.colours[locker])
+    assert len(set(gallery.colours.values())) == len(spec.components)  # a colour per part
+    lines = gallery.legend()
+    assert len(lines) == 1 + len(spec.locks)
+    assert f"goal {spec.goal.component}" in lines[0][0] and lines[0][0].endswith("its locker's colour")
+    for rule, (text, colour) in zip(spec.locks, lines[1:], strict=True):
+        assert text.startswith(rule_text(spec, rule)) and colour == gallery.colours[rule.locker]
+        assert f"on {rule.locker}]" in text  # the feature that shows it, on its locker
+    assert rule_text(spec, spec.locks[0]).split(" keeps ")[0].endswith(("closed", "open"))
+
+
+def _exact(image: np.ndarray, rgb) -> int:
+    return int(np.all(image == np.asarray(rgb, dtype=np.uint8), axis=-1).sum())
+
+
+def test_the_annotated_views_label_every_part_mark_the_goal_and_append_the_legend(gallery, tmp_path):
+    spec = gallery.spec
+    paths = gallery.write_annotated(tmp_path)
+    assert [p.name for p in paths] == ["top-annotated.png", "three-quarter-annotated.png"]
+    for path in paths:
+        image = iio.imread(path)
+        assert image.shape[1] == WIDTH and image.shape[0] > HEIGHT + 14 * (1 + len(spec.locks)), path.name
+        view, legend = image[:HEIGHT], image[HEIGHT:]
+        for c in spec.components:  # a label chip in the part's colour
+            chip = [int(255 * v) for v in gallery.colours[c.name]]
+            assert _exact(view, chip) > 150, (path.name, c.name)
+        assert _exact(view, (220, 20, 20)) > 100, "the goal's red rim"
+        for rule in spec.locks:  # the legend's chip of each rule, in its locker's colour
+            assert _exact(legend, [int(255 * v) for v in gallery.colours[rule.locker]]) > 100
+    plain = gallery.render(gallery.top_view())
+    assert np.abs(iio.imread(paths[0])[:HEIGHT].astype(int) - plain).max(axis=-1).astype(bool).mean() > 0.02
 
 
 def test_turntable_has_its_frames_and_the_box_in_every_one(gallery, tmp_path):

@@ -164,7 +164,8 @@ def test_state_round_trip_reproduces_the_future_exactly(reality):
         assert np.array_equal(first[0], third[0]) and np.array_equal(first[1], third[1])
 
 
-def test_divergence_raises_naming_the_warning_and_never_resets():
+def test_divergence_raises_naming_the_warning_and_never_resets(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # MuJoCo logs the warning to MUJOCO_LOG.TXT in the working directory
     with TwinSession(paper_family("test")[0], seed=0) as session:
         session.advance(0.1)
         session.data.qvel[:] = 1e12

@@ -1,6 +1,7 @@
 """The task runner: executes pure, seeded, picklable tasks in-process, in a local process pool or on a
 Ray cluster, writes each task's record atomically the moment it ends, and on a rerun computes only what
-is missing. It knows nothing of what a task does (DESIGN.md: composing a trial is the scripts' wiring).
+is missing. It knows nothing of what a task does (DESIGN.md: composing a trial is the composition layer's,
+``puzzlebox.lab``).
 
 Example::
 
@@ -9,8 +10,8 @@ Example::
         report = run_tasks(tasks, RecordStore(out / "runs"), executor)
 """
 
-from puzzlebox.learning.runner.errors import RunnerError
-from puzzlebox.learning.runner.executors import (
+from puzzlebox.lab.runner.errors import RunnerError
+from puzzlebox.lab.runner.executors import (
     Completion,
     Executor,
     InlineExecutor,
@@ -18,9 +19,9 @@ from puzzlebox.learning.runner.executors import (
     RayExecutor,
     make_executor,
 )
-from puzzlebox.learning.runner.records import RecordStore
-from puzzlebox.learning.runner.run import RunReport, run_tasks
-from puzzlebox.learning.runner.task import Task
+from puzzlebox.lab.runner.records import RecordStore
+from puzzlebox.lab.runner.run import RunReport, run_tasks
+from puzzlebox.lab.runner.task import Task
 
 __all__ = [
     "Completion",

@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from puzzlebox.learning.runner.task import Task
+from puzzlebox.lab.runner.task import Task
 from puzzlebox.models.atomic import write_text_atomically
 
 
@@ -24,7 +24,7 @@ class RecordStore:
         """The record of ``task`` if it finished earlier with the same settings, else None."""
         try:
             stored = json.loads(self.path(task.key).read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError):
             return None  # absent (a torn file cannot happen with atomic writes: recompute rather than trust)
         if not isinstance(stored, dict) or stored.get("settings_sha256") != task.settings_hash:
             return None

@@ -10,11 +10,11 @@ from typing import Any
 
 from tqdm import tqdm
 
+from puzzlebox.lab.runner.errors import RunnerError
+from puzzlebox.lab.runner.executors import Executor
+from puzzlebox.lab.runner.records import RecordStore
+from puzzlebox.lab.runner.task import Task
 from puzzlebox.learning.errors import LearningError
-from puzzlebox.learning.runner.errors import RunnerError
-from puzzlebox.learning.runner.executors import Executor
-from puzzlebox.learning.runner.records import RecordStore
-from puzzlebox.learning.runner.task import Task
 
 
 @dataclass
@@ -40,8 +40,9 @@ class RunReport:
     planned: int = 0
 
     def raise_for_failures(self, what: str = "task") -> None:
-        """Raise :class:`~learning.errors.LearningError` (one line: how many ``what``s failed, the first one's key
-        and error) if a task failed, or if a stop left tasks undone; the finished records are kept either way."""
+        """Raise :class:`~puzzlebox.learning.errors.LearningError` (one line: how many ``what``s failed, the first
+        one's key and error) if a task failed, or if a stop left tasks undone; the finished records are kept either
+        way."""
         if self.failures:
             key, error = next(iter(self.failures.items()))
             first = error.splitlines()[0]

@@ -6,14 +6,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from puzzlebox.learning.runner.errors import RunnerError
-
-_KEY = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9._+=@-]{0,199}$")
+from puzzlebox.lab.runner.errors import RunnerError
+from puzzlebox.models.names import is_key
 
 
 @dataclass(frozen=True)
@@ -39,7 +37,7 @@ class Task:
     context: Mapping[str, Any] | None = None
 
     def __post_init__(self) -> None:
-        if not _KEY.match(self.key):
+        if not is_key(self.key):  # the one rule for names and keys (models.names); make keys with name_slug
             raise RunnerError(f"task key {self.key!r} is not a file name (letters, digits, ._+=@-; not hidden)")
         name = getattr(self.function, "__qualname__", "")
         if "<" in name or not getattr(self.function, "__module__", None):
@@ -69,4 +67,5 @@ def execute(
     try:
         return True, function(settings) if context is None else function(settings, context)
     except Exception as err:  # noqa: BLE001 - any task error is reported with its key, not raised
-        return False, f"{type(err).__name__}: {err}\n{traceback.format_exc()}"
+        message = " ".join(line.strip() for line in str(err).splitlines())  # its first line is the whole reason
+        return False, f"{type(err).__name__}: {message}\n{traceback.format_exc()}"

@@ -9,8 +9,7 @@ import threading
 import pytest
 import runner_tasks
 
-from puzzlebox.learning.errors import LearningError
-from puzzlebox.learning.runner import (
+from puzzlebox.lab.runner import (
     InlineExecutor,
     PoolExecutor,
     RayExecutor,
@@ -20,6 +19,7 @@ from puzzlebox.learning.runner import (
     Task,
     run_tasks,
 )
+from puzzlebox.learning.errors import LearningError
 
 
 def _tasks(n, function=runner_tasks.draws, **extra):

@@ -22,8 +22,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from puzzlebox.learning.runner.errors import RunnerError
-from puzzlebox.learning.runner.task import Task, execute
+from puzzlebox.lab.runner.errors import RunnerError
+from puzzlebox.lab.runner.task import Task, execute
 
 MAX_BARREN_RESTARTS = 5
 """Pool restarts in a row with no task finished after which the pool gives up (workers that cannot start)."""

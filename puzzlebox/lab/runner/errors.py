@@ -1,4 +1,5 @@
-"""Errors of the task runner."""
+"""Errors of the task runner. Each is a :class:`~puzzlebox.learning.errors.LearningError`, as it was before the
+runner moved out of ``learning/`` (issue 34): the callers that map a failed run to one line catch that."""
 
 from __future__ import annotations
 
