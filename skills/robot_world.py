@@ -386,7 +386,7 @@ class RobotWorld:
             if result.closed_on_nothing:
                 self.empty_handles.setdefault(marker, []).append(jm.grasp_point)
             elif adopt is None and (
-                (outcome.outcome == "blocked" and first.outcome == "failed")
+                (outcome.outcome == "blocked" and empty)
                 or (jm.handling.swings_up and result.progress >= self.toggler.config.blocked_progress)
             ):
                 adopt = jm  # its handle is there (held, or carried part of the way): this kind from now on
