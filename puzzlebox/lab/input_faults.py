@@ -204,7 +204,7 @@ def malformed_inputs(out: Path, spec: Path) -> dict[str, bool]:
         "generate chain --seed -1": [SCRIPTS / "generate.py", "chain", "--kinds", "door,slide", "--seed", -1, "--out",
                                      where / "c.json"],
         "calibrate --seed -1": [SCRIPTS / "calibrate.py", "--seed", -1, "--out", where / "cal.json"],
-        "trial --runs 1e9": [*trial[:7], 10**9, *trial[8:], "--out", where / "o6"],
+        "trial --runs 1e9": [*trial[:8], 10**9, *trial[9:], "--out", where / "o6"],
         "train --episodes 1e9": [SCRIPTS / "train.py", "--specs", spec, "--episodes", 10**9, "--memory",
                                  where / "m.sqlite"],
         "render 100000 x 100000": [SCRIPTS / "render.py", spec, "--out", where / "o7", "--width", 100_000, "--height",
