@@ -51,7 +51,9 @@ def run_trial(
     if memory is None and agent is None and config.memory is not None:
         memory = MemoryStore.open_existing(config.memory)
     if isinstance(cell, RealCell):
-        return _run_real(spec, config, cell, agent, memory, observers, video, recording, on_action, on_record)
+        if video is not None or recording is not None:
+            raise TrialConfigError("a video or a recording is of a twin trial: a real cell has no simulator to draw")
+        return _run_real(spec, config, cell, agent, memory, observers, on_action, on_record)
     if isinstance(cell, TwinCell):
         if config.sim != "twin":
             raise TrialConfigError("a TwinCell is the twin's: TrialConfig(sim='twin')")
@@ -99,18 +101,11 @@ def _run_real(
     agent: Agent | None,
     memory: MemoryStore | None,
     observers: Sequence[TrialObserver],
-    video: str | Path | None,
-    recording: str | Path | None,
     on_action: Callable[[Any], None] | None,
     on_record: Callable[[dict[str, Any]], None] | None,
 ) -> TrialRecord:
-    problems = [
-        *(["a real cell is not simulated: TrialConfig(sim='twin'), the default"] if config.sim != "twin" else []),
-        *(["a video or a recording is of a twin trial"] if video is not None or recording is not None else []),
-        *(["misreport_kind is a twin fault"] if config.misreport_kind else []),
-    ]
-    if problems:
-        raise TrialConfigError("; ".join(problems))
+    if config.sim != "twin" or config.misreport_kind:
+        raise TrialConfigError("a real cell runs TrialConfig(sim='twin'), the default, without misreport_kind")
     from puzzlebox.lab.real_trial import run_real_trial  # the motion primitives only when a real trial is asked
 
     entry = run_real_trial(

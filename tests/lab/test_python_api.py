@@ -12,7 +12,16 @@ from pathlib import Path
 import pytest
 from user_agents import TryInTurn
 
-from puzzlebox.lab import TrialConfig, TrialConfigError, TrialObserver, TrialRecord, TwinCell, open_world, run_trial
+from puzzlebox.lab import (
+    RealCell,
+    TrialConfig,
+    TrialConfigError,
+    TrialObserver,
+    TrialRecord,
+    TwinCell,
+    open_world,
+    run_trial,
+)
 from puzzlebox.lab.trial_task import without_timing
 from puzzlebox.models.generator import paper_family
 
@@ -92,6 +101,11 @@ def test_a_config_that_cannot_run_is_refused_with_every_problem():
         TrialConfig(max_actions=0, locks="glue")
     with pytest.raises(TrialConfigError, match="twin"):
         run_trial(SPEC, TrialConfig(sim="symbolic"), video="out.mp4")
+    arm = RealCell(robot=None, config=None, calibration=None)  # type: ignore[arg-type]  # refused before use
+    with pytest.raises(TrialConfigError, match="real cell"):
+        run_trial(SPEC, TrialConfig(misreport_kind=True), cell=arm)
+    with pytest.raises(TrialConfigError, match="real cell has no simulator"):
+        run_trial(SPEC, cell=arm, video="out.mp4")
 
 
 def _python_api_block() -> str:
