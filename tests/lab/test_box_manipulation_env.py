@@ -11,7 +11,7 @@ from typing import Any
 import gymnasium
 import numpy as np
 import pytest
-from gymnasium.utils.env_checker import check_env
+from gymnasium.utils.env_checker import check_env, data_equivalence
 
 import puzzlebox  # noqa: F401  (registers the environment)
 from puzzlebox.lab.box_manipulation_env import BoxManipulationEnv
@@ -24,11 +24,8 @@ from puzzlebox.twin import renderer_pool
 
 
 def _same(a, b) -> bool:
-    if isinstance(a, dict):
-        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
-    if isinstance(a, tuple | list):
-        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
-    return bool(np.array_equal(a, b))
+    """Bit for bit: gymnasium's own comparison of observations (dicts, tuples, arrays and their dtypes)."""
+    return data_equivalence(a, b, exact=True)
 
 
 def open_slide(env: BoxManipulationEnv, obs: dict, slide_yaw: float) -> tuple[dict, list[float]]:

@@ -8,7 +8,7 @@ from dataclasses import replace
 import gymnasium
 import numpy as np
 import pytest
-from gymnasium.utils.env_checker import check_env
+from gymnasium.utils.env_checker import check_env, data_equivalence
 
 import puzzlebox  # noqa: F401  (registers the environment)
 from puzzlebox.lab import TrialConfig, TrialConfigError
@@ -39,11 +39,8 @@ def _episode(seed: int, actions: list[int]) -> list:
 
 
 def _same(a, b) -> bool:
-    if isinstance(a, dict):
-        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
-    if isinstance(a, tuple | list):
-        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
-    return bool(np.array_equal(a, b))
+    """Bit for bit: gymnasium's own comparison of observations (dicts, tuples, arrays and their dtypes)."""
+    return data_equivalence(a, b, exact=True)
 
 
 def test_a_seeded_reset_and_the_same_actions_give_the_same_observations_bit_for_bit():
