@@ -8,7 +8,8 @@
 ``DEEP`` is one of dqn, model-based, mt-dqn, mt-model-based.
 
 ``--max-lockers K`` (symbolic) trains the memory agent with a belief over sets of up to K lockers per component
-(default 1: the paper's one-locker belief); the memory stores each episode's graph in the one format either way,
+(default: 2 if a training spec is a computer or has a part held by two lockers, else 1, the paper's one-locker
+belief: ``learning.scene_lockers``); the memory stores each episode's graph in the one format either way,
 each pair's probability of being among the lockers (``learning.lock_belief.LockBelief.locker_memberships``: for
 one locker the belief itself), so any agent can recall it.
 
@@ -48,6 +49,7 @@ from puzzlebox.lab.training_setup import (
     twin_training_for,
 )
 from puzzlebox.learning import DEEP_AGENT_NAMES
+from puzzlebox.learning.scene_lockers import training_max_lockers
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -63,8 +65,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--reality", default=None, help="twin reality profile: ideal, realistic, harsh or FILE.json")
     parser.add_argument("--calibration", default=None, help="twin: the cell's calibration file (calibrate.py)")
     parser.add_argument(
-        "--max-lockers", type=int, default=1, metavar="K",
-        help="symbolic memory agent: believe in sets of up to K lockers per component (default 1: the paper's)",
+        "--max-lockers", type=int, default=None, metavar="K",
+        help="symbolic memory agent: believe in sets of up to K lockers per component (default: 2 if a training "
+        "spec is a computer or has a part held by two lockers, else 1, the paper's)",
     )  # fmt: skip
     parser.add_argument("--resume", action="store_true", help="continue the latest run of this same command")
     args = parser.parse_args(argv)
@@ -80,6 +83,9 @@ def main(argv: list[str] | None = None) -> int:
 
 def _train(args: argparse.Namespace) -> int:
     specs = load_training_specs(args.specs)
+    if args.max_lockers is None:  # what fits the training scenes (logged resolved: a rerun resumes the same run)
+        symbolic_memory = args.sim == "symbolic" and args.agent == "memory"
+        args.max_lockers = training_max_lockers(specs) if symbolic_memory else 1
     if args.sim == "symbolic" and (args.reality is not None or args.calibration is not None):
         fail("--reality and --calibration are for --sim twin")
     controller = memory_controller(args.max_lockers, args.sim, args.agent)

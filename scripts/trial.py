@@ -114,7 +114,7 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
     parser.add_argument("--out", required=True, help="output directory")
     parser.add_argument("--agent", default="memory", help=f"{', '.join(AGENT_NAMES)} or package.module:Class")
     parser.add_argument("--checkpoint", default=None, help="checkpoint from train.py (deep agents)")
-    parser.add_argument("--max-lockers", type=int, default=1, metavar="K", help="memory/dual: up to K lockers a part")
+    parser.add_argument("--max-lockers", type=int, metavar="K", help="memory/dual: up to K lockers a part")
     parser.add_argument("--video", action="store_true", help="record rollout videos (twin only)")
     parser.add_argument("--record", default=None, metavar="FILE.rrd", help="a Rerun recording of each twin run")
     parser.add_argument("--wrong-kind", action="store_true", help="twin: tell the pipeline one kind wrong per run")
@@ -167,7 +167,7 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
 
     out = Path(args.out)
     experiment = {"command": "trial", **{k: v for k, v in vars(args).items() if k not in NOT_RESULTS}}
-    if args.max_lockers == 1:  # the default leaves the configuration as it was before k existed (resumable)
+    if args.max_lockers is None:  # the default leaves the configuration as it was before k existed (resumable)
         del experiment["max_lockers"]
     if args.locks == "latch" or args.sim != "twin":  # latches: the configuration made before mechanisms existed
         del experiment["locks"]

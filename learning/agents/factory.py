@@ -11,6 +11,7 @@ from puzzlebox.learning.belief import BeliefConfig
 from puzzlebox.learning.dual_controller import DualControllerConfig
 from puzzlebox.learning.errors import ConfigError, UnknownAgent
 from puzzlebox.learning.memory.store import MemoryStore
+from puzzlebox.learning.scene_lockers import scene_max_lockers
 from puzzlebox.models import PuzzleSpec
 
 __all__ = ["AGENT_NAMES", "BELIEF_AGENT_NAMES", "DEEP_AGENT_NAMES", "POSE_ENCODINGS", "make_agent"]
@@ -22,12 +23,15 @@ def make_agent(
     memory: MemoryStore | None = None,
     checkpoint: str | None = None,
     belief: BeliefConfig | None = None,
-    max_lockers: int = 1,
+    max_lockers: int | None = None,
 ) -> Agent:
     """A fresh agent for one puzzle; :class:`UnknownAgent` lists the names that exist. ``belief`` is the
     observation model of the belief-based agents (``memory``, ``dual``; default :class:`BeliefConfig`),
     ``max_lockers`` the most lockers their belief allows one component (1: the paper's; see
-    :class:`DualControllerConfig`); the other agents take neither."""
+    :class:`DualControllerConfig`; None: what fits the scene and the memory, :func:`scene_max_lockers`); the
+    other agents take neither."""
+    if max_lockers is None:
+        max_lockers = scene_max_lockers(spec, memory, name)
     controller = DualControllerConfig(belief=belief) if belief is not None else None
     if max_lockers != 1:  # k = 1 keeps the agents' own default config, as before k existed
         if name not in BELIEF_AGENT_NAMES:

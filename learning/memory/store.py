@@ -73,6 +73,11 @@ LEGACY_KEY_SCHEMAS = ("1", "2", "3")
 """Schemas whose pair keys are compact (4 or 9 numbers), converted to SE(3) keys when read."""
 SOURCES = ("symbolic", "twin")
 """Where an episode was experienced: the symbolic simulator, or end to end in the twin."""
+SEVERAL_LOCKERS_LEARNED = 1.9
+"""Expected number of lockers of one component in one state (its memberships summed) from which an episode has
+learned a component held by several: with sets of up to two, ``P(two) >= sum - 1``, so at least 0.9. A belief
+over sets of two left uncertain on a one-locker chain box sums to at most 1.62 (paper training boxes, 18
+episodes); multi-locker boxes and lab-computer-a reach 1.96-2.0 (``runs/s4/defaults/membership_probe.py``)."""
 
 _LOG_SCHEMA = """
 CREATE TABLE training_runs (id INTEGER PRIMARY KEY, started REAL NOT NULL, config TEXT NOT NULL);
@@ -197,6 +202,9 @@ class MemoryStore:
         self.rotation_weight = rotation_weight
         self._pairs: dict[tuple[str, str], list[tuple[np.ndarray, np.ndarray]]] = defaultdict(list)
         self._independence: dict[str, list[np.ndarray]] = defaultdict(list)
+        self.most_lockers = 0.0
+        """The largest expected number of lockers of one component in one state over the stored episodes [-]
+        (:func:`expected_lockers`; at most 1 for episodes learned with the paper's one-locker belief)."""
         self._cache: dict[tuple[str, ...], Bucket] = {}
         self.num_episodes = 0
         self._provenance: list[tuple[str, str | None, float | None]] = []
@@ -288,8 +296,10 @@ class MemoryStore:
             self._provenance = [(source or "symbolic", profile, robot_time) for source, profile, robot_time in rows]
         else:
             self._provenance = [("symbolic", None, None)] * self.num_episodes
-        for kind_i, kind_j, key, value in conn.execute(
-            "SELECT kind_i, kind_j, key, value FROM pair_entries ORDER BY rowid"
+        sizes = dict(conn.execute("SELECT episode, COUNT(*) FROM independence_entries GROUP BY episode"))
+        by_episode: dict[int, list[np.ndarray]] = defaultdict(list)
+        for episode, kind_i, kind_j, key, value in conn.execute(
+            "SELECT episode, kind_i, kind_j, key, value FROM pair_entries ORDER BY rowid"
         ):
             key_arr, value_arr = _decode(key, path), _decode(value, path)
             legacy = self._schema in LEGACY_KEY_SCHEMAS
@@ -306,6 +316,9 @@ class MemoryStore:
                     raise MemoryFileError(f"{path} has a malformed pair key ({kind_i} -> {kind_j}): {err}") from None
             _check_probabilities(value_arr, f"{path} has a pair entry ({kind_i} -> {kind_j})")
             self._pairs[(kind_i, kind_j)].append((key_arr, value_arr))
+            by_episode[episode].append(value_arr)
+        for episode, values in by_episode.items():
+            self.most_lockers = max(self.most_lockers, _stored_expected_lockers(values, sizes.get(episode, 0)))
         for kind, value in conn.execute("SELECT kind, value FROM independence_entries ORDER BY rowid"):
             value_arr = _decode(value, path)
             if value_arr.size != 2:
@@ -469,6 +482,7 @@ class MemoryStore:
                 )
         for ki, kj, k, v in pairs:
             self._pairs[(ki, kj)].append((k, v))
+        self.most_lockers = max(self.most_lockers, expected_lockers(pair_values))
         for kind, v in singles:
             self._independence[kind].append(v)
         self._cache.clear()
@@ -520,6 +534,10 @@ class MemoryStore:
         """Whether any stored episode is of the kind family ``family`` (``models.disassembly_kinds.kind_family``)."""
         return any(kind_family(kind) == family for kind, entries in self._independence.items() if entries)
 
+    def learned_several_lockers(self) -> bool:
+        """Whether an episode learned a component held by several lockers (:data:`SEVERAL_LOCKERS_LEARNED`)."""
+        return self.most_lockers >= SEVERAL_LOCKERS_LEARNED
+
     def independence_values(self, kind: str) -> np.ndarray | None:
         """``(M, 2)`` stored independence probabilities of a kind, or None if never seen."""
         entries = self._independence.get(kind)
@@ -538,6 +556,27 @@ class MemoryStore:
 
     def __repr__(self) -> str:
         return f"MemoryStore({json.dumps(self.summary())})"
+
+
+def expected_lockers(pair_values: np.ndarray) -> float:
+    """The largest expected number of lockers of one component in one state in an episode's ``(N, N, 6)`` pair
+    values (:meth:`MemoryStore.add_episode`): its memberships ``P((i, s_i) among the lockers of j in s_j)`` summed
+    over ``(i, s_i)``, ``i != j``."""
+    n = pair_values.shape[0]
+    off_diagonal = ~np.eye(n, dtype=bool)[:, :, None]
+    memberships = np.where(off_diagonal, pair_values[:, :, :4], 0.0).reshape(n, n, 2, 2)  # [i, j, s_j, s_i]
+    return float(memberships.sum(axis=(0, 3)).max(initial=0.0))
+
+
+def _stored_expected_lockers(values: list[np.ndarray], n: int) -> float:
+    """:func:`expected_lockers` of an episode read back: its pair values in storage order (``i`` major, ``j != i``
+    minor, as :meth:`MemoryStore.add_episode` writes them) for ``n`` components (0 or a count that does not fit:
+    unknown, 0)."""
+    if n < 2 or len(values) != n * (n - 1):
+        return 0.0
+    full = np.zeros((n, n, PAIR_VALUE_SIZE))
+    full[~np.eye(n, dtype=bool)] = np.stack(values)  # row-major over (i, j), the diagonal skipped
+    return expected_lockers(full)
 
 
 def _meta_number(meta: dict[str, str], name: str, path: Path, rule: str, positive: bool) -> float:

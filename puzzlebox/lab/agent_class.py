@@ -61,10 +61,12 @@ def make_agent_object(name: str) -> Any:
     return agent
 
 
-def check_agent(agent: str, memory: str | PathLike[str] | None, checkpoint: str | None, max_lockers: int) -> bool:
+def check_agent(
+    agent: str, memory: str | PathLike[str] | None, checkpoint: str | None, max_lockers: int | None
+) -> bool:
     """Refuse an agent that cannot run as asked (``trial.py``'s ``--agent``, ``--memory``, ``--checkpoint``,
     ``--max-lockers``): :class:`AgentClassError` for a class of one's own that is not an agent,
-    :class:`TrialConfigError` for the rest. True for an agent class of one's own."""
+    :class:`TrialConfigError` for the rest (``max_lockers`` None: not given). True for an agent class of one's own."""
     from puzzlebox.learning import AGENT_NAMES, LearningError
     from puzzlebox.learning.agents.factory import BELIEF_AGENT_NAMES
     from puzzlebox.learning.dual_controller import DualControllerConfig
@@ -72,7 +74,7 @@ def check_agent(agent: str, memory: str | PathLike[str] | None, checkpoint: str 
     own = is_agent_class_name(agent)
     if own:
         load_agent_class(agent)
-        if memory or checkpoint or max_lockers != 1:
+        if memory or checkpoint or max_lockers is not None:
             raise TrialConfigError(
                 f"--memory, --checkpoint and --max-lockers are for the project's agents, not {agent!r}"
             )
@@ -82,7 +84,7 @@ def check_agent(agent: str, memory: str | PathLike[str] | None, checkpoint: str 
         )
     if (agent == "memory") != (memory is not None):
         raise TrialConfigError("--memory goes with --agent memory (and only with it): train one with scripts/train.py")
-    if max_lockers != 1:
+    if max_lockers is not None and max_lockers != 1:
         if agent not in BELIEF_AGENT_NAMES:
             raise TrialConfigError(f"--max-lockers is for the agents {list(BELIEF_AGENT_NAMES)}, not {agent!r}")
         try:

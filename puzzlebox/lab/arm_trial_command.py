@@ -42,7 +42,7 @@ class ArmTrialRequest:
     checkpoint: str | None
     seed: int
     max_actions: int
-    max_lockers: int
+    max_lockers: int | None
     out: Path
     force: bool
 

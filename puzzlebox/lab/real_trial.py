@@ -90,7 +90,7 @@ def run_real_trial(
     on_action: Callable[[Any], None] | None = None,
     on_record: Callable[[dict[str, Any]], None] | None = None,
     primitives: PrimitiveConfig | None = None,
-    max_lockers: int = 1,
+    max_lockers: int | None = None,
     agent: Agent | None = None,
     observers: Sequence[TrialObserver] = (),
 ) -> dict[str, Any]:
@@ -102,7 +102,8 @@ def run_real_trial(
     spec's marker map and goal, never the box's state. ``on_action`` is called after every action as
     ``learning.run_episode`` calls it, ``on_record`` with the record so far after every action and once at the
     end (after a stop too): a caller writes it as it grows. ``max_lockers``: the most lockers the agent's belief
-    allows one component (1: the paper's). ``agent``: an agent object of one's own instead of ``agent_name``'s;
+    allows one component (1: the paper's; None: what fits the scene and the memory). ``agent``: an agent object of
+    one's own instead of ``agent_name``'s;
     ``observers`` see every reading, wait and action as in a twin trial (:mod:`puzzlebox.lab.observers`; no
     session: a real cell has no simulator to read)."""
     wall = time.perf_counter()

@@ -226,6 +226,11 @@ def _check_recipe(recipe: object) -> None:
         raise SweepError(f"'generate': 'generator' must be 'random' or 'chain', got {_shown(recipe.get('generator'))}")
 
 
+def sweep_specs(sweep: dict[str, Any], base: Path) -> list[PuzzleSpec]:
+    """The specs a checked sweep (:func:`load_sweep`) runs, its paths relative to ``base`` (its file's folder)."""
+    return _specs(sweep, base)
+
+
 def _specs(sweep: dict[str, Any], base: Path) -> list[PuzzleSpec]:
     if "specs" in sweep:
         files = [f for pattern in sweep["specs"] for f in sorted(glob.glob(str(base / pattern)))]
@@ -372,7 +377,7 @@ def grid(sweep: dict[str, Any], base: Path) -> tuple[list[Task], dict[str, Cell]
                             memory=agent.get("memory"), checkpoint=agent.get("checkpoint"),
                             reality=reality.to_dict() if reality is not None else None,
                             calibration=calibration.to_dict() if calibration is not None else None,
-                            max_lockers=agent.get("max_lockers", 1),
+                            max_lockers=agent.get("max_lockers"),  # None: what fits the scene
                         ))  # fmt: skip
                         cells[key] = cell
     return tasks, cells

@@ -47,7 +47,7 @@ class TrialBatch:
     video: bool = False
     record: str | None = None
     misreport_kind: bool = False
-    max_lockers: int = 1
+    max_lockers: int | None = None
     locks: str = "contact"
 
     def tasks(self, out: Path) -> list:

@@ -35,7 +35,8 @@ class TrialConfig:
         memory: the memory agent's memory file (SQLite, ``train.py``'s).
         checkpoint: a deep agent's checkpoint file.
         misreport_kind: the pipeline is told one component's kind wrong (drawn from the seed).
-        max_lockers: the most lockers the belief-based agents allow one component (1: the paper's).
+        max_lockers: the most lockers the belief-based agents allow one component (1: the paper's; None: what fits
+            the scene and the memory, ``learning.scene_lockers.scene_max_lockers``).
         locks: the twin box's locks: ``contact`` (mechanisms that block by contact) or ``latch`` (rule-driven
             joint constraints, the ablation).
     """
@@ -49,7 +50,7 @@ class TrialConfig:
     memory: Path | None = None
     checkpoint: Path | None = None
     misreport_kind: bool = False
-    max_lockers: int = 1
+    max_lockers: int | None = None
     locks: Literal["contact", "latch"] = "contact"
 
     def __post_init__(self) -> None:
@@ -58,7 +59,7 @@ class TrialConfig:
             problems.append(f"sim must be one of {list(SIMS)}, got {self.sim!r}")
         if self.max_actions < 1:
             problems.append(f"max_actions must be at least 1, got {self.max_actions}")
-        if self.max_lockers < 1:
+        if self.max_lockers is not None and self.max_lockers < 1:
             problems.append(f"max_lockers must be at least 1, got {self.max_lockers}")
         if self.locks not in LOCK_MODES:
             problems.append(f"locks must be one of {list(LOCK_MODES)}, got {self.locks!r}")

@@ -18,6 +18,7 @@ from puzzlebox.lab.runner import Task
 from puzzlebox.lab.trial_config import TrialConfig
 from puzzlebox.lab.trials import run_trial as run_trial_of
 from puzzlebox.learning.memory import MemoryStore
+from puzzlebox.learning.scene_lockers import scene_max_lockers
 from puzzlebox.models import PuzzleSpec
 from puzzlebox.models.spec_loading import spec_from_dict
 
@@ -49,13 +50,14 @@ def trial_task(
     calibration: dict[str, Any] | None = None,
     video: str | None = None,
     misreport_kind: bool = False,
-    max_lockers: int = 1,
+    max_lockers: int | None = None,
     record: str | None = None,
     locks: str = "contact",
 ) -> Task:
     """The task of one run (``reality`` and ``calibration`` as their ``to_dict()``; twin only;
     ``misreport_kind``: one component's kind told wrong, drawn from the seed; ``max_lockers``: the most
-    lockers the memory and dual agents' belief allows a component, symbolic only; ``locks``: the twin box's locks,
+    lockers the memory and dual agents' belief allows a component (None: what fits the scene and the memory,
+    resolved here, so that a task says what it runs); ``locks``: the twin box's locks,
     ``contact`` mechanisms or ``latch``)."""
     settings = {
         "sim": sim, "spec": spec.to_dict(), "seed": seed, "agent": agent, "max_actions": max_actions,
@@ -67,6 +69,9 @@ def trial_task(
     }  # fmt: skip
     if misreport_kind:  # only then: the settings (and hashes) of every other task stay as they were
         settings["misreport_kind"] = True
+    if max_lockers is None:
+        store = _memory(settings["memory"], settings["memory_sha256"]) if memory else None
+        max_lockers = scene_max_lockers(spec, store, agent)
     if max_lockers != 1:  # likewise: a k = 1 task is the task it was before k existed
         settings["max_lockers"] = max_lockers
     if sim == "twin" and locks != "latch":  # a latch task is the task it was before mechanisms existed
