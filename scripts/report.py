@@ -9,7 +9,9 @@ sweep, one row per cell with its settings), figures (actions per run, success pe
 action), the videos and every run with a compact timeline: one block per action, as wide as its simulated time
 (twin runs; symbolic runs: equal blocks), coloured by the sensed outcome, marked where the sensed outcome
 disagrees with the simulator's truth. CSS, figures (inline SVG) and script are in the page, nothing is fetched
-from the network; videos are linked relative to the page, not inlined, so the page stays small.
+from the network; videos are linked relative to the page, not inlined, so the page stays small. A twin
+directory's page opens with the annotated top view of each box it ran (parts named, the goal ringed, lock features
+in their locker's colour), rendered once into ``DIR/gallery/<spec>/top-annotated.png`` and linked.
 
 ``--measure-load`` opens the written page in headless Chromium (if installed) and adds its load time (ms from
 navigation to the ``load`` event) to the output line. A DIR that is not a trial or sweep directory is refused
@@ -26,6 +28,7 @@ import time
 from pathlib import Path
 
 from puzzlebox.lab.cli import fail, one_line
+from puzzlebox.lab.report_gallery import write_top_views
 from puzzlebox.lab.report_html import ReportError, build_page, load_results_dir
 from puzzlebox.models.atomic import write_text_atomically
 
@@ -59,7 +62,7 @@ def main(argv: list[str] | None = None) -> int:
         fail(f"--out {page} is a directory: give a file name (FILE.html)")
     try:
         data = load_results_dir(directory)
-        text = build_page(data, page)
+        text = build_page(data, page, write_top_views(data))
         write_text_atomically(page, text)
     except ReportError as err:
         fail(str(err))

@@ -35,8 +35,16 @@ H.264 in yuv420p (:class:`twin.video.VideoWriter`, written atomically): browsers
 the cameras whose looks it shows.
 
 Rendering: MuJoCo's offscreen renderer without shadows or multisampling (on the CPU a shadowed, multisampled frame
-costs 10x a plain one). A frame whose bodies did not move since the previous one by more than
-:attr:`RolloutConfig.still` (under half a pixel) reuses its views.
+costs 10x a plain one), on the arm's links simplified for the video (:attr:`RolloutConfig.mesh_cell`,
+:func:`twin.mesh_lod.coarsen_meshes`: the xArm's 91 k triangles cost every view the same whether seen or not; the
+gripper, seen from centimetres, keeps all of its). A frame whose bodies did not move since the
+previous one by more than :attr:`RolloutConfig.still` (under half a pixel) reuses its views. The drawing process
+renders with two llvmpipe threads and hands frames to x264 from a thread of its own (:class:`_Encoder`).
+
+Cost (paper-test-0 under ``realistic``: ~98 s simulated, ~980 frames; 2026-11-28, a loaded 2-core machine): ~44 ms
+of CPU a frame (drawing ~33, x264 ~10; it was ~49 before the changes above, on the same machine at the same time),
+~7x the trial's own CPU. Twice the trial's wall time would leave ~16 ms of CPU a frame on two cores for rendering
+~1 Mpx and encoding it: out of reach for a CPU renderer at this size and rate (a GPU renders it in ~1 ms).
 """
 
 from __future__ import annotations
@@ -62,8 +70,9 @@ import numpy as np
 from puzzlebox.models.atomic import PublishedOnExit, write_text_atomically
 from puzzlebox.models.scene import BOX
 from puzzlebox.twin.errors import VideoError
+from puzzlebox.twin.mesh_lod import coarsen_meshes
 from puzzlebox.twin.rendering import pinhole_intrinsics, presentation_look
-from puzzlebox.twin.video import VideoWriter
+from puzzlebox.twin.video import X264_PRESETS, VideoWriter
 
 VIEWS = ("three-quarter", "overview", "wrist")
 """The tiled views: the large one on the left, then the right column top to bottom."""
@@ -74,6 +83,8 @@ ABORT = "abort"
 """Sent instead of a frame: the trial failed, the drawing process discards its video."""
 HIGHLIGHT_RGB = (1.0, 0.78, 0.1)
 """Colour [0-1] the part being tried is tinted towards (its plate, handle and lock features; not its marker)."""
+DRAW_THREADS = 2
+"""llvmpipe's rasterizer threads in the drawing process (``LP_NUM_THREADS``)."""
 BACKDROP_RGB = ((0.58, 0.63, 0.70), (0.46, 0.50, 0.56), (0.30, 0.31, 0.34))
 """Colours [0-1] of the backdrop's walls, ceiling and floor (lit as well as glowing: they look paler)."""
 
@@ -111,6 +122,12 @@ class RolloutConfig:
     lid_luminance: tuple[float, float] = (60.0, 200.0)
     """The band the mean luminance (Rec. 601 luma, 0-255) of the lid's pixels keeps in every view: neither
     washed out nor sunk in shade (:meth:`RolloutDrawer.lid_luminance`)."""
+    mesh_cell: float = 0.004
+    """Grid the video's copy of the arm's meshes is simplified on [m] (:func:`twin.mesh_lod.coarsen_meshes`; 0: as
+    modelled; the gripper is kept whole): 4 mm takes the xArm from 91 k to 70 k triangles (the links from 42 k
+    to 21 k)."""
+    preset: str = "veryfast"
+    """x264's preset (:data:`twin.video.X264_PRESETS`): its CPU per frame against the file's size."""
     still: float = 2e-4
     """Largest move of any body since the previous frame [m] (its origin, or a point 10 cm from it as it turns)
     under which a frame reuses the previous frame's views: 0.2 mm is under half a pixel in every view."""
@@ -121,6 +138,10 @@ class RolloutConfig:
         for name in ("main_size", "side_size"):
             if any(v < 16 or v % 2 for v in getattr(self, name)):
                 raise VideoError(f"{name} must be even and at least 16 px, got {getattr(self, name)}")
+        if self.mesh_cell < 0:
+            raise VideoError(f"mesh_cell must be 0 (meshes as modelled) or positive [m], got {self.mesh_cell}")
+        if self.preset not in X264_PRESETS:
+            raise VideoError(f"unknown x264 preset {self.preset!r}; presets: {list(X264_PRESETS)}")
         if self.three_quarter_margin < 1 or self.overview_margin < 1:
             raise VideoError("the margins must be at least 1 (the box in view)")
 
@@ -238,9 +259,18 @@ class RolloutDrawer:
         model.vis.quality.offsamples = 0  # the context's buffers are made here: no multisampling
         model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
         model.vis.global_.offheight = max(model.vis.global_.offheight, height)
+        if config.mesh_cell > 0:  # before the renderers upload the meshes
+            # the gripper keeps every triangle: the wrist camera sees it from centimetres, the three-quarter view
+            # from closest, and its thin shell folds on itself when clustered
+            carried = _meshes_in_subtree(model, int(model.camera(cameras.wrist).bodyid[0]))
+            coarsen_meshes(model, config.mesh_cell, [m for m in range(model.nmesh) if m not in carried])
+        side = mujoco.Renderer(model, config.side_size[1], config.side_size[0])  # a context: ~100 MB
         self.renderers = {
-            size: mujoco.Renderer(model, size[1], size[0]) for size in {config.main_size, config.side_size}
+            "three-quarter": mujoco.Renderer(model, config.main_size[1], config.main_size[0]),
+            "overview": side,
+            "wrist": side,
         }
+        """Each view's renderer (the overview and the wrist view share one)."""
         self.option = mujoco.MjvOption()
         self.option.geomgroup[3] = 0  # the lock mechanisms (their pins would show as grey rods)
         self._box_geoms = np.flatnonzero(
@@ -329,7 +359,7 @@ class RolloutDrawer:
         width, height = self.cameras.capture_size
         K = pinhole_intrinsics(self.model, self.model.camera(self.cameras.overview).id, width, height)
         u0, v0, u1, v1 = self.crop
-        scene = self.renderers[self.config.side_size].scene
+        scene = self.renderers["overview"].scene
         for k in range(2):
             gl = scene.camera[k]
             near = gl.frustum_near
@@ -367,12 +397,11 @@ class RolloutDrawer:
 
     def highlight(self, part: str) -> None:
         """Tint ``part`` (a spec name; "" for none) from now on."""
-        self.model.geom_rgba[:] = self._rgba
+        rgba = self._rgba.copy()
         geoms = self._parts.get(part)
         if geoms is not None and len(geoms):
-            rgba = self._rgba[geoms]
-            rgba[:, :3] = 0.35 * rgba[:, :3] + 0.65 * np.array(HIGHLIGHT_RGB)
-            self.model.geom_rgba[geoms] = rgba
+            rgba[geoms, :3] = 0.35 * rgba[geoms, :3] + 0.65 * np.array(HIGHLIGHT_RGB)
+        self.model.geom_rgba[:] = rgba
 
     def render_view(
         self, view: str, qpos: np.ndarray | None = None, segmentation: bool = False, lid_top: bool = False
@@ -384,7 +413,7 @@ class RolloutDrawer:
         if qpos is not None:
             self.pose(qpos)
         camera = {"overview": self.cameras.overview, "wrist": self.cameras.wrist}.get(view, self.free)
-        renderer = self.renderers[self.config.main_size if view == "three-quarter" else self.config.side_size]
+        renderer = self.renderers[view]
         if segmentation:
             renderer.enable_segmentation_rendering()
         try:
@@ -575,7 +604,7 @@ class RolloutDrawer:
         return plot
 
     def close(self) -> None:
-        for renderer in self.renderers.values():
+        for renderer in {id(r): r for r in self.renderers.values()}.values():
             renderer.close()
 
 
@@ -599,6 +628,12 @@ def _in_subtree(model: mujoco.MjModel, body: int, root: int) -> bool:
             return True
         body = int(model.body_parentid[body])
     return root == 0
+
+
+def _meshes_in_subtree(model: mujoco.MjModel, root: int) -> set[int]:
+    """The meshes drawn by geoms of ``root``'s subtree (bodies that move with it)."""
+    geoms = [g for g in range(model.ngeom) if _in_subtree(model, int(model.geom_bodyid[g]), root)]
+    return {int(model.geom_dataid[g]) for g in geoms if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH}
 
 
 def _backdrop(centre: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
@@ -643,7 +678,9 @@ def _serve(inbox, outbox) -> None:
     ``(model_path, cameras, config, path)`` then its frames then ``None`` (publish) or :data:`ABORT` (discard);
     ``None`` instead of a job ends the process. A failed job ends it too (its parent starts another)."""
     os.environ.setdefault("MUJOCO_GL", "egl")
-    os.environ["LP_NUM_THREADS"] = "1"  # one core for the drawing: the trial renders its cameras on the other
+    # Two rasterizer threads: while the trial runs they share its second core with x264; once it has ended (the
+    # drawing, ~30 ms a frame on the CPU, lags far behind the trial) they take both cores.
+    os.environ["LP_NUM_THREADS"] = str(DRAW_THREADS)
     current: dict[str, Any] = {"model": None, "video": None}
     _watch_parent(multiprocessing.parent_process(), current)
     while (job := inbox.get()) is not None:
@@ -667,12 +704,13 @@ def _draw_video(model_path: str, cameras: SceneCameras, config: RolloutConfig, p
     try:
         # no faststart: ffmpeg's second pass reopens the file by name, and would bring back one a dying trial's
         # watcher (_watch_parent) removed
-        with VideoWriter(path, fps=config.fps, preset="veryfast", faststart=False) as video:
+        with VideoWriter(path, fps=config.fps, preset=config.preset, faststart=False) as video, \
+                _Encoder(video) as encoder:  # fmt: skip
             current["video"] = video
             while (frame := inbox.get()) is not None:
                 if isinstance(frame, str):  # ABORT: the trial failed; publish nothing
                     raise VideoError("aborted by the trial")
-                video.append(drawer.draw(frame))
+                encoder.append(drawer.draw(frame))
                 c = frame.caption
                 index.append({"time": round(frame.time, 6), "action": c.action, "component": c.component,
                               "sensed": c.sensed, "truth": c.truth, "phase": c.phase, "previous": c.previous,
@@ -688,6 +726,41 @@ def _draw_video(model_path: str, cameras: SceneCameras, config: RolloutConfig, p
                "overview_crop": [round(v, 2) for v in drawer.crop], "frames": index}  # fmt: skip
     write_text_atomically(frames_path(path), json.dumps(sidecar, indent=1))
     return frames
+
+
+class _Encoder:
+    """Hands frames to a :class:`VideoWriter` from a thread of its own: writing a 3 MB frame into ffmpeg's pipe
+    waits on ffmpeg (the GIL released), and the next frame is drawn meanwhile. Leaving the ``with`` block waits
+    for the frames handed over; an error in the thread comes back from the next :meth:`append` or at the end."""
+
+    def __init__(self, video: VideoWriter, depth: int = 4) -> None:
+        self._video = video
+        self._frames: queue.Queue[np.ndarray | None] = queue.Queue(maxsize=depth)
+        self._error: BaseException | None = None
+        self._thread = threading.Thread(target=self._run, name="rollout-encoder", daemon=True)
+
+    def __enter__(self) -> _Encoder:
+        self._thread.start()
+        return self
+
+    def _run(self) -> None:
+        while (frame := self._frames.get()) is not None:
+            if self._error is None:
+                try:
+                    self._video.append(frame)
+                except BaseException as err:  # noqa: BLE001 (raised again in the drawing thread)
+                    self._error = err
+
+    def append(self, frame: np.ndarray) -> None:
+        if self._error is not None:
+            raise self._error
+        self._frames.put(frame)
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        self._frames.put(None)
+        self._thread.join()
+        if self._error is not None and exc_type is None:
+            raise self._error
 
 
 def _view_of(cameras: SceneCameras, camera: str) -> str:

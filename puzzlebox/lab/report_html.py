@@ -7,7 +7,9 @@
 script inline, nothing fetched from the network; videos are linked (``<video src>``, relative to the page), never
 inlined. Every string that comes from the data is escaped (:func:`html.escape`).
 
-The page holds a summary table (a sweep: one row per cell with its settings), the figures, the videos and every
+The page opens with the annotated top view of each box a twin directory ran (linked PNGs that
+:mod:`puzzlebox.lab.report_gallery` renders), then holds a summary table (a sweep: one row per cell with its
+settings), the figures, the videos and every
 run as a row (a twin run's with its box placement and reality profile) with a compact timeline: one block per
 action, named by the part it tried, coloured by the sensed outcome, as wide as the action's simulated time (twin
 runs; symbolic runs have no time: equal blocks), and a mark on each action whose sensed outcome (``moved``)
@@ -426,7 +428,9 @@ overflow:hidden;text-overflow:clip}
 .sample{position:relative;width:2em;height:14px;background:#666;vertical-align:middle}
 .ok{color:#2e7d32;font-weight:bold}.no{color:#c62828;font-weight:bold}.key{font-family:monospace;font-size:12px}
 .ended{color:#c62828;font-size:12px}figure{display:inline-block;margin:0 1em 1em 0;vertical-align:top}
-figure svg{max-width:100%;height:auto}video{max-width:640px;display:block}pre{background:#f7f7f7;padding:.5em;
+figure svg{max-width:100%;height:auto}figure.box img{width:560px;max-width:100%;height:auto;display:block}
+figure.many img{width:360px}figure.box figcaption{max-width:560px}figure.many figcaption{max-width:360px}
+video{max-width:640px;display:block}pre{background:#f7f7f7;padding:.5em;
 overflow:auto;max-height:20em}.muted{color:#777}
 """
 
@@ -449,8 +453,22 @@ def legend() -> str:
     )
 
 
-def build_page(data: ResultsDir, page: Path) -> str:
-    """The whole page (a string) for ``data``, its links relative to ``page`` (where it will be written)."""
+def top_views_html(top_views: dict[str, Path], page: Path) -> str:
+    """The boxes' annotated top views (:mod:`puzzlebox.lab.report_gallery`), linked, each captioned by its spec."""
+    size = "box" if len(top_views) == 1 else "box many"  # several boxes: side by side, smaller
+    figures = [
+        f'<figure class="{size}"><img src="{href(path, page)}" alt="annotated top view of {esc(name)}">'
+        f"<figcaption>{esc(name)}: parts named, the goal ringed, each lock feature in its locker's colour"
+        "</figcaption></figure>"
+        for name, path in top_views.items()
+    ]
+    return '<h2 id="boxes">The box' + ("es" if len(figures) > 1 else "") + "</h2>" + "".join(figures)
+
+
+def build_page(data: ResultsDir, page: Path, top_views: dict[str, Path] | None = None) -> str:
+    """The whole page (a string) for ``data``, its links relative to ``page`` (where it will be written); with
+    ``top_views`` (spec name -> annotated top view, :func:`puzzlebox.lab.report_gallery.write_top_views`) they open
+    the page."""
     config = data.config
     title = f"{data.kind} report: {data.path.resolve().name}"
     what = []
@@ -471,6 +489,7 @@ def build_page(data: ResultsDir, page: Path) -> str:
         f"<h1>{esc(title)}</h1>",
         f'<p class="muted">{esc(data.path)} &middot; {esc(", ".join(str(w) for w in what))} &middot; '
         f"{len(data.runs)} run(s)</p>",
+        top_views_html(top_views, page) if top_views else "",
         '<h2 id="summary">Summary</h2>',
         summary_table(data),
     ]

@@ -13,6 +13,7 @@ from html.parser import HTMLParser
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
+import imageio.v3 as iio
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -151,6 +152,7 @@ def test_a_symbolic_trial_report_shows_every_run_with_one_block_per_action(made)
     assert "summary" in parsed.tables
     text = page.read_text()
     assert "success rate" in text and "100.0%" in text
+    assert "<img" not in text and not (made / "trial" / "gallery").exists(), "a symbolic trial renders no picture"
 
 
 def test_a_30_run_sweep_report_has_a_row_per_cell_and_every_run_under_its_cell(made):
@@ -241,6 +243,15 @@ def test_a_twin_trial_report_links_its_video_and_draws_its_timeline(made, tmp_pa
     check_timelines(parsed, runs)
     videos = [link for tag, link in parsed.links if tag == "video"]
     assert videos == ["rollout.mp4"]
+    # the page opens with the box's annotated top view: a PNG beside the run, linked before the summary
+    text = page.read_text()
+    assert [link for tag, link in parsed.links if tag == "img"] == ["gallery/paper-test-0/top-annotated.png"]
+    assert text.index("<img") < text.index('id="summary"')
+    top = iio.imread(out / "gallery/paper-test-0/top-annotated.png")
+    assert top.shape[1] == 640 and top.shape[0] > 480  # the view, and the legend of lock rules below it
+    stamp = (out / "gallery/paper-test-0/top-annotated.png").stat().st_mtime_ns
+    ok(script("report.py", out, "--out", tmp_path / "again.html"))
+    assert (out / "gallery/paper-test-0/top-annotated.png").stat().st_mtime_ns == stamp, "drawn once, then reused"
     assert page.stat().st_size < (out / "rollout.mp4").stat().st_size, "the video is linked, not inlined"
     text = page.read_text()
     assert "outcome agreement" in text and "Peak wrist force per action" in text
