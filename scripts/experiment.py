@@ -6,7 +6,7 @@ the reality gap in the twin.
     python scripts/experiment.py reality --out DIR [--quick] [--runs R] [--memory MEM.sqlite] [--workers W | --ray ...]
     python scripts/experiment.py faults --out DIR [--quick] [--runs R]
     python scripts/experiment.py twin-learning --out DIR [--quick] [--runs R] [--seeds S] [--workers W | --ray ...]
-                                 [--agents memory,dqn,model-based]
+                                 [--agents memory,dqn,model-based] [--test-set paper|hard]
     python scripts/experiment.py sysid --out DIR [--workers W] [--cells 0,1,2] [--quick]
     python scripts/experiment.py disassembly --agents memory,dual,dqn,model-based --out DIR [--quick] [--runs R]
                                  [--seeds S] [--workers W | --ray ...] [--validation] [--no-holding-rule]
@@ -33,6 +33,12 @@ alone over σ; each profile's cell is calibrated from ChArUco images first. It w
 factor's level; the F/T noise at which outcome agreement drops below 99 %) and keeps every calibration and
 trial in ``DIR/calibrations/`` and ``DIR/trials/``: the same command resumes. ``--memory`` is the memory
 agent's store (default: trained into ``DIR/memory.sqlite`` on the paper training boxes).
+
+``twin-learning`` (``puzzlebox/lab/twin_learning.py``) measures the memory agent in the twin after 0-2 simulated
+robot hours from an empty memory, a symbolic one, and a symbolic one with twin experience:
+``DIR/twin-learning.{json,md,png}``, the test boxes' optimum beside every figure. ``--test-set hard`` tests on
+eight-part boxes of every kind (random, multi-locker, chains: ``puzzlebox/lab/hard_sets.py``) held out from training
+on boxes of the same families.
 
 ``sysid`` (``puzzlebox/lab/sysid.py``) identifies the box's per-kind joint damping, joint friction and latch
 compliance from logged robot data of toggles (oracle trials in the twin under ``realistic``, three cells) and
@@ -74,6 +80,7 @@ from puzzlebox.lab.errors import ExperimentStepFailed, LabError
 from puzzlebox.lab.experiment_flags import AGENTS, PROTOCOL_NAMES, ExperimentFlags
 from puzzlebox.lab.experiment_protocols import run_experiment
 from puzzlebox.lab.interrupt import AbortOnSignal, Interrupted
+from puzzlebox.lab.learning_boxes import TEST_SETS
 from puzzlebox.learning.agents.factory import POSE_ENCODINGS
 
 
@@ -106,6 +113,7 @@ def main(argv: list[str] | None = None) -> int:
     )  # fmt: skip
     parser.add_argument("--steps", type=int, default=None, help="manipulation: env steps per run (default 60000)")
     parser.add_argument("--algo", default=None, help="manipulation: ppo (default) or sac")
+    parser.add_argument("--test-set", choices=TEST_SETS, default=None, help="twin-learning: paper (default) or hard")
     args = parser.parse_args(argv)
     try:  # SIGINT or SIGTERM, whatever this process inherited: stop now, in one line; every saved job is kept
         with AbortOnSignal():

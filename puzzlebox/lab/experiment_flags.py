@@ -55,6 +55,7 @@ class ExperimentFlags:
     no_holding_rule: bool = False
     steps: int | None = None
     algo: str | None = None
+    test_set: str | None = None
 
     def check(self) -> None:
         """The flags that belong to one protocol only are not given to another; sizes are bounded."""
@@ -68,6 +69,8 @@ class ExperimentFlags:
             raise ExperimentSettingsError("--validation and --no-holding-rule go with the disassembly protocol")
         if (self.steps is not None or self.algo is not None) and self.protocol != MANIPULATION:
             raise ExperimentSettingsError("--steps and --algo go with the manipulation protocol")
+        if self.test_set is not None and self.protocol != TWIN_LEARNING:
+            raise ExperimentSettingsError("--test-set goes with the twin-learning protocol")
 
     def agent_names(self, available: tuple[str, ...]) -> list[str]:
         """The ``--agents`` of a protocol that needs them, each one of ``available``."""

@@ -79,7 +79,8 @@ def run_twin_learning(flags: ExperimentFlags, echo: Echo = print) -> None:
             "the twin-learning protocol runs the memory agent from its own memories (no --memory)"
         )
     flags.check_workers()
-    config = TwinLearningConfig().quick() if flags.quick else TwinLearningConfig()
+    config = TwinLearningConfig().hard() if flags.test_set == "hard" else TwinLearningConfig()
+    config = config.quick() if flags.quick else config
     if flags.agents is not None:  # the memory's curve always; the deep agents asked for beside it
         agents = [a.strip() for a in flags.agents.split(",") if a.strip()]
         unknown = [a for a in agents if a not in ("memory", *DEEP_AGENTS)]
@@ -88,6 +89,9 @@ def run_twin_learning(flags: ExperimentFlags, echo: Echo = print) -> None:
                 f"twin-learning --agents: memory and any of {list(DEEP_AGENTS)}, got {agents}"
             )
         config = replace(config, deep_agents=tuple(a for a in agents if a != "memory"))
+        if config.deep_agents and config.test_set != "paper":
+            raise ExperimentSettingsError("twin-learning --test-set hard runs the memory agent only (the deep agents "
+                                          "are trained on the paper's boxes): --agents memory")  # fmt: skip
     config = flags.with_seeds(flags.with_runs(config, "placements", 1), "seeds", as_range=True)
     out = flags.out_dir()
     flags.write_config(out, TWIN_LEARNING, twin_learning=asdict(config))

@@ -10,6 +10,12 @@ starts:
   time: what simulation is worth before a robot touches a box;
 - ``symbolic+twin``: that symbolic memory, then experience in the twin.
 
+With ``--test-set hard`` (:attr:`TwinLearningConfig.test_set`) the test boxes are the hard sets of
+:mod:`puzzlebox.lab.hard_sets` (eight parts of every kind: random, multi-locker and chains, ``test_boxes`` of each
+family), and training runs on generated boxes of the same families with other seeds
+(:mod:`puzzlebox.lab.learning_boxes`); the multi-locker boxes are tried with a belief over sets of up to two lockers.
+Every figure carries the test boxes' optimum beside it.
+
 Each start is run for every training seed (the spread in the plot). Beside them, the deep agents
 (``dqn``, ``model-based``: ``deep_agents``) trained to convergence in the symbolic simulator (the paper
 protocols' 650 episodes on the 9 training variants, one network per training seed) run the same test trials:
@@ -38,19 +44,30 @@ from typing import Any, cast
 
 from puzzlebox.lab.cli import write_json
 from puzzlebox.lab.deep_protocols_run import job_task
+from puzzlebox.lab.learning_boxes import LearningBox, test_boxes, training_boxes
+from puzzlebox.lab.learning_optimum import family_table, with_optimum
 from puzzlebox.lab.reality_sweep import calibration_task
 from puzzlebox.lab.runner import RecordStore, Task, make_executor, run_tasks
 from puzzlebox.lab.trial_task import trial_task
 from puzzlebox.lab.twin_training import TwinTraining
 from puzzlebox.learning import MemoryAgent, SymbolicWorld, run_episode, summarise
+from puzzlebox.learning.dual_controller import DualControllerConfig
 from puzzlebox.learning.experiments.deep_protocols import TrainingJob, job_key
 from puzzlebox.learning.experiments.protocol import ProtocolConfig
 from puzzlebox.learning.memory import MemoryStore
+from puzzlebox.models import PuzzleSpec
 from puzzlebox.models.atomic import apply_umask
 from puzzlebox.models.calibration import CellCalibration
 from puzzlebox.models.generator import TRAIN_INDICES, paper_family
+from puzzlebox.models.spec_loading import spec_from_dict
 from puzzlebox.twin.reality import RealityProfile, load_profile
 
+HARD_TEST_BOXES = 2
+"""Test boxes of each hard family in ``--test-set hard`` (x 3 families x ``placements``, at every checkpoint)."""
+HARD_TRAIN_BOXES = 40
+"""Training boxes of each hard family, chosen on validation boxes (seeds 5000-5009, never the test boxes), symbolic,
+3 seeds each: 20 of each took 1.20 / 1.29 / 1.14 x the optimum on random / multi-locker / chain boxes, 40 of each
+1.09 / 1.19 / 1.08 (``runs/s4/hard-sets/symbolic_val.py``)."""
 STARTS = ("empty", "symbolic", "symbolic+twin")
 """Where a learning curve starts (see the module docstring)."""
 PAPER_ROBOT = {0.0: 26.0, 0.5: 10.0, 1.0: 8.8}
@@ -72,8 +89,13 @@ class TwinLearningConfig:
     """Training seeds (each start is run once per seed)."""
     placements: int = 2
     """Random reachable placements of each test box, per checkpoint."""
+    test_set: str = "paper"
+    """``paper`` (the paper's test boxes, training on its 9 training boxes) or ``hard`` (the hard sets, training on
+    generated boxes of their families: :mod:`puzzlebox.lab.learning_boxes`)."""
     test_boxes: int = 3
-    """How many of the paper test boxes are measured (all three but in CI)."""
+    """How many of the paper test boxes are measured (all three but in CI); with ``hard``, boxes of each family."""
+    train_boxes: int = 9
+    """With ``hard``: training boxes of each family (the paper's are its 9)."""
     symbolic_episodes: int = 9
     """Episodes of symbolic training of the ``symbolic`` starts (one per training box)."""
     max_actions: int = 30
@@ -92,9 +114,21 @@ class TwinLearningConfig:
 
     def quick(self) -> TwinLearningConfig:
         """CI size: checkpoints at 0 and 0.02 h, one seed, one placement of one test box, 8 actions; DQN
-        trained 10 episodes."""
+        trained 10 episodes. With ``hard``: one box of each family, 16 actions, 2 training boxes of each family,
+        no deep agent."""
+        if self.test_set == "hard":
+            return dataclasses.replace(self, hours=(0.0, 0.02), seeds=(0,), placements=1, max_actions=16,
+                                       test_boxes=1, train_boxes=2, symbolic_episodes=6)  # fmt: skip
         return dataclasses.replace(self, hours=(0.0, 0.02), seeds=(0,), placements=1, max_actions=8, test_boxes=1,
                                    deep_agents=("dqn",), deep_episodes=10, deep_eval_runs=1)  # fmt: skip
+
+    def hard(self) -> TwinLearningConfig:
+        """The hard test sets (module docstring): HARD_TEST_BOXES boxes of each family, HARD_TRAIN_BOXES training
+        boxes of each, each once symbolically, a 40-action budget (a chain of 8 takes 8 at best), checkpoints at 0,
+        0.5 and 1 h (the paper's robot's), no deep agent (theirs are trained on the paper's boxes)."""
+        return dataclasses.replace(self, test_set="hard", test_boxes=HARD_TEST_BOXES, train_boxes=HARD_TRAIN_BOXES,
+                                   symbolic_episodes=3 * HARD_TRAIN_BOXES, max_actions=40, hours=(0.0, 0.5, 1.0),
+                                   deep_agents=())  # fmt: skip
 
     def starts(self) -> tuple[str, ...]:
         return STARTS
@@ -114,12 +148,14 @@ def _snapshot(store_path: Path, target: Path) -> None:
             os.unlink(name)
 
 
-def _symbolic_training(store: MemoryStore, seed: int, episodes: int, max_actions: int) -> None:
-    """The ``symbolic`` starts' memory: ``episodes`` symbolic episodes on the training boxes (seeded by ``seed``)."""
-    train = paper_family("train", seed=0)
+def _symbolic_training(
+    store: MemoryStore, seed: int, episodes: int, max_actions: int, train: list[PuzzleSpec], lockers: list[int]
+) -> None:
+    """The ``symbolic`` starts' memory: ``episodes`` symbolic episodes on the training boxes ``train`` (box ``i``
+    with a belief over up to ``lockers[i]`` lockers a part), seeded by ``seed``."""
     for e in range(episodes):
-        spec = train[e % len(train)]
-        agent = MemoryAgent(store, learn=True)
+        spec, k = train[e % len(train)], lockers[e % len(train)]
+        agent = MemoryAgent(store, learn=True, config=DualControllerConfig(max_lockers=k) if k != 1 else None)
         agent.episode_label, agent.episode_seed = spec.name, 1000 * seed + e
         run_episode(agent, SymbolicWorld(spec, 1000 * seed + e), spec.name, 1000 * seed + e, max_actions)
 
@@ -137,20 +173,23 @@ def training_chain(settings: dict[str, Any], context: dict[str, Any]) -> dict[st
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"{start}-s{seed}.sqlite"
     store = MemoryStore(path)
+    # the paper's training boxes unless the chain was given its own (--test-set hard; its settings then name them)
+    train = [spec_from_dict(d) for d in settings["train"]] if "train" in settings else paper_family("train", seed=0)
+    lockers = settings.get("train_max_lockers", [1] * len(train))
     try:
         if start != "empty" and store.num_episodes == 0:
-            _symbolic_training(store, seed, settings["symbolic_episodes"], settings["max_actions"])
+            _symbolic_training(store, seed, settings["symbolic_episodes"], settings["max_actions"], train, lockers)
         twin = TwinTraining(RealityProfile.from_dict(settings["reality"]),
                             CellCalibration.from_dict(settings["calibration"]))  # fmt: skip
-        train = paper_family("train", seed=0)
         hours = [0.0] if start == "symbolic" else sorted(settings["hours"])
         checkpoints, skipped, runs = [], [], []
         for h in hours:
             while _provenance(store)["twin"]["robot_hours"] < h:
                 # (resumed: the episodes stored are not run again; one the cell could not run stores nothing)
                 e = _provenance(store)["twin"]["episodes"] + len(skipped)
-                spec = train[e % len(train)]
-                agent = MemoryAgent(store, learn=True, config=twin.controller)
+                spec, k = train[e % len(train)], lockers[e % len(train)]
+                controller = twin.controller if k == 1 else dataclasses.replace(twin.controller, max_lockers=k)
+                agent = MemoryAgent(store, learn=True, config=controller)
                 episode_seed = settings["train_seed"] + 1000 * seed + e
                 agent.episode_label, agent.episode_seed = spec.name, episode_seed
                 before = store.num_episodes
@@ -184,13 +223,17 @@ def run_twin_learning(
     """
     out.mkdir(parents=True, exist_ok=True)
     reality = load_profile(config.profile)
-    tests = paper_family("test", seed=0)[: config.test_boxes]
+    tests = test_boxes(config.test_set, config.test_boxes, out / "specs")
+    train: list[LearningBox] = []
+    if config.test_set != "paper":  # (the paper's chains keep the settings they had: their records resume)
+        train = training_boxes(config.test_set, config.train_boxes, out / "specs")
     begin = time.perf_counter()
     phases: dict[str, float] = {}
     deep_records: dict[str, Any] = {}
     with make_executor(workers, ray) as executor:
+        board = paper_family("test", seed=0)[0]  # the cell is calibrated once, whatever box it then meets
         calibrations = run_tasks([Task(reality.name, calibration_task,
-                                       {"spec": tests[0].to_dict(), "profile": reality.to_dict()})],
+                                       {"spec": board.to_dict(), "profile": reality.to_dict()})],
                                  RecordStore(out / "calibrations"), executor, desc="calibration")  # fmt: skip
         calibrations.raise_for_failures()
         calibration = calibrations.records[reality.name]["calibration"]
@@ -200,6 +243,8 @@ def run_twin_learning(
                 "start": start, "seed": seed, "hours": list(config.hours), "reality": reality.to_dict(),
                 "calibration": calibration, "symbolic_episodes": config.symbolic_episodes,
                 "max_actions": config.max_actions, "train_seed": config.train_seed,
+                **({"train": [b.spec.to_dict() for b in train],
+                    "train_max_lockers": [b.max_lockers for b in train]} if train else {}),
             }, context={"dir": str(memories)})
             for start in STARTS for seed in config.seeds
         ]  # fmt: skip
@@ -217,23 +262,23 @@ def run_twin_learning(
         for chain in chains:
             record = trained.records[chain.key]
             for checkpoint in record["checkpoints"]:
-                for spec in tests:
+                for box in tests:
                     for placement in range(config.placements):
-                        key = f"{chain.key}@{checkpoint['hours']:g}h-{spec.name}-p{placement}"
+                        key = f"{chain.key}@{checkpoint['hours']:g}h-{box.spec.name}-p{placement}"
                         trials.append(trial_task(
-                            key, spec, config.eval_seed + placement, sim="twin", agent="memory",
+                            key, box.spec, config.eval_seed + placement, sim="twin", agent="memory",
                             max_actions=config.max_actions, memory=str(memories / checkpoint["memory"]),
-                            reality=reality.to_dict(), calibration=calibration,
+                            reality=reality.to_dict(), calibration=calibration, max_lockers=box.max_lockers,
                         ))  # fmt: skip
                         where[key] = (record["start"], record["seed"], checkpoint["hours"])
         for job in deep_jobs:
             record = deep_records[job.key]
             agent, seed = job.settings["job"]["agent"], job.settings["job"]["seed"]
-            for spec in tests:
+            for box in tests:
                 for placement in range(config.placements):
-                    key = f"{job.key}-{spec.name}-p{placement}"
+                    key = f"{job.key}-{box.spec.name}-p{placement}"
                     trials.append(trial_task(
-                        key, spec, config.eval_seed + placement, sim="twin", agent=agent,
+                        key, box.spec, config.eval_seed + placement, sim="twin", agent=agent,
                         max_actions=config.max_actions, checkpoint=str(out / "deep" / "jobs" / record["checkpoint"]),
                         reality=reality.to_dict(), calibration=calibration,
                     ))  # fmt: skip
@@ -243,6 +288,7 @@ def run_twin_learning(
         measured.raise_for_failures()
         phases["test_trials_s"] = time.perf_counter() - begin - sum(phases.values())
     summary = _summary(config, reality.name, trained.records, measured.records, where, deep_records)
+    summary = with_optimum(summary, measured.records, where, tests, config.max_actions)
     summary["wall_time_s"] = time.perf_counter() - begin
     summary["wall_time_by_phase_s"] = phases
     write_json(out / "twin-learning.json", summary)
@@ -320,25 +366,36 @@ def _training_outcomes(chains: dict[str, Any]) -> dict[str, Any]:
 
 def markdown(summary: dict[str, Any]) -> str:
     config = summary["config"]
+    paper_set = config.get("test_set", "paper") == "paper"
+    boxes = (
+        "on the paper training boxes at random placements, measured on the unseen test boxes"
+        if paper_set
+        else f"on generated eight-part boxes ({config['train_boxes']} of each hard family) at random placements, "
+        f"measured on the held-out hard sets ({config['test_boxes']} boxes of each family)"
+    )
     lines = [
         "# Learning in the twin: the paper's robot learning curve, closed in simulation",
         "",
-        f"The memory agent trained end to end in the twin (`{summary['profile']}` profile) on the paper training "
-        f"boxes at random placements, measured on the unseen test boxes ({config['placements']} random placements "
-        f"each, {config['max_actions']} actions per trial), mean and spread over {len(config['seeds'])} training "
-        "seed(s).",
+        f"The memory agent trained end to end in the twin (`{summary['profile']}` profile) {boxes} "
+        f"({config['placements']} random placements each, {config['max_actions']} actions per trial), mean and "
+        f"spread over {len(config['seeds'])} training seed(s).",
         "",
-        "| start | robot hours | solved | mean actions | paper (real robot) |",
-        "|---|---|---|---|---|",
+        "| start | robot hours | solved | mean actions | optimum | ratio | peak force [N] | paper (real robot) |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for p in summary["points"]:
-        paper = PAPER_ROBOT.get(p["hours"]) if p["start"] == "empty" else p.get("paper_robot")
+        paper = (PAPER_ROBOT.get(p["hours"]) if p["start"] == "empty" else p.get("paper_robot")) if paper_set else None
         start = f"{p['start']} ({p['training_episodes']} symbolic episodes)" if p.get("deep") else p["start"]
+        optimum = f"{p['optimum']:.2f} | {p['ratio_to_optimum']:.2f}" if "optimum" in p else "- | -"
+        force = f"{p['peak_true_wrist_force_n']:.1f}" if p.get("peak_true_wrist_force_n") is not None else "-"
         lines.append(
             f"| {start} | {p['hours']:g} | {p['success_rate']:.1%} ± {p['success_rate_std']:.1%} "
-            f"| {p['mean_actions']:.2f} ± {p['mean_actions_std']:.2f} | {'-' if paper is None else paper} |"
+            f"| {p['mean_actions']:.2f} ± {p['mean_actions_std']:.2f} | {optimum} | {force} "
+            f"| {'-' if paper is None else paper} |"
         )
-    lines += ["", f"The paper's robot in its final trials: {PAPER_FINAL} actions.", ""]
+    lines += ["", *family_table(summary)]
+    if paper_set:
+        lines += [f"The paper's robot in its final trials: {PAPER_FINAL} actions.", ""]
     for start, t in summary.get("training", {}).items():
         reasons = "; ".join(f"{why} x{n}" for why, n in sorted(t["ended"].items(), key=lambda kv: -kv[1]))
         lines += [f"Training in the twin, `{start}`: {t['solved']} of {t['episodes']} episodes solved"
@@ -375,15 +432,20 @@ def plot(summary: dict[str, Any], path: Path) -> None:
             axes[0].plot([hours[-1]], [p["paper_robot"]], "kx", markersize=8)
             axes[0].annotate(f"paper {p['start']}", (hours[-1], p["paper_robot"]), fontsize=7,
                              textcoords="offset points", xytext=(-40, 4))  # fmt: skip
-    axes[0].plot(list(PAPER_ROBOT), list(PAPER_ROBOT.values()), "k*", markersize=10, label="paper, real robot")
-    axes[0].axhline(PAPER_FINAL, color="k", linestyle=":", linewidth=1, label="paper, final trials")
+    optimum = [p["optimum"] for p in summary["points"] if "optimum" in p]
+    if optimum:
+        axes[0].axhline(optimum[0], color="C2", linestyle="-.", linewidth=1, label="optimum (test boxes' mean)")
+    if summary["config"].get("test_set", "paper") == "paper":  # the paper's robot met the paper's boxes only
+        axes[0].plot(list(PAPER_ROBOT), list(PAPER_ROBOT.values()), "k*", markersize=10, label="paper, real robot")
+        axes[0].axhline(PAPER_FINAL, color="k", linestyle=":", linewidth=1, label="paper, final trials")
     axes[0].set_ylabel("mean actions (unsolved count the budget)")
     axes[1].set_ylabel("solved [-]")
     for ax in axes:
         ax.set_xlabel("simulated robot experience [h]")
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8)
-    fig.suptitle(f"learning in the twin ({summary['profile']})")
+    test_set = summary["config"].get("test_set", "paper")
+    fig.suptitle(f"learning in the twin ({summary['profile']}, {test_set} test set)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

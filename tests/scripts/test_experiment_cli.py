@@ -167,6 +167,16 @@ def test_quick_twin_learning_trains_each_start_in_the_twin_measures_its_checkpoi
         assert bad.returncode == 2 and words in bad.stderr and "Traceback" not in bad.stderr, bad.stderr
 
 
+def test_the_hard_test_set_goes_with_twin_learning_and_its_memory_agent_only(tmp_path):
+    for args, words in (
+        (("variants", "--agents", "memory", "--test-set", "hard"), "--test-set goes with the twin-learning protocol"),
+        (("twin-learning", "--test-set", "hard", "--agents", "memory,dqn"), "runs the memory agent only"),
+    ):
+        bad = experiment(*args, "--out", tmp_path / "out")
+        assert bad.returncode == 2 and words in bad.stderr and "Traceback" not in bad.stderr, bad.stderr
+    assert not (tmp_path / "out").exists()  # refused before any work
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [
