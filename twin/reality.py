@@ -206,7 +206,8 @@ class ArmReality:
     stall_rate: float = 0.0
     """Rate of command stalls (the controller stops taking commands for :attr:`stall_duration`) [1/s]."""
     stall_duration: float = 0.0
-    """Length of a command stall [s]: a command sent during one takes effect when it ends."""
+    """Length of a command stall [s]: a command sent during one is held until it ends, then the held commands
+    take effect in order, one per controller cycle (:data:`~twin.servos.CONTROLLER_CYCLE`)."""
     tcp_bias: float = 0.0
     """Length of the offset of the true TCP (the physical gripper) from the one the arm's kinematics
     report, fixed in the flange frame [m] (fixed per cell)."""

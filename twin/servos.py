@@ -5,8 +5,13 @@ Joint commands wait in a queue keyed by the physics step at which they take effe
 rounded up to whole steps: never shorter than the profile's, and 5 ms at 2 ms steps is 6 ms, where
 Python's half-to-even ``round`` would make it 4 ms); the session steps up to each one and writes it to
 the servos. Stalls are a Poisson process (``stall_rate``) of windows ``stall_duration`` long: a command
-sent during one takes effect when it ends. Gripper commands take effect at once (the gripper has its
-own controller). With no latency and no stalls a command is written immediately, as to an ideal servo.
+sent during one is held until it ends, and the backlog a stall leaves is then taken in order, one command
+per controller cycle (:data:`CONTROLLER_CYCLE`): the first at the stall's end, the last (backlog - 1) cycles
+later, as a controller that resumes works through the commands it received (writing them all at once would
+jump the arm to the last one in one physics step and saturate the wrist servos). A command sent while a
+backlog drains waits its turn behind it. Outside stalls and their backlogs a command waits its latency only.
+Gripper commands take effect at once (the gripper has its own controller). With no latency and no stalls a
+command is written immediately, as to an ideal servo.
 """
 
 from __future__ import annotations
@@ -19,6 +24,10 @@ import mujoco
 import numpy as np
 
 from puzzlebox.twin.reality import ArmReality
+
+CONTROLLER_CYCLE = 0.004
+"""The arm controller's servo cycle [s]: it takes at most one joint command per cycle (the xArm's servo mode
+runs at 250 Hz, REALITY_NOTES.md §2 "command / feedback rate", U12: xArm-Python-SDK#5)."""
 
 
 def _whole_steps(seconds: float, timestep: float) -> int:
@@ -40,6 +49,7 @@ class Servos:
         self.latency_steps = _whole_steps(config.command_latency, timestep)
         self._stall_steps = _whole_steps(config.stall_duration, timestep) if config.stall_rate > 0 else 0
         self._stall_rate = config.stall_rate
+        self.cycle_steps = max(1, _whole_steps(CONTROLLER_CYCLE, timestep))
 
     @property
     def immediate(self) -> bool:
@@ -52,6 +62,7 @@ class Servos:
         self._rng = rng
         self._queue: collections.deque[tuple[int, np.ndarray]] = collections.deque()
         self._stall_start = self._next_stall(0) if self._stall_steps else None
+        self._backlog_free = 0  # the first step at which a stall's backlog can take its next command
 
     def _next_stall(self, after: int) -> int:
         return after + max(1, math.ceil(self._rng.exponential(1.0 / self._stall_rate) / self._dt))
@@ -63,13 +74,18 @@ class Servos:
             return
         now = self._step()
         due = now + self.latency_steps
+        held = False  # by a stall or the backlog one left: then it takes a controller cycle of its own
         if self._stall_start is not None:
             while self._stall_start + self._stall_steps <= now:  # stalls already over
                 self._stall_start = self._next_stall(self._stall_start + self._stall_steps)
-            if self._stall_start <= now:
-                due = max(due, self._stall_start + self._stall_steps)
+            if self._stall_start <= now and self._stall_start + self._stall_steps > due:
+                due, held = self._stall_start + self._stall_steps, True
+        if due < self._backlog_free:
+            due, held = self._backlog_free, True
         if self._queue:
             due = max(due, self._queue[-1][0])  # a controller keeps the order of its commands
+        if held:
+            self._backlog_free = due + self.cycle_steps
         self._queue.append((due, np.array(q, dtype=float)))
         self.apply_due()
 
@@ -92,9 +108,11 @@ class Servos:
             "rng": self._rng.bit_generator.state,
             "queue": [(due, q.copy()) for due, q in self._queue],
             "stall_start": self._stall_start,
+            "backlog_free": self._backlog_free,
         }
 
     def set_state(self, state: dict[str, Any]) -> None:
         self._rng.bit_generator.state = state["rng"]
         self._queue = collections.deque((due, q.copy()) for due, q in state["queue"])
         self._stall_start = state["stall_start"]
+        self._backlog_free = state["backlog_free"]
