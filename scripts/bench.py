@@ -1,6 +1,6 @@
 """Speed figures, measured in one run on this machine (ratios matter more than absolutes here).
 
-    python scripts/bench.py --out FILE [--quick] [--scale-trials T] [--only manipulation]
+    python scripts/bench.py --out FILE [--quick] [--scale-trials T] [--only manipulation|soak] [--trials T]
 
 - agent decision latency: median and 90th percentile milliseconds per dual-controller decision on
   random lock graphs of N = 5, 10, 16, 32 components (beliefs as they evolve during real episodes;
@@ -22,7 +22,10 @@
 - scale (``puzzlebox/lab/bench_scale.py``): each executor's overhead per no-op task, and twin trials per hour of
   the same T oracle trials on one worker, on a local pool (one worker per core) and on a local Ray cluster,
   one after the other in this run, with each one's speed-up over one worker: start-up included, and warm
-  (after one trial per worker).
+  (after one trial per worker);
+- soak (``puzzlebox/lab/bench_soak.py``, ``--only soak [--trials T]``, alone): T twin trials (default 200) of varied
+  boxes under ``realistic`` in this process, the resident memory after each, and whether the one after the last is
+  within 50 MB of the one after trial 20 (the file is rewritten after every trial: a stopped soak keeps its curve).
 Single-threaded numpy is enforced for the agent figures (one core).
 """
 
@@ -43,11 +46,31 @@ from puzzlebox.lab.bench_figures import (  # noqa: E402
     measured_figures,
     scale_figures,
 )
+from puzzlebox.lab.bench_soak import SoakConfig, SoakPoint, soak_points, soak_verdict  # noqa: E402
 from puzzlebox.lab.cli import fail, one_line, write_json  # noqa: E402
 from puzzlebox.lab.errors import RunStoreError  # noqa: E402
 from puzzlebox.lab.out_lock import OutputLock  # noqa: E402
 
 MAX_SCALE_TRIALS = 10_000
+
+
+def soak(out: Path, results: dict, config: SoakConfig) -> Path:
+    """Run the soak, printing a line and rewriting ``out`` after every trial; then the verdict."""
+    points: list[SoakPoint] = []
+
+    def keep(point: SoakPoint) -> None:
+        points.append(point)
+        print(f"soak trial {point.trial}: {point.spec} seed {point.seed} solved={point.solved} "
+              f"{point.wall_s:.1f} s, resident {point.rss_mb:.1f} MB", flush=True)  # fmt: skip
+        write_json(out, {**results, "soak": soak_verdict(points, config)})
+
+    soak_points(config, keep)
+    verdict = soak_verdict(points, config)
+    if verdict["holds"] is not None:
+        print(f"soak: resident {verdict['reference_rss_mb']:.1f} MB after trial {config.reference}, "
+              f"{verdict['last_rss_mb']:.1f} MB after trial {len(points)} ({verdict['growth_mb']:+.1f} MB; bound "
+              f"{config.bound_mb:g} MB: {'holds' if verdict['holds'] else 'DOES NOT HOLD'})")  # fmt: skip
+    return write_json(out, {**results, "soak": verdict})
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -58,15 +81,23 @@ def main(argv: list[str] | None = None) -> int:
         "--scale-trials", type=int, default=None,
         help="twin trials per executor for the scale figures (default 40; --quick 4; 0 skips them)",
     )  # fmt: skip
-    parser.add_argument("--only", choices=("manipulation",), help="measure these figures alone")
+    parser.add_argument("--only", choices=("manipulation", "soak"), help="measure these figures alone")
+    parser.add_argument("--trials", type=int, default=None, help="twin trials of the soak (--only soak; default 200)")
     args = parser.parse_args(argv)
     if args.scale_trials is not None and not 0 <= args.scale_trials <= MAX_SCALE_TRIALS:
         fail(f"--scale-trials must be >= 0 and <= {MAX_SCALE_TRIALS}, got {args.scale_trials}")
+    if args.trials is not None and (args.only != "soak" or not 1 <= args.trials <= MAX_SCALE_TRIALS):
+        fail(f"--trials goes with --only soak and must be >= 1 and <= {MAX_SCALE_TRIALS}, got {args.trials}")
     try:  # owned before the work (minutes): a directory there, a read-only place or another writer is refused now
         lock = OutputLock(Path(args.out), directory=False)
     except RunStoreError as err:
         fail(one_line(err))
     results = bench_header()
+    if args.only == "soak":
+        path = soak(Path(args.out), results, SoakConfig() if args.trials is None else SoakConfig(trials=args.trials))
+        print(f"-> {path}")
+        lock.release()
+        return 0
     for figure in manipulation_figures(args.quick) if args.only else measured_figures(args.quick):
         figure.keep(results)
         for line in figure.lines:

@@ -20,6 +20,7 @@ from typing import Any
 from puzzlebox.lab.cell_bars import cell_bars
 from puzzlebox.lab.cli import fail, one_line
 from puzzlebox.lab.errors import RunStoreError
+from puzzlebox.lab.inputs import MAX_WORKERS
 from puzzlebox.lab.interrupt import StopRequests
 from puzzlebox.lab.run_store import Periodic, RunStore
 from puzzlebox.lab.runner import RunnerError, make_executor, run_tasks
@@ -88,6 +89,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.workers is not None and (args.workers < 1 or args.ray is not None):
         fail("--workers must be >= 1, and goes without --ray" if args.workers < 1 else "give --workers or --ray")
+    if args.workers is not None and args.workers > MAX_WORKERS:  # each one a process: fork them all, then fail
+        fail(f"--workers must be <= {MAX_WORKERS}, got {args.workers}")
     path = Path(args.sweep)
     try:
         sweep = load_sweep(path)

@@ -14,6 +14,7 @@ import numpy as np
 
 from puzzlebox.lab.narrated_world import NarratedWorld
 from puzzlebox.lab.observers import ObservedRobot, PeakWristForce, SensedDigest, TrialContext, TrialObserver
+from puzzlebox.lab.process_memory import release_freed_memory
 from puzzlebox.lab.rollout_observers import RecordingDetector, RerunRecording, RolloutVideo, scene_cameras
 from puzzlebox.lab.trial_config import TrialConfig
 from puzzlebox.lab.trial_record import TrialRecord
@@ -174,6 +175,8 @@ def run_twin_trial(
          "pose_error_m": pose_errors.get(spec.components[by_marker[a.marker]].name)}
         for a in (world.log if world else [])
     )  # fmt: skip
+    # the session's scene, frames and logs are garbage now: hand them back, or a long worker grows (issue 37)
+    release_freed_memory()
     return TrialRecord.of_run(
         result,
         wall_time_s=time.perf_counter() - wall,

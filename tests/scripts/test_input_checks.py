@@ -141,6 +141,10 @@ NUMBER_CASES = {
                               "--runs must be <="),
     "experiment --seeds 1e9": (["experiment", "variants", "--agents", "dual", "--seeds", 10**9, "--out", "OUT"],
                                "--seeds must be <="),
+    "sweep --workers 1e9": (["sweep", "SPEC", "--workers", 10**9, "--out", "OUT"], "--workers must be <="),
+    "bench --trials without --only soak": (["bench", "--trials", 5, "--out", "OUT/b.json"], "--trials goes with"),
+    "bench --only soak --trials 0": (["bench", "--only", "soak", "--trials", 0, "--out", "OUT/b.json"],
+                                     "must be >= 1"),
 }  # fmt: skip
 
 

@@ -91,6 +91,37 @@ def test_two_open_sessions_never_share_a_renderer(spec):
         assert a.cameras._renderer is not b.cameras._renderer
 
 
+def test_idle_renderers_beyond_the_bound_are_closed_oldest_first():
+    renderer_pool.clear()
+    model = mujoco.MjModel.from_xml_string(
+        '<mujoco><worldbody><camera name="c" pos="0 0 1"/><geom size="0.1"/></worldbody></mujoco>'
+    )
+    renderers = [Renderer(model, RenderConfig(width=32, height=24)) for _ in range(renderer_pool.MAX_IDLE + 1)]
+    for renderer in renderers:
+        renderer_pool.release(renderer)
+    assert renderers[0].closed, "the oldest idle renderer is closed, not kept"
+    assert not any(r.closed for r in renderers[1:])
+    assert renderer_pool.acquire(model, RenderConfig(width=32, height=24)) is renderers[1]  # the oldest kept
+    renderer_pool.clear()
+    assert all(r.closed for r in renderers[2:])
+    renderers[1].close()
+
+
+def test_the_scene_cache_keeps_its_bound_and_builds_again_a_scene_it_forgot(monkeypatch):
+    scene_cache.clear()
+    monkeypatch.setattr(scene_cache, "MAX_SCENES", 1)
+    built = []
+    build = scene_cache.build_scene
+    monkeypatch.setattr(scene_cache, "build_scene", lambda spec, config: built.append(spec.name) or build(spec, config))
+    first, second = (generate_chain(["slide", "door"], seed=s) for s in (0, 1))
+    config = scene_cache.SceneConfig()
+    for spec in (first, second, second, first):
+        scene_cache.compiled_scene(spec, config)
+    assert built == [first.name, second.name, first.name]  # the second kept, the first forgotten and rebuilt
+    assert len(scene_cache._cache) == 1
+    scene_cache.clear()
+
+
 def test_the_small_shadow_map_changes_no_pixel_without_shadows_and_leaves_the_model_its_own(spec, monkeypatch):
     with TwinSession(spec) as session:
         model_size = session.model.vis.quality.shadowsize
