@@ -66,8 +66,14 @@ def _meet(model, data, owner, qadr, travel, moving: int, other: int) -> bool:
             data.qpos[qadr[moving]] = fraction * travel[moving]
             mujoco.mj_kinematics(model, data)
             mujoco.mj_collision(model, data)
-            for c in data.contact[: data.ncon]:
-                pair = {int(owner[model.geom_bodyid[c.geom[0]]]), int(owner[model.geom_bodyid[c.geom[1]]])}
-                if pair == {moving, other} and c.dist < -TOUCH_DEPTH:
-                    return True
+            n = data.ncon
+            if n == 0:
+                continue
+            # the contacts as arrays: a Python object per contact cost 90 % of the sweep (0.55 s -> 0.06 s a box)
+            owners = owner[model.geom_bodyid[data.contact.geom[:n]]]
+            between = ((owners[:, 0] == moving) & (owners[:, 1] == other)) | (
+                (owners[:, 0] == other) & (owners[:, 1] == moving)
+            )
+            if np.any(between & (data.contact.dist[:n] < -TOUCH_DEPTH)):
+                return True
     return False
