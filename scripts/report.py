@@ -24,6 +24,7 @@ import argparse
 import re
 import shutil
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -62,7 +63,7 @@ def main(argv: list[str] | None = None) -> int:
         fail(f"--out {page} is a directory: give a file name (FILE.html)")
     try:
         data = load_results_dir(directory)
-        text = build_page(data, page, write_top_views(data))
+        text = build_page(data, page, write_top_views(data, lambda why: print(f"note: {why}", file=sys.stderr)))
         write_text_atomically(page, text)
     except ReportError as err:
         fail(str(err))

@@ -40,7 +40,8 @@ import numpy as np
 
 from puzzlebox.lab.cli import scripts_folder, write_json
 from puzzlebox.lab.errors import ExperimentStepFailed
-from puzzlebox.models import LockTable, PuzzleSpec, load_spec, save_spec
+from puzzlebox.lab.hard_sets import optimum as box_optimum
+from puzzlebox.models import PuzzleSpec, load_spec, save_spec
 from puzzlebox.models.atomic import write_atomically, write_text_atomically
 from puzzlebox.models.generator import RandomGraphConfig, generate_chain, generate_random
 from puzzlebox.models.kinds import registry_family
@@ -165,7 +166,7 @@ def run_kinds(out: Path, config: KindsConfig, workers: int | None) -> dict[str, 
     if config.twin_random and config.profiles:
         name = f"twin-random-{config.profiles[-1]}"
         results[name] = _trial(out / name, sets["random"][: config.twin_random], twin(config.profiles[-1], 1))
-    optimum = dict(_optimum(load_spec(p)) for paths in sets.values() for p in paths)
+    optimum = {spec.name: box_optimum(spec) for spec in (load_spec(p) for paths in sets.values() for p in paths)}
     summary = {
         "config": asdict(config),
         "kinds": list(registry_family().kinds),
@@ -177,12 +178,6 @@ def run_kinds(out: Path, config: KindsConfig, workers: int | None) -> dict[str, 
     write_text_atomically(out / "kinds.md", table(summary))
     plot(summary, out / "kinds.png")
     return summary
-
-
-def _optimum(spec: PuzzleSpec) -> tuple[str, int]:
-    """``(name, fewest actions that solve it)``: the lock table's shortest solution."""
-    plan = LockTable.from_spec(spec).shortest_solution()
-    return spec.name, len(plan) if plan is not None else 0
 
 
 def _figures(result: dict[str, Any], optimum: dict[str, int]) -> dict[str, Any]:

@@ -8,12 +8,13 @@ the page stays small whatever the number of boxes.
 
 The specs are those the directory was made from: a trial's ``config.json`` lists its spec files; a sweep's names
 its sweep file, whose ``specs`` globs or ``generate`` recipe give them again. Symbolic directories get none (no
-rendering needed to read them), nor does a spec whose file has gone: the page then shows no picture for it.
+rendering needed to read them), nor does a spec whose file has gone: the page then shows no picture for it, and
+``on_skip`` is told why (``report.py`` prints it: nothing is left out silently).
 """
 
 from __future__ import annotations
 
-import contextlib
+from collections.abc import Callable
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -39,15 +40,21 @@ def top_view_path(directory: Path, spec_name: str) -> Path:
     return Path(directory) / GALLERY_DIR / name_slug(spec_name) / "top-annotated.png"
 
 
-def directory_specs(data: ResultsDir) -> list[PuzzleSpec]:
+def _ignore(_: str) -> None:
+    pass
+
+
+def directory_specs(data: ResultsDir, on_skip: Callable[[str], None] = _ignore) -> list[PuzzleSpec]:
     """The specs a twin trial or sweep directory ran, as far as their files can still be read (none for a
-    symbolic one); each once, in the order first met."""
+    symbolic one); each once, in the order first met. ``on_skip`` is told of each file that cannot be read."""
     config = data.config
     if config.get("command") == "trial" and config.get("sim") == "twin":
         specs = []
         for file in config.get("specs") or []:
-            with contextlib.suppress(ModelsError, OSError, ValueError):
+            try:
                 specs.append(load_spec(file))
+            except (ModelsError, OSError, ValueError) as err:
+                on_skip(f"no top view of {file}: {err}")
     elif config.get("command") == "sweep" and isinstance(config.get("sweep"), dict):
         sweep = config["sweep"]
         if sweep.get("sim") != "twin":
@@ -56,7 +63,8 @@ def directory_specs(data: ResultsDir) -> list[PuzzleSpec]:
 
         try:
             specs = sweep_specs(sweep, Path(str(config.get("sweep_file", "."))).parent)
-        except (SweepError, ModelsError, OSError, ValueError):
+        except (SweepError, ModelsError, OSError, ValueError) as err:
+            on_skip(f"no top views: the sweep's specs cannot be read again ({err})")
             return []
     else:
         return []
@@ -65,18 +73,19 @@ def directory_specs(data: ResultsDir) -> list[PuzzleSpec]:
     return [unique[name] for name in dict.fromkeys(s.name for s in specs) if name in unique]
 
 
-def write_top_views(data: ResultsDir) -> dict[str, Path]:
+def write_top_views(data: ResultsDir, on_skip: Callable[[str], None] = _ignore) -> dict[str, Path]:
     """Spec name -> its annotated top view in ``data``'s directory, rendered now if it is not there yet (see the
-    module docstring). A box that cannot be drawn (no OpenGL here) has no entry."""
+    module docstring). A box that cannot be drawn (no OpenGL here) has no entry; ``on_skip`` is told why."""
     out: dict[str, Path] = {}
-    for spec in directory_specs(data):
+    for spec in directory_specs(data, on_skip):
         path = top_view_path(data.path, spec.name)
         if not path.is_file():
             try:
                 with Gallery(spec, TOP_VIEW_CONFIG) as gallery:
                     view = gallery.top_view()
                     image = gallery.annotate(view, gallery.render(view))
-            except (TwinError, ModelsError):
+            except (TwinError, ModelsError) as err:
+                on_skip(f"no top view of {spec.name}: {err}")
                 continue
             path.parent.mkdir(parents=True, exist_ok=True)
             write_atomically(path, lambda tmp, image=image: iio.imwrite(tmp, image, extension=".png"))

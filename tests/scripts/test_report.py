@@ -324,3 +324,15 @@ def test_the_sweep_page_loads_in_headless_chromium_and_shows_every_run(made, tmp
     check_timelines(parsed, records(made / "sweep"))
     result = ok(script("report.py", made / "sweep", "--out", tmp_path / "again.html", "--measure-load"))
     assert re.search(r"; load \d+ ms in headless Chromium \([\d.]+ s with browser start\)$", result.stdout.strip())
+
+
+def test_a_box_whose_spec_file_is_gone_gets_no_top_view_and_the_report_says_why(tmp_path):
+    from types import SimpleNamespace
+
+    from puzzlebox.lab.report_gallery import directory_specs
+
+    gone = tmp_path / "gone.json"
+    data = SimpleNamespace(config={"command": "trial", "sim": "twin", "specs": [str(gone)]}, runs=[])
+    told: list[str] = []
+    assert directory_specs(data, told.append) == []  # type: ignore[arg-type]
+    assert len(told) == 1 and str(gone) in told[0]
