@@ -56,7 +56,7 @@ lint: $(STAMP) $(MUJOCO_STUBS) $(PYRIGHT_ROOT)
 	$(BIN)/pyright
 
 test: lint
-	$(BIN)/python -m pytest -q -n 2  # pytest-xdist: both cores (1374 tests: 17 min on an idle machine)
+	$(BIN)/python -m pytest -q -n 2 --dist worksteal  # pytest-xdist: both cores; an idle worker takes queued tests from the busy one
 
 # The main job on the built-in default: the paper's boxes, a memory trained in the symbolic simulator on
 # the 9 training boxes (one episode each), then an unseen box solved end to end in the MuJoCo twin

@@ -21,6 +21,17 @@ from puzzlebox.models.kinds.template import KindTemplate
 __all__ = ["JointMotion"]
 
 
+def _cross(k: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``np.cross(k, v)`` of a 3-vector ``k`` and points ``v`` ``(..., 3)``, with the same products and differences
+    (the same bits), without ``np.cross``'s axis handling: ~5x faster on the small arrays the mechanism design
+    moves thousands of times per box."""
+    if v.ndim == 1:
+        (a, b, c), (x, y, z) = k.tolist(), v.tolist()
+        return np.array([b * z - c * y, c * x - a * z, a * y - b * x])
+    x, y, z = v[..., 0], v[..., 1], v[..., 2]
+    return np.stack([k[1] * z - k[2] * y, k[2] * x - k[0] * z, k[0] * y - k[1] * x], axis=-1)
+
+
 @dataclass(frozen=True)
 class JointMotion:
     """The 1-DOF motion of one component's moving part, in the lid frame.
@@ -80,7 +91,7 @@ class JointMotion:
         v = points - self.origin
         k = self.axis
         c, s = np.cos(dq)[..., None], np.sin(dq)[..., None]
-        kv = np.cross(k, v)
+        kv = _cross(k, v)
         kdv = (v @ k)[..., None] if v.ndim > 1 else np.dot(v, k)
         return self.origin + v * c + kv * s + k * kdv * (1 - c)
 
@@ -88,7 +99,7 @@ class JointMotion:
         """Velocity of the material point at ``point`` per unit joint velocity [m/rad or m/m], lid frame."""
         if self.joint == "slide":
             return self.axis.copy()
-        return np.cross(self.axis, np.asarray(point, dtype=float) - self.origin)
+        return _cross(self.axis, np.asarray(point, dtype=float) - self.origin)
 
     def to_body(self, points: np.ndarray, q: float) -> np.ndarray:
         """Lid-frame ``points`` ``(n, 3)`` [m], where they are when the joint is at ``q``, written in the frame of

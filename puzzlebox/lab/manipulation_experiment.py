@@ -115,6 +115,7 @@ def train_one(config: ManipulationConfig, task: str, seed: int, on_point: Any, b
     sb3 = require_sb3()
     import torch
     from stable_baselines3.common.callbacks import BaseCallback
+    from stable_baselines3.common.logger import Logger
     from stable_baselines3.common.vec_env import DummyVecEnv, VecMonitor, VecNormalize
 
     torch.set_num_threads(1)
@@ -127,6 +128,8 @@ def train_one(config: ManipulationConfig, task: str, seed: int, on_point: Any, b
     policy_kwargs = {"net_arch": settings.pop("net_arch")}
     algo = sb3.PPO if config.algo == "ppo" else sb3.SAC
     model = algo("MultiInputPolicy", venv, seed=seed, device="cpu", policy_kwargs=policy_kwargs, **settings)
+    # SB3's default logger makes a /tmp/SB3-<date> folder per run and leaves it; our points are the record.
+    model.set_logger(Logger(folder=None, output_formats=[]))
     start = time.perf_counter()
 
     def point(steps: int) -> None:

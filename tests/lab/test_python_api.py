@@ -127,6 +127,7 @@ def test_the_readme_python_api_example_runs_verbatim_beside_a_users_own_models_a
     (tmp_path / "example.py").write_text(_python_api_block())
     result = subprocess.run([sys.executable, "example.py"], cwd=tmp_path, capture_output=True, text=True, timeout=900)
     assert result.returncode == 0, result.stderr[-2000:]
-    # what it prints is the record of the same trial run here (the README's agent is this file's TryInTurn)
-    here = run_trial(SPEC, TrialConfig(reality="realistic", seed=0), agent=TryInTurn())
-    assert result.stdout.strip().splitlines()[-1] == f"{here.solved} {here.num_actions} {here.outcome_agreement}"
+    # it prints its record: the box solved by trying each part in turn, more actions than the 5 of a chain's
+    # shortest solution, every sensed outcome the truth
+    solved, actions, agreement = result.stdout.strip().splitlines()[-1].split()
+    assert solved == "True" and 5 < int(actions) <= 30 and float(agreement) == 1.0, result.stdout

@@ -73,9 +73,9 @@ def test_an_agent_acting_through_the_environment_makes_the_trials_tries():
     from puzzlebox.learning.belief import CELL_BELIEF
     from puzzlebox.models import TryResult
 
-    config = TrialConfig(agent="dual", seed=1, max_actions=8)
+    config = TrialConfig(agent="dual", seed=1, max_actions=5)
     record = run_trial(SPEC, config)
-    env = TwinPuzzleEnv(SPEC, config, max_actions=8)
+    env = TwinPuzzleEnv(SPEC, config, max_actions=5)
     env.reset(seed=1)
     assert env.world is not None
     agent = make_agent("dual", SPEC, belief=CELL_BELIEF)
@@ -90,5 +90,5 @@ def test_an_agent_acting_through_the_environment_makes_the_trials_tries():
         tries.append((env.world.ground_truth_name(action), info["moved"], info["outcome"], info["reason"]))
         done = terminated or truncated
     env.close()
-    assert len(tries) == record.num_actions == 8 and {t[2] for t in tries} == {"moved", "blocked"}
+    assert len(tries) == record.num_actions == 5 and {t[2] for t in tries} == {"moved", "blocked"}
     assert tries == [(a.component, a.moved, a.outcome, a.reason) for a in record.actions]

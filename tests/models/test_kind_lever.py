@@ -49,8 +49,8 @@ def test_the_lever_is_registered_from_its_module_and_joins_the_registry_family_o
     assert all(registry_family().may_neighbour("lever", k) for k in ("door", "slide", "wheel"))
     assert KIND_NAMES == ("door", "slide", "wheel")
     assert all("lever" not in spec.kinds for spec in paper_family("all"))
-    kinds = {k for s in range(30) for k in generate_random(RandomGraphConfig(6, family=family_named("all")), s).kinds}
-    assert "lever" in kinds
+    boxes = (generate_random(RandomGraphConfig(6, family=family_named("all")), s) for s in range(30))
+    assert any("lever" in box.kinds for box in boxes)  # the random family draws it (stops at the first box)
 
 
 def test_the_lever_stays_where_it_is_left_in_either_state_with_no_warnings():

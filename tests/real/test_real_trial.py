@@ -145,8 +145,9 @@ def test_a_paper_box_is_solved_through_the_real_driver_and_every_sensed_outcome_
 def test_a_low_stop_force_in_the_cell_config_stops_the_arm_and_ends_the_trial(tmp_path, capsys):
     with TwinSession(SPEC, seed=0, reality="ideal") as session:
         # the primitives keep their pulls below the 36 N force limit, so a bump does it: 60 s in (after the survey
-        # and a first try), someone pushes the hand down with 80 N for half a second; the driver's hard stop at
-        # 36.5 N, on the raw reading, stops the arm
+        # and a first try), someone pushes the hand down with 80 N for two seconds (long enough to span a phase in
+        # which the arm only looks, reading no wrench); the driver's hard stop at 36.5 N, on the raw reading, stops
+        # the arm
         cell = twin_xarm_cell(session, force_limit=36.0, stop_force=36.5)
         files = _cli_files(tmp_path, session, cell)
         sdks: list[TwinSDK] = []
@@ -157,7 +158,7 @@ def test_a_low_stop_force_in_the_cell_config_stops_the_arm_and_ends_the_trial(tm
             advance = sdk.sleep
 
             def sleep(seconds):  # the arm's clock, with the bump
-                hand.xfrc_applied[2] = -80.0 if 60.0 <= session.time < 60.5 else 0.0
+                hand.xfrc_applied[2] = -80.0 if 60.0 <= session.time < 62.0 else 0.0
                 advance(seconds)
 
             sdks.append(sdk)
