@@ -9,7 +9,8 @@ door by pad friction alone, which a weak grip does not give (harsh profile: 12 o
 handle slipping out). A pushed door opens under the inner face of a finger pad pressed on the back of its
 handle, and closes under the pads' edges pressed on its plate; doors are always shut that way
 (``push.close_by_push``). Beside a door that may stand open over the part (``cautious``), descents are slow
-and stop at a light touch (:mod:`skills.door_clearance`).
+and stop at a light touch (:mod:`skills.door_clearance`); every other descent runs its last ``touch_height``
+slowly under that light touch, where fingers aimed beside a handle (a wrong hand-eye calibration) land on it.
 
 Motion is differential IK on the robot-only model at a 10 ms control tick, targets sent to the position
 servos. The wrist wrench is read every tick and filtered (a running median over
@@ -21,7 +22,9 @@ filtered force — rotated into the base frame, tared with the fingers open — 
 handle's direction of motion: if the force opposing the motion exceeds ``blocked_force`` while the
 measured progress is below ``blocked_progress``, the component is latched: the arm backs off to where
 it started and lets go (DESIGN.md: this rule made no error in 36 randomized attempts and stopped every
-latched attempt within 0.13-1.2 s; without a stop the grasp is torn off at 100-300 N). The start of the
+latched attempt within 0.13-1.2 s; without a stop the grasp is torn off at 100-300 N). A handle pressed down
+along its own post (a lever), which the pads hold by friction alone, is held once the opposing force exceeds the
+lighter ``press_force``, at any progress short of ``moved_fraction``. The start of the
 travel, where latches and sticky parts are met, is driven at ``breakaway_pace`` of the rest's pace, and a
 door's path yields across itself to the load there (``comply_gain``): only the load along the motion tells a latch,
 and a path planned from a slightly wrong hinge otherwise drags the handle across its true arc (57 N on a free
@@ -60,6 +63,8 @@ from puzzlebox.skills.toggle_result import ToggleResult
 SLIPPED_OFF = "latched: held until the grasp slipped"
 HELD_PART_WAY = "latched: held part-way"
 """Reason prefix of a part that stalled against the pull past ``blocked_progress`` (``PrimitiveConfig.stall_force``)."""
+MAX_HEAD_START = 0.5
+"""Largest :attr:`Toggler.head_start` believed [-]: a part seen further along is not where its state says."""
 INCOMPLETE_TRAVEL = "IncompleteTravel"
 """Reason prefix of a motion that ran its course short of ``moved_fraction`` (no latch read)."""
 STOPPED = "motion stopped"
@@ -89,12 +94,27 @@ class PrimitiveConfig:
     """Time of the 8 cm descent onto a handle [s]: slow enough (peak 6 cm/s) that a part standing in
     the way (a door left leaning over its neighbour) is met softly and the force guard stops the arm
     near its limit; at 1 s the impact put up to 270 N of true force on the wrist."""
-    cautious_descend_time: float = 5.0
+    touch_height: float = 0.018
+    """Last part of a descent that is made slowly and stopped at a light touch (``cautious_contact_force``) [m]:
+    fingers aimed beside a handle land on its top 12.6-12.9 mm above the grasp point (``GRASP_DEPTH``), on a
+    neighbour's at about the same height. Met at the ~4.5 cm/s of the normal descent there, the impact alone put
+    112 N on the wrist in one tick, and the servos went on pressing with 55-70 N while the 40 ms late, filtered
+    reading caught up with the 60 N guard (wrist camera's hand-eye pose 20 mm off; issue 37)."""
+    touch_speed: float = 0.006
+    """TCP speed over ``touch_height`` [m/s] (slower by :attr:`Toggler.slowdown`): the impact of the touch, one
+    tick's spike, grows with it (fingers on a handle's top: 112 N at 4.5 cm/s, 22-45 N at 0.5-1.1 cm/s), and so
+    does the servos' tracking lag they press on with while the filtered reading catches up (runs/s5/force-descent)."""
+    cautious_descend_time: float = 6.5
     """Time of the descent beside a door that may stand open over it (``toggle(cautious=True)``) [s]: met at
     the 6 cm/s peak of a normal descent, a flap's edge put 80 N on the wrist at the first touch; at a third of
-    that speed 20-25 N (harsh profile)."""
+    that speed 20-25 N (harsh profile). Made at a constant speed (1.2 cm/s over 8 cm): in 5 s with a smooth start
+    and stop, its 2.4 cm/s peak met an open door's plate 4 cm above a slide's grasp point, and the pad bounced on it
+    for 11 ticks (47 N true) while the filtered reading, a median that needs most of its window in contact, read
+    3 N (paper-test-2 seed 100, harsh); at a constant 1.6 cm/s a knuckle met a plate with 42 N true (hard chain8,
+    harsh; runs/s5/force-base)."""
     cautious_contact_force: float = 15.0
-    """Filtered force that stops a cautious descent [N]: nothing should touch the fingers on the way down, and
+    """Filtered force that stops a cautious descent, and the last ``touch_height`` of every descent [N]: nothing
+    should touch the fingers on the way down, and
     the servos keep pushing into what they met by ~1 N per 10 ms tick while the 30 ms late, filtered reading
     catches up."""
     cautious_noise_margin: float = 4.0
@@ -149,6 +169,21 @@ class PrimitiveConfig:
     lift_sidestep: float = 0.03
     """How far the open gripper steps along its pads (parallel to the handle it straddles, which it then never
     pushes) to clear what stopped the lift [m]: a pad is 30 mm long, a post 12 mm wide."""
+    gentle_release_speed: float = 0.4
+    """Rate at which the gripper's commanded closure ramps open to let go of a handle [1/s], divided by
+    :attr:`Toggler.slowdown`: the servo alone snaps the fingers open at ~2/s, and an inner knuckle swinging out
+    under the plate of an open door (one the world did not count as standing over the part) met it with 38 N in
+    one tick and 93 N before the late, filtered reading passed the guard (paper-test-2, harsh; 34 N ramped)."""
+    base_radius: float = 0.22
+    """A lift whose TCP stands closer than this to the vertical axis of the arm's base [m] first moves out to it,
+    ``base_rise`` above where it let go: the arm folded over its own shoulder to reach there (a drawer pulled
+    towards the base, the TCP 0.176 m from its axis), and straight up the gripper's knuckle met link 2 (224 N
+    true) 6 cm up, with 1 cm of clearance where it let go; moved out first, never under 6 mm (robot model). An
+    approach to above such a part comes in from it at ``base_rise`` (:meth:`Toggler._approach`)."""
+    base_rise: float = 0.035
+    """How far the gripper rises above where it let go before it moves out to ``base_radius`` [m]: clear of the
+    35 mm post it straddled, which moving across would push; and the height above the grasp point from which a
+    descent near the base begins."""
     lean_angle: float = math.radians(20.0)
     """Tilt of the gripper about its closing axis, its upper part leaning away from a door that may stand open
     over the part it grasps (``toggle(lean=...)``) [rad]: at its end stop a door's 35 mm post stands out
@@ -191,6 +226,17 @@ class PrimitiveConfig:
     60 N guard (63 N true; its retry then descended onto the post it had left part-way: 65 N). Stopped there, the
     handle is taken back along its path to where it was grasped; one stalled past ``moved_fraction`` is at its
     stop, and pushed no further."""
+    press_force: float = 10.0
+    """Force opposing a handle pressed down along its own post (``press_angle``) that means it is held, whatever
+    the progress short of ``moved_fraction`` [N]: the pads hold a post along its length by friction alone, and
+    under the harsh grip they slid down a locked lever's post at 13 N (the lever still) until the fingers met its
+    arm, where the load rose 4.5 N a tick to 56 N true before the stall was read; a free lever is pressed with
+    ~5 N (harsh), and past ``moved_fraction`` more force is its end stop (runs/s5/force-descent/locked_lever.py)."""
+    press_noise_margin: float = 3.0
+    """... or this many times the filtered F/T noise of the toggle, if larger: noise must not read as a hold."""
+    press_angle: float = math.radians(30.0)
+    """Largest angle between the motion of a grasped handle and the gripper's approach axis (down, into the part)
+    at which it is pressed along its post (``press_force``) [rad]: a lever's handle starts down at ~20 deg."""
     stall_progress: float = 0.01
     """Least progress (fraction of the travel) over ``stall_window`` of a part that has not stalled: a free part
     covers ~2 % in that time; a slide met by a pin crept 0.6 % in 0.15 s as the load rose 10 N a tick."""
@@ -310,6 +356,11 @@ class PrimitiveConfig:
                 f"need lift_slow_height >= 0 [m] and lift_slow_time >= tick [s], got {self.lift_slow_height}, "
                 f"{self.lift_slow_time}"
             )
+        if self.gentle_release_speed <= 0.0 or min(self.base_radius, self.base_rise) < 0.0:
+            raise ValueError(
+                "need gentle_release_speed > 0 [1/s] and base_radius, base_rise >= 0 [m], got "
+                f"{self.gentle_release_speed}, {self.base_radius}, {self.base_rise}"
+            )
         if not (0.0 < self.stall_force < self.force_limit and self.stall_progress >= 0.0 and self.stall_window > 0.0):
             raise ValueError(
                 "need 0 < stall_force < force_limit [N], stall_progress >= 0 and stall_window > 0 [s], got "
@@ -320,8 +371,18 @@ class PrimitiveConfig:
                 "need blocked_force < back_off_force <= force_limit [N], got "
                 f"{self.blocked_force}, {self.back_off_force}, {self.force_limit}"
             )
+        if self.press_force <= 0.0 or self.press_noise_margin < 0.0 or not 0.0 <= self.press_angle <= math.pi / 2:
+            raise ValueError(
+                "need press_force > 0 [N], press_noise_margin >= 0 and 0 <= press_angle <= pi/2 [rad], got "
+                f"{self.press_force}, {self.press_noise_margin}, {self.press_angle}"
+            )
         if not 0.0 < self.careful_pace <= 1.0:
             raise ValueError(f"need 0 < careful_pace <= 1, got {self.careful_pace}")
+        if not 0.0 < self.touch_height < self.approach_height or self.touch_speed <= 0.0:
+            raise ValueError(
+                "need 0 < touch_height < approach_height [m] and touch_speed > 0 [m/s], got "
+                f"{self.touch_height}, {self.approach_height}, {self.touch_speed}"
+            )
         if not 0.0 < self.cautious_contact_force < self.force_limit:
             raise ValueError(
                 "need 0 < cautious_contact_force < force_limit [N], got "
@@ -383,6 +444,13 @@ class Toggler(DoorPushing):
         self.slowdown = 1.0
         """How much slower than configured the motions in contact of the toggle in progress run [-]: the
         running median's length over ``force_filter_samples`` (1 below 7.2 N of F/T noise)."""
+        self.head_start = 0.0
+        """Fraction of the travel towards the other state a part stood at when the toggle in progress began
+        (``toggle(stands_at=...)``), counted into the progress that tells it reached its stop: the fingers' progress
+        counts from the perceived closed (or open) pose, and the handle of a lever left part-way is that much ahead
+        of them (a lever rests up to ~20 % pressed once lifted, a try taken back leaves it at 30-45 %). Its stop
+        was met with the fingers at 57-73 % and read ``held part-way``; taken back, the lever was tried again and
+        again until the grasp closed on nothing (runs/s5/force-descent/lever.py)."""
         self.lean: np.ndarray | None = None
         """Horizontal vector (base frame) along which the gripper leans over the part of the toggle in progress,
         by ``lean_angle`` times its length (``toggle(lean=...)``), or None: upright."""
@@ -451,14 +519,16 @@ class Toggler(DoorPushing):
         self._wait_tick()
         return position_error, orientation_error
 
-    def move_to(self, target: np.ndarray, duration: float) -> None:
-        """Move the TCP to ``target`` (4x4) along a straight line and a slerp over ``duration`` [s]."""
+    def move_to(self, target: np.ndarray, duration: float, smooth: bool = True) -> None:
+        """Move the TCP to ``target`` (4x4) along a straight line and a slerp over ``duration`` [s], with a smooth
+        start and stop, or at a constant speed (``smooth=False``: no faster than the mean anywhere)."""
         self.ik.set_joints(self.robot.joint_positions())
         start = self.ik.tcp_pose()
         slerp = Slerp([0.0, 1.0], Rotation.from_matrix([start[:3, :3], target[:3, :3]]))
         ticks = max(1, round(duration / self.config.tick))
         s = np.arange(1, ticks + 1) / ticks
-        s = s * s * (3 - 2 * s)  # smooth start and stop
+        if smooth:
+            s = s * s * (3 - 2 * s)
         rotations = slerp(s).as_matrix()  # all at once: one scipy call per tick cost ~0.2 ms
         for k in range(ticks):
             waypoint = np.eye(4)
@@ -531,6 +601,7 @@ class Toggler(DoorPushing):
         cautious: bool = False,
         lean: np.ndarray | None = None,
         careful: bool = False,
+        stands_at: float | None = None,
     ) -> ToggleResult:
         """Try to move the component of joint model ``jm`` to its other state (see the module docstring).
         ``where_is`` looks at the part and tells the fraction of its travel at which it stands now (0 closed,
@@ -544,10 +615,13 @@ class Toggler(DoorPushing):
         frame) in whose direction a pinch's gripper leans by ``lean_angle`` times its length (at most 1) about its
         closing axis, away from what may stand over the part (:func:`skills.door_clearance.lean_away`); it
         descends and lifts along its tilted axis. ``careful``: every motion in contact at ``careful_pace`` (a part
-        tried as a kind it was not told)."""
+        tried as a kind it was not told). ``stands_at``: where a part that does not swing up was just seen to stand
+        (fraction of its travel, 0 closed, 1 open; :attr:`head_start`)."""
         wall = time.perf_counter()
         self.cautious = cautious
         self.careful = careful
+        ahead = None if stands_at is None or jm.handling.swings_up else (stands_at if opening else 1.0 - stands_at)
+        self.head_start = 0.0 if ahead is None else min(max(ahead, 0.0), MAX_HEAD_START)
         self.lean = lean
         start_time = self.robot.time
         self.reset_force_watch()
@@ -636,17 +710,15 @@ class Toggler(DoorPushing):
             return result
 
     def _descend_to(self, target: np.ndarray) -> None:
-        """Open to the pre-grasp closure, travel to ``approach_height`` above ``target`` (4x4), tare the F/T
-        there and descend onto it."""
+        """Open to the pre-grasp closure, travel above ``target`` (4x4; :meth:`_approach`), tare the F/T there and
+        descend onto it."""
         c = self.config
-        above = target.copy()
-        above[:3, 3] -= c.approach_height * target[:3, 2]  # back along the approach axis (up, when upright)
         # the lift off this part goes back the same way: a pinch's lean, not a push's upright pads after it
         self._lean_drift = target[:3, 2] / target[2, 2]
         self._lean_drift[2] = 0.0
         self.robot.command_gripper(c.pregrasp_closure)
         self.phase = "approaching"
-        self.travel_to(above, c.approach_time)
+        height = self._approach(target)
         self.rest_noise = self.force_noise()  # coming to rest above the part
         self.robot.tare(self.tare_samples(self.rest_noise))  # fingers open, arm still: the gripper's load alone
         # older samples were taken with another zero; the window is as long as this noise needs
@@ -654,14 +726,47 @@ class Toggler(DoorPushing):
         self._force_window = collections.deque(maxlen=samples)
         self.slowdown = samples / c.force_filter_samples / (c.careful_pace if self.careful else 1.0)
         self.phase = "descending"
-        if not self.cautious:
-            self.move_to(target, c.descend_time * self.slowdown)
+        touch_limit = max(c.cautious_contact_force, c.cautious_noise_margin * self.rest_noise)
+        if self.cautious:
+            self.limit = touch_limit
+            try:
+                self.move_to(target, c.cautious_descend_time * height / c.approach_height * self.slowdown, smooth=False)
+            finally:
+                self.limit = c.force_limit
             return
-        self.limit = max(c.cautious_contact_force, c.cautious_noise_margin * self.rest_noise)
+        # quickly down to where the fingers could first meet a handle they were aimed beside, then slowly, so that
+        # one met (a wrong perception or calibration) stops the arm at a light touch: the try fails, not the part
+        near = target.copy()
+        near[:3, 3] -= c.touch_height * target[:3, 2]
+        self.move_to(near, c.descend_time * (height - c.touch_height) / c.approach_height * self.slowdown)
+        self.limit = touch_limit
         try:
-            self.move_to(target, c.cautious_descend_time * self.slowdown)
+            self.move_to(target, c.touch_height / c.touch_speed * self.slowdown, smooth=False)
         finally:
             self.limit = c.force_limit
+
+    def _approach(self, target: np.ndarray) -> float:
+        """Travel to above ``target`` (4x4) along its approach axis (up, when upright) and return how high above it
+        [m]: ``approach_height``, or, where that point stands within ``base_radius`` of the vertical axis of the
+        arm's base, ``base_rise``, reached at that height from ``base_radius`` out and moving in horizontally (the
+        way :meth:`_out_from_base` leaves): the arm reaches there folded over its own shoulder, and every route to 8
+        cm above a drawer's handle 0.176 m from the axis put the gripper's knuckle on link 2 (101-137 N, 17 mm deep in
+        the robot model); arriving 3.5 cm above it from outside kept 3-6 mm of clearance, more on the way down
+        (runs/s5/force-retreat, force-base)."""
+        c = self.config
+        above = target.copy()
+        above[:3, 3] -= c.approach_height * target[:3, 2]
+        radius = math.hypot(above[0, 3], above[1, 3])
+        if not 1e-6 <= radius < c.base_radius:
+            self.travel_to(above, c.approach_time)
+            return c.approach_height
+        height = max(c.base_rise, c.touch_height)
+        above[:3, 3] = target[:3, 3] - height * target[:3, 2]
+        out = above.copy()
+        out[:2, 3] *= max(1.0, c.base_radius / max(math.hypot(above[0, 3], above[1, 3]), 1e-6))
+        self.travel_to(out, c.approach_time)
+        self.move_to(above, c.retreat_time)
+        return height
 
     def _toggle(self, jm: JointModel, sign: float) -> ToggleResult:
         c = self.config
@@ -708,6 +813,8 @@ class Toggler(DoorPushing):
         yields = jm.handling.swings_up  # (slides and wheels yielding too were read latched while free)
         returning = 1.0 - c.tick / c.comply_return_time  # the offset kept per tick past the travel
         window = max(2, round(c.stall_window * self.slowdown / c.tick))
+        pressed = float(sign * jm.motion_direction(begin) @ at_grasp[:3, 2]) > math.cos(c.press_angle)
+        press_limit = max(c.press_force, c.press_noise_margin * self.filtered_noise_now()) if pressed else math.inf
         recent: collections.deque[float] = collections.deque(maxlen=window)  # progress over the last stall_window
         self.ik.set_joints(self.robot.joint_positions())
         for k in range(1, last_tick + 1):
@@ -740,17 +847,21 @@ class Toggler(DoorPushing):
             in_end_stop = in_end_stop or (s > 1.0 and magnitude > c.end_stop_force)
             if s > 1.0 and magnitude > c.overtravel_force:  # past the travel and pushing hard: stop here
                 end = max(1.0, min(progress, s))
-            if (opposing > c.blocked_force or magnitude > c.blocked_magnitude) and progress < c.blocked_progress:
+            held = opposing > press_limit and s <= 1.0  # a handle pressed along its post: held at a light force
+            if (
+                opposing > c.blocked_force or magnitude > c.blocked_magnitude or held
+            ) and progress < c.blocked_progress:
                 self._take_back(functools.partial(self.move_to, at_grasp, 0.5))  # back to where the handle was grasped
                 return ToggleResult(
                     "blocked", "latched: force rose without progress", progress, max(forces), forces=forces
                 )
             recent.append(progress)
             stalled = len(recent) == recent.maxlen and progress - recent[0] < c.stall_progress
-            if stalled and opposing > c.stall_force and s <= 1.0 and progress >= c.moved_fraction:
+            held = held or (stalled and opposing > c.stall_force and s <= 1.0)
+            if held and progress + self.head_start >= c.moved_fraction:
                 end = max(progress, 0.0)  # at its stop short of the perceived travel: pushed no further
                 break
-            if stalled and opposing > c.stall_force and s <= 1.0:  # (progress >= blocked_progress: tested above)
+            if held:  # (progress >= blocked_progress: tested above)
                 self._take_back(functools.partial(self._return_along, jm, sign, begin, progress, at_grasp, across))
                 return ToggleResult(
                     "blocked", f"{HELD_PART_WAY} ({progress:.0%} of the travel)", progress, max(forces), forces=forces
@@ -766,7 +877,8 @@ class Toggler(DoorPushing):
                 if not in_end_stop:
                     raise
                 break
-        result = self._verdict(self._progress(jm, sign, begin), forces, "latched: pulled without progress")
+        reached = self._progress(jm, sign, begin) + self.head_start
+        result = self._verdict(reached, forces, "latched: pulled without progress")
         result.end_stop_felt = in_end_stop
         if result.outcome == "blocked":
             self._take_back(functools.partial(self.move_to, at_grasp, 0.5))
@@ -915,10 +1027,10 @@ class Toggler(DoorPushing):
             self.guard = True
 
     def _retreat_moves(self) -> None:
-        """Open to the pre-grasp closure (wide enough to let the 12 mm post go; fully open, the ~8 cm
+        """Open gently to the pre-grasp closure (wide enough to let the 12 mm post go; fully open, the ~8 cm
         fingers caught neighbouring parts on the way up), lift, and go to rest."""
         c = self.config
-        self._gripper(c.pregrasp_closure, c.release_time)
+        self._open_gently(c.pregrasp_closure)
         try:
             self.ik.set_joints(self.robot.joint_positions())
             self._lift_clear(c.approach_height)
@@ -930,9 +1042,11 @@ class Toggler(DoorPushing):
         """Lift the open gripper by ``height`` [m], stopping at a light touch (``lift_contact_force``); on one,
         back off, step ``lift_sidestep`` along the pads (the TCP's x: parallel to the handle between them, which
         the step then never pushes), first to the side the load pushed towards, then to the other, and lift
-        again. Withdrawing (guard off), or when neither side clears, the lift runs under the full guard."""
+        again. Withdrawing (guard off), or when neither side clears, the lift runs under the full guard. Near the
+        base's axis it first moves out from it (:meth:`_out_from_base`)."""
         c = self.config
-        top = self.robot.tcp_pose_in_base()[2, 3] + height
+        bottom = self.robot.tcp_pose_in_base()[2, 3]
+        top = bottom + height
         if self.guard:
             limit = self.limit
             self.limit = max(c.lift_contact_force, c.lift_noise_margin * self.filtered_noise_now())
@@ -946,6 +1060,7 @@ class Toggler(DoorPushing):
                         up = self.robot.tcp_pose_in_base()
                         self._rise(up, min(up[2, 3] + c.lift_slow_height, top))
                         self.move_to(up, c.lift_slow_time)
+                        self._out_from_base(up, bottom, top)
                         self._rise(up, top)
                         self.move_to(up, c.retreat_time)
                         return
@@ -962,8 +1077,52 @@ class Toggler(DoorPushing):
             finally:
                 self.limit = limit
         up = self.robot.tcp_pose_in_base()
+        self._out_from_base(up, bottom, top)
         self._rise(up, top)
         self.move_to(up, c.retreat_time)
+
+    def _out_from_base(self, pose: np.ndarray, bottom: float, top: float) -> None:
+        """If ``pose`` (4x4, the lift's target so far; moved in place) stands within ``base_radius`` of the vertical
+        axis of the arm's base, rise to ``base_rise`` above ``bottom`` (where the lift began; at most ``top``) [m]
+        and move out horizontally to ``base_radius``: the arm reached there folded over its own shoulder."""
+        c = self.config
+        radius = math.hypot(pose[0, 3], pose[1, 3])
+        if radius >= c.base_radius or radius < 1e-6:
+            return
+        if pose[2, 3] < min(bottom + c.base_rise, top):
+            self._rise(pose, min(bottom + c.base_rise, top))
+            self.move_to(pose, c.lift_slow_time)
+        pose[:2, 3] *= c.base_radius / radius
+        self.move_to(pose, c.retreat_time)
+
+    def _open_gently(self, closure: float) -> None:
+        """Ramp the gripper's command open to ``closure`` at ``gentle_release_speed`` (slowed with the motions in
+        contact); a filtered force that rises past the lift's light touch (``lift_contact_force``, or
+        ``lift_noise_margin`` times the filtered noise) above its value at the start holds the command, and the arm
+        backs off along the load before they open on (three times; at a fourth touch the fingers stay where they
+        are): a finger opening under the plate of a door standing open over the part presses into it with the
+        gripper's whole force."""
+        c = self.config
+        touch = max(c.lift_contact_force, c.lift_noise_margin * self.filtered_noise_now())
+        touch += math.sqrt(self.force_in_base @ self.force_in_base)  # the handle's load, gone once let go
+        step = c.gentle_release_speed * c.tick / self.slowdown
+        command = self.robot.gripper_opening()
+        touches = 0
+        while command > closure:
+            command = max(closure, command - step)
+            self.robot.command_gripper(command)
+            self._tick(self.ik.tcp_pose())
+            if math.sqrt(self.force_in_base @ self.force_in_base) > touch:
+                if touches == 3:  # let go as far as there is room: the lift steps aside from what stops it
+                    self.robot.command_gripper(self.robot.gripper_opening())
+                    return
+                touches += 1
+                # the command held, no harder: the finger opens on as the arm backs off, until the load is gone
+                guard, self.guard = self.guard, False
+                try:
+                    self._relieve()
+                finally:
+                    self.guard = guard
 
     def _rise(self, pose: np.ndarray, height: float) -> None:
         """Raise ``pose`` (4x4, in place) to ``height`` [m] along the approach axis of a leaning gripper (straight

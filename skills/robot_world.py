@@ -226,6 +226,7 @@ class RobotWorld:
         empty = False  # a grasp closed on nothing where the kind in use has its handle
         for attempt in range(1 + self.config.max_retries):
             attempts = attempt + 1
+            stands_at = self._stands_at(marker)
             result: ToggleResult = self.toggler.toggle(
                 self.joint_models[marker],
                 opening,
@@ -234,6 +235,7 @@ class RobotWorld:
                 raised=raised,
                 cautious=bool(overhanging),
                 lean=lean,
+                stands_at=stands_at,
             )
             peak, sim_time, wall_time = (
                 max(peak, result.peak_force),
@@ -445,6 +447,14 @@ class RobotWorld:
         if seen is None:
             return None
         return jm.fraction_between(closed, seen.T_base_marker[:3, 3])
+
+    def _stands_at(self, marker: int) -> float | None:
+        """Where a part whose small motion is read from its marker close up and that does not swing up (a lever)
+        stands before a try (fraction of its travel; :attr:`Toggler.head_start`), or None: not looked at."""
+        handling = self.joint_models[marker].handling
+        if handling.swings_up or handling.verdict != "arc" or not handling.read_close_up:
+            return None
+        return self._fraction_open(marker)
 
     def _closed_point(self, marker: int) -> np.ndarray:
         """Where ``marker``'s centre is with its part closed, in the base frame [m]."""

@@ -4,11 +4,15 @@ A lock's pins leave play: a part held open closes up to ~30 % of its travel befo
 the pace of a free part, a slide was driven on to the 60 N guard (63 N true) and left part-way, where the next try
 descended onto its post (65 N); a stall past the breakaway is now read as a hold, and the handle taken back."""
 
+import dataclasses
+
+import mujoco
 from world_fixtures import TrueForceWatch
 
 from puzzlebox.lab.twin_trial import evaluation_world
 from puzzlebox.models.generator import generate_chain
-from puzzlebox.skills.primitives import HELD_PART_WAY
+from puzzlebox.skills.primitives import HELD_PART_WAY, STOPPED_DESCENDING, PrimitiveConfig
+from puzzlebox.twin.reality import ForceTorqueReality, PhysicsReality, RealityProfile
 from puzzlebox.twin.session import TwinSession
 
 FORCE_MARGIN = 45.0
@@ -30,3 +34,55 @@ def test_a_part_held_open_by_a_lock_with_play_reads_blocked_within_the_margin_an
         # and tried again, the handle is where the fingers descend
         again = world.try_toggle(slide)
         assert again.outcome == "blocked" and robot.peak <= FORCE_MARGIN, robot.peak_during
+
+
+def test_a_descent_onto_a_handle_beside_where_it_was_aimed_stops_at_a_light_touch():
+    # a rigid but wrong hand-eye pose puts the grasp point beside the handle (issue 37): one finger lands on its top
+    spec = generate_chain(["slide", "wheel"], seed=1)
+    with TwinSession(spec, seed=0) as session:
+        robot = TrueForceWatch(session.robot, session)
+        world = evaluation_world(session, robot)
+        jm = world.joint_models[spec.components[0].marker]
+        beside = 0.02 * jm.axis  # the fingers close along a slide's axis: one of them over the post
+        aimed = dataclasses.replace(jm, origin=jm.origin + beside, grasp_point=jm.grasp_point + beside)
+        robot.peak = 0.0
+        missed = world.toggler.toggle(aimed)
+        assert missed.outcome == "failed" and missed.reason.endswith(STOPPED_DESCENDING), missed
+        assert robot.peak <= FORCE_MARGIN, robot.peak  # 85 N true with the whole descent at its normal pace
+        assert session.component_states()[0] == 0
+
+
+def test_a_lever_left_part_way_is_pressed_into_its_stop_and_read_open():
+    # a lever rests up to ~20 % pressed once lifted, and a try taken back leaves it lower: the fingers, aimed at its
+    # closed pose, met its stop at 57-73 % of their travel and read it held part-way, again and again
+    spec = generate_chain(["lever", "wheel"], seed=4)
+    lever = spec.index_of("lever-0")
+    with TwinSession(spec, seed=0) as session:
+        session.data.qpos[session.component_qpos[lever]] = 0.3 * session.travel[lever]
+        mujoco.mj_forward(session.model, session.data)
+        world = evaluation_world(session)
+        index = world.markers.index(spec.components[lever].marker)
+        opened = world.try_toggle(index)
+        assert opened.moved and session.component_states()[lever] == 1, opened
+        assert world.log[-1].true_moved
+
+
+def test_a_locked_lever_pressed_by_a_weak_grip_reads_blocked_at_a_light_force():
+    # the pads hold a post along its length by friction alone: the harsh grip's slid down a locked lever's post
+    # until the fingers met its arm, and the load rose there to 46-57 N true before the stall was read (here, with
+    # the harsh grip and F/T delay alone: 41 N, read held part-way)
+    weak_grip = RealityProfile(
+        name="weak grip, late F/T",
+        physics=PhysicsReality(pad_friction=0.25, grip_force_scale=1 / 3),
+        force_torque=ForceTorqueReality(delay=0.030, rate_hz=100.0),
+    )
+    spec = generate_chain(["slide", "lever", "door"], seed=1)  # the closed slide keeps the lever up
+    lever = spec.index_of("lever-1")
+    with TwinSession(spec, seed=0, reality=weak_grip) as session:
+        robot = TrueForceWatch(session.robot, session)
+        world = evaluation_world(session, robot)
+        robot.peak = 0.0
+        pressed = world.try_toggle(world.markers.index(spec.components[lever].marker))
+        assert pressed.outcome == "blocked", pressed
+        assert robot.peak < PrimitiveConfig().blocked_force, robot.peak_during  # lighter than a latch elsewhere
+        assert session.component_states()[lever] == 0

@@ -139,9 +139,10 @@ def test_a_toggle_with_the_wrong_kind_is_stopped_below_the_force_limit():
 
 
 def test_a_cautious_descent_meets_a_part_in_its_way_at_a_light_touch():
-    """A pad landing on the top of a handle post (the fingers 23 mm off along their closing axis): at the normal
-    pace the guard stops the descent at the 60 N limit, the true force past it; a cautious descent (beside a
-    door that may stand open) stops at ``cautious_contact_force`` with the true force well under half that."""
+    """A pad landing on the top of a handle post (the fingers 23 mm off along their closing axis): a cautious
+    descent (beside a door that may stand open) stops at ``cautious_contact_force`` with the true force well under
+    the 60 N limit, and so does a normal one, whose last ``touch_height`` runs at ``touch_speed`` (at its full pace
+    the guard stopped it at the limit, the true force past it)."""
     spec = generate_chain(["slide", "door"], seed=2)
     true_peak, reasons = {}, {}
     for cautious in (False, True):
@@ -155,8 +156,9 @@ def test_a_cautious_descent_meets_a_part_in_its_way_at_a_light_touch():
             assert session.component_states()[0] == 0
             true_peak[cautious], reasons[cautious] = watch.peak, result.reason
     config = PrimitiveConfig()
-    assert f"> {config.cautious_contact_force:.0f} N" in reasons[True]
-    assert true_peak[True] < config.cautious_contact_force + 15.0 < config.force_limit < true_peak[False]
+    for cautious in (False, True):
+        assert f"> {config.cautious_contact_force:.0f} N" in reasons[cautious]
+        assert true_peak[cautious] < config.cautious_contact_force + 15.0 < config.force_limit
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -176,11 +178,11 @@ def test_a_cautious_descent_is_not_stopped_by_sensor_noise(seed):
             assert toggler.force_noise() == pytest.approx(7.0, rel=0.2)
 
 
-@pytest.mark.parametrize("seed", [1, 5])
+@pytest.mark.parametrize("seed", [4, 6])
 def test_at_15_n_of_sensor_noise_a_latched_part_reads_blocked_and_a_free_one_moved(seed):
     """At 15 N of F/T force noise (rms per axis) a 5-tick median and a 10-reading tare read a free slide latched
-    (both seeds here; 4 of seeds 0-7); a filter and a tare sized to the noise measured above the part read both
-    parts right (all 8)."""
+    (both seeds here; 2 of seeds 0-7, 4 before the descents' last ``touch_height`` ran slowly); a filter and a tare
+    sized to the noise measured above the part read both parts right (all 8)."""
     noisy = RealityProfile(name="noisy-ft", force_torque=ForceTorqueReality(force_noise=15.0))
     spec = generate_chain(["slide", "door"], seed=2)  # the door is latched until the slide is open
     fixed = replace(PrimitiveConfig(), filtered_noise=1e9, tare_noise=1e9)

@@ -91,8 +91,10 @@ def test_a_fit_to_ideal_world_logs_stays_near_the_nominal_model(ideal_logs):
     ready, _ = prepare(ideal_logs)
     slide, door = fit_kind("slide", ready, FIT), fit_kind("door", ready, FIT)
     assert slide.scales.friction == pytest.approx(1.0, rel=0.02), slide  # replayed to 0.002 N: nothing to fit
-    # the doors' replay mismatch (above) reads as ~35 % more damping than the nominal model's
-    assert door.scales.damping == pytest.approx(1.0, rel=0.5), door
+    # the doors' replay mismatch (above) reads as more damping than the nominal model's: ~35 % with the pads closing
+    # 1.5-1.6 mm above their target on the post, 70 % since the descent's last centimetres run slowly and they close
+    # 0.8-1.1 mm above it (runs/s5/force-descent/checks/grasp_height.py)
+    assert door.scales.damping == pytest.approx(1.0, rel=0.75), door
     assert door.scales.friction == pytest.approx(1.0, rel=0.3), door
 
 
