@@ -397,6 +397,14 @@ _MEDIAN_SPREAD = math.sqrt(math.pi / 2)
 """Spread of the median of n samples of a Gaussian, times sqrt(n), over the samples' spread (large n)."""
 
 
+def _out_to_radius(pose: np.ndarray, radius: float) -> None:
+    """Move ``pose`` (4x4, base frame; in place) out horizontally from the base's vertical axis to ``radius`` [m] if
+    it stands closer (and not on the axis itself)."""
+    now = math.hypot(pose[0, 3], pose[1, 3])
+    if 1e-6 <= now < radius:
+        pose[:2, 3] *= radius / now
+
+
 def _median_rows(rows: collections.abc.Sequence[np.ndarray]) -> np.ndarray:
     """``np.median(rows, axis=0)``, bit for bit, at a fifth of its cost on a few short rows (it runs every tick)."""
     ordered = np.sort(np.array(rows), axis=0)
@@ -726,22 +734,19 @@ class Toggler(DoorPushing):
         self._force_window = collections.deque(maxlen=samples)
         self.slowdown = samples / c.force_filter_samples / (c.careful_pace if self.careful else 1.0)
         self.phase = "descending"
-        touch_limit = max(c.cautious_contact_force, c.cautious_noise_margin * self.rest_noise)
-        if self.cautious:
-            self.limit = touch_limit
-            try:
-                self.move_to(target, c.cautious_descend_time * height / c.approach_height * self.slowdown, smooth=False)
-            finally:
-                self.limit = c.force_limit
-            return
-        # quickly down to where the fingers could first meet a handle they were aimed beside, then slowly, so that
-        # one met (a wrong perception or calibration) stops the arm at a light touch: the try fails, not the part
-        near = target.copy()
-        near[:3, 3] -= c.touch_height * target[:3, 2]
-        self.move_to(near, c.descend_time * (height - c.touch_height) / c.approach_height * self.slowdown)
-        self.limit = touch_limit
+        if self.cautious:  # the whole way slowly, under the light touch
+            slow = c.cautious_descend_time * height / c.approach_height
+        else:
+            # quickly down to where the fingers could first meet a handle they were aimed beside, then slowly, so
+            # that one met (a wrong perception or calibration) stops the arm at a light touch: the try fails, not
+            # the part
+            near = target.copy()
+            near[:3, 3] -= c.touch_height * target[:3, 2]
+            self.move_to(near, c.descend_time * (height - c.touch_height) / c.approach_height * self.slowdown)
+            slow = c.touch_height / c.touch_speed
+        self.limit = max(c.cautious_contact_force, c.cautious_noise_margin * self.rest_noise)
         try:
-            self.move_to(target, c.touch_height / c.touch_speed * self.slowdown, smooth=False)
+            self.move_to(target, slow * self.slowdown, smooth=False)
         finally:
             self.limit = c.force_limit
 
@@ -763,7 +768,7 @@ class Toggler(DoorPushing):
         height = max(c.base_rise, c.touch_height)
         above[:3, 3] = target[:3, 3] - height * target[:3, 2]
         out = above.copy()
-        out[:2, 3] *= max(1.0, c.base_radius / max(math.hypot(above[0, 3], above[1, 3]), 1e-6))
+        _out_to_radius(out, c.base_radius)
         self.travel_to(out, c.approach_time)
         self.move_to(above, c.retreat_time)
         return height
@@ -1092,7 +1097,7 @@ class Toggler(DoorPushing):
         if pose[2, 3] < min(bottom + c.base_rise, top):
             self._rise(pose, min(bottom + c.base_rise, top))
             self.move_to(pose, c.lift_slow_time)
-        pose[:2, 3] *= c.base_radius / radius
+        _out_to_radius(pose, c.base_radius)
         self.move_to(pose, c.retreat_time)
 
     def _open_gently(self, closure: float) -> None:
