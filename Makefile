@@ -56,7 +56,7 @@ lint: $(STAMP) $(MUJOCO_STUBS) $(PYRIGHT_ROOT)
 	$(BIN)/pyright
 
 test: lint
-	$(BIN)/python -m pytest -q -n 2 --dist worksteal  # pytest-xdist: both cores; an idle worker takes queued tests from the busy one
+	$(BIN)/python -m pytest -q -n 2 --dist loadgroup --no-loadscope-reorder  # both cores, the longest work first (tests/_schedule.py)
 
 # The main job on the built-in default: the paper's boxes, a memory trained in the symbolic simulator on
 # the 9 training boxes (one episode each), then an unseen box solved end to end in the MuJoCo twin

@@ -1,4 +1,5 @@
-"""Shared fixtures: the SPEC.md example as a dict, and a writer for spec files."""
+"""Shared fixtures: the SPEC.md example as a dict, and a writer for spec files; the longest tests first
+(:mod:`_schedule`)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from _schedule import load_costs, order_longest_first, recording
 from hypothesis import settings
 
 # CI explores the same examples every run (a failure there is reproducible); local runs explore anew.
@@ -80,3 +82,13 @@ def write_spec(tmp_path: Path):
         return path
 
     return write
+
+
+def pytest_collection_modifyitems(config, items):
+    order_longest_first(items, load_costs())
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    with recording(item):
+        yield

@@ -13,6 +13,7 @@ from html.parser import HTMLParser
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
+import _shared as shared
 import imageio.v3 as iio
 import pytest
 
@@ -231,10 +232,8 @@ def test_data_strings_are_escaped(made, tmp_path):
     check_page(tmp_path / "t" / "report.html")
 
 
-def test_a_twin_trial_report_links_its_video_and_draws_its_timeline(made, tmp_path):
-    out = tmp_path / "twin"
-    ok(script("trial.py", "--specs", made / "specs/paper-test-0.json", "--sim", "twin", "--agent", "oracle",
-              "--runs", 1, "--seed", 0, "--max-actions", 3, "--workers", 1, "--video", "--out", out))  # fmt: skip
+def test_a_twin_trial_report_links_its_video_and_draws_its_timeline(tmp_path, tmp_path_factory):
+    out = shared.private_copy(shared.video_trial(tmp_path_factory) / "video", tmp_path / "twin")  # paper-test-1
     assert (out / "rollout.mp4").is_file()
     ok(script("report.py", out))
     page = out / "report.html"
@@ -245,13 +244,13 @@ def test_a_twin_trial_report_links_its_video_and_draws_its_timeline(made, tmp_pa
     assert videos == ["rollout.mp4"]
     # the page opens with the box's annotated top view: a PNG beside the run, linked before the summary
     text = page.read_text()
-    assert [link for tag, link in parsed.links if tag == "img"] == ["gallery/paper-test-0/top-annotated.png"]
+    assert [link for tag, link in parsed.links if tag == "img"] == ["gallery/paper-test-1/top-annotated.png"]
     assert text.index("<img") < text.index('id="summary"')
-    top = iio.imread(out / "gallery/paper-test-0/top-annotated.png")
+    top = iio.imread(out / "gallery/paper-test-1/top-annotated.png")
     assert top.shape[1] == 640 and top.shape[0] > 480  # the view, and the legend of lock rules below it
-    stamp = (out / "gallery/paper-test-0/top-annotated.png").stat().st_mtime_ns
+    stamp = (out / "gallery/paper-test-1/top-annotated.png").stat().st_mtime_ns
     ok(script("report.py", out, "--out", tmp_path / "again.html"))
-    assert (out / "gallery/paper-test-0/top-annotated.png").stat().st_mtime_ns == stamp, "drawn once, then reused"
+    assert (out / "gallery/paper-test-1/top-annotated.png").stat().st_mtime_ns == stamp, "drawn once, then reused"
     assert page.stat().st_size < (out / "rollout.mp4").stat().st_size, "the video is linked, not inlined"
     text = page.read_text()
     assert "outcome agreement" in text and "Peak wrist force per action" in text
@@ -265,7 +264,7 @@ def test_a_twin_trial_report_links_its_video_and_draws_its_timeline(made, tmp_pa
     ok(script("report.py", tmp_path / "flipped", "--out", tmp_path / "pages" / "flipped.html"))
     parsed = check_page(tmp_path / "pages" / "flipped.html")  # the video resolves from another directory too
     check_timelines(parsed, crafted)
-    assert [a["mark"] for a in parsed.timelines[0]["actions"]] == [False, True, False]
+    assert [a["mark"] for a in parsed.timelines[0]["actions"]] == [i == 1 for i in range(len(record["timeline"]))]
     assert [link for tag, link in parsed.links if tag == "video"] == ["../flipped/rollout.mp4"]
 
 

@@ -4,23 +4,20 @@ washed out nor dark, drawn in a second process, and no frames at all without --v
 
 import json
 import math
-import subprocess
-import sys
 from pathlib import Path
 
+import _shared as shared
 import imageio.v3 as iio
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-
-from puzzlebox.lab import TrialConfig, run_trial  # noqa: E402
-from puzzlebox.lab.rollout_observers import scene_cameras  # noqa: E402
-from puzzlebox.models.generator import generate_chain, paper_family  # noqa: E402
-from puzzlebox.models.placement import placed  # noqa: E402
-from puzzlebox.models.scene import SceneConfig, unreachable_handles  # noqa: E402
-from puzzlebox.twin.errors import VideoError  # noqa: E402
-from puzzlebox.twin.rollout_video import (  # noqa: E402
+from puzzlebox.lab import TrialConfig, run_trial
+from puzzlebox.lab.rollout_observers import scene_cameras
+from puzzlebox.models.generator import generate_chain, paper_family
+from puzzlebox.models.placement import placed
+from puzzlebox.models.scene import SceneConfig, unreachable_handles
+from puzzlebox.twin.errors import VideoError
+from puzzlebox.twin.rollout_video import (
     BackgroundRollout,
     Caption,
     FrameCollector,
@@ -30,26 +27,15 @@ from puzzlebox.twin.rollout_video import (  # noqa: E402
     RolloutFrame,
     frames_path,
 )
-from puzzlebox.twin.session import TwinSession  # noqa: E402
+from puzzlebox.twin.session import TwinSession
 
 
 @pytest.fixture(scope="module")
 def video_trial(tmp_path_factory):
-    """One twin trial with --video and the same trial without (paper test box, oracle agent)."""
-    out = tmp_path_factory.mktemp("rollout")
-    spec_dir = out / "specs"
-    subprocess.run([sys.executable, str(ROOT / "scripts/generate.py"), "paper", "--split", "test", "--out",
-                    str(spec_dir)], check=True, capture_output=True)  # fmt: skip
-    runs = {}
-    for name, extra in (("video", ["--video"]), ("plain", [])):
-        done = subprocess.run(
-            [sys.executable, str(ROOT / "scripts/trial.py"), "--specs", str(spec_dir / "paper-test-1.json"), "--sim",
-             "twin", "--agent", "oracle", "--runs", "1", "--seed", "3", "--max-actions", "8", "--out",
-             str(out / name), "--workers", "1", *extra],
-            capture_output=True, text=True, timeout=600,
-        )  # fmt: skip
-        assert done.returncode == 0, done.stderr[-2000:]
-        runs[name] = json.loads((out / name / "results.json").read_text())["runs"][0]
+    """One twin trial with --video and the same trial without (paper test box, oracle agent), shared with the
+    report's tests."""
+    out = shared.video_trial(tmp_path_factory)
+    runs = {name: json.loads((out / name / "results.json").read_text())["runs"][0] for name in ("video", "plain")}
     return out, runs
 
 
