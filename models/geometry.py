@@ -71,6 +71,17 @@ def polygon_gap(a: np.ndarray, b: np.ndarray) -> float:
     return float(best)
 
 
+def polygons_clear(a: np.ndarray, b: np.ndarray, clearance: float) -> bool:
+    """Whether ``polygon_gap(a, b) >= clearance`` [m], decided at the first axis that shows it (the same
+    comparisons, so the same answer, in a fraction of the time for polygons far apart)."""
+    for polygon in (a, b):
+        for axis in _axes(polygon):
+            pa, pb = (a @ axis).tolist(), (b @ axis).tolist()  # (Python floats: the same values, min/max faster)
+            if max(min(pb) - max(pa), min(pa) - max(pb)) >= clearance:
+                return True
+    return False
+
+
 def clip_below_x(polygon: np.ndarray, x_max: float) -> np.ndarray:
     """The part of a convex polygon ``(n, 2)`` [m] at ``x <= x_max``, a convex polygon ``(m, 2)`` in the
     same order (empty ``(0, 2)`` if none of it is there)."""

@@ -43,7 +43,7 @@ import trimesh
 from trimesh.visual import ColorVisuals
 
 from puzzlebox.models.errors import UnknownKindError
-from puzzlebox.models.geometry import circle_polygon, polygon_gap, rectangle, transform_points
+from puzzlebox.models.geometry import circle_polygon, polygons_clear, rectangle, transform_points
 from puzzlebox.models.kinds.parts import PLATE_THICKNESS
 from puzzlebox.models.kinds.registry import get_kind
 from puzzlebox.models.kinds.template import HANDLE_SIZE, MARKER_SIZE, KindTemplate
@@ -347,7 +347,7 @@ class _Obstacles:
             c = polygon.mean(axis=0)
             if float(np.linalg.norm(c - centre)) > radius + float(np.linalg.norm(polygon - c, axis=1).max()):
                 continue
-            if polygon_gap(strip, polygon) < CLEARANCE:
+            if not polygons_clear(strip, polygon, CLEARANCE):
                 return False
         return True
 

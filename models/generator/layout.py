@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from puzzlebox.models.errors import GeneratorError
-from puzzlebox.models.geometry import compose, polygon_gap
+from puzzlebox.models.geometry import compose, polygon_gap, polygons_clear
 from puzzlebox.models.kinds import get_kind
 
 TURNS = (-math.pi / 2.0, 0.0, math.pi / 2.0)
@@ -105,7 +105,7 @@ class Layout:
             return pose, template.footprint_in_lid(pose)
 
         def clears(distance: float) -> bool:
-            return polygon_gap(at(distance)[1], self._footprints[anchor]) >= self.config.clearance
+            return polygons_clear(at(distance)[1], self._footprints[anchor], self.config.clearance)
 
         # The first distance on the grid step, 2 step, ... at which the footprint clears the anchor.
         # The gap is convex in the distance (a max of functions linear in it), so "clears" is false
@@ -124,7 +124,7 @@ class Layout:
             low, high = (low, middle) if clears(grid[middle]) else (middle, high)
         pose, polygon = at(grid[high])
         for other, footprint in enumerate(self._footprints):
-            if other != anchor and polygon_gap(polygon, footprint) < self.config.clearance:
+            if other != anchor and not polygons_clear(polygon, footprint, self.config.clearance):
                 return None
         if not self._respects_edges(kind, pose):
             return None
