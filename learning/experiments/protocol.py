@@ -50,7 +50,7 @@ class ProtocolConfig:
 
     def quick(self) -> ProtocolConfig:
         """A CI-sized version: few runs, one training seed."""
-        return replace(self, runs_per_variant=4, training_seeds=1)
+        return replace(self, runs_per_variant=2, training_seeds=1)
 
 
 @functools.lru_cache(maxsize=4096)

@@ -41,6 +41,7 @@ transaction.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import math
 import os
@@ -556,6 +557,27 @@ class MemoryStore:
 
     def __repr__(self) -> str:
         return f"MemoryStore({json.dumps(self.summary())})"
+
+
+_NOT_LEARNED = (("episodes", "created"), ("episodes", "training_run"))
+"""Columns that say when and by which command an episode was stored, not what it taught."""
+
+
+def content_sha256(path: str | Path) -> str:
+    """A digest of what a memory file holds for an agent: its settings, its episodes (spec, seed, outcome, source,
+    profile, robot time: not when they were stored), its pair and independence entries in their order. Two files
+    with the same digest make the same memory agent, so a trial run with one is the trial run with the other."""
+    digest = hashlib.sha256()
+    with contextlib.closing(sqlite3.connect(f"{Path(path).resolve().as_uri()}?mode=ro", uri=True)) as conn:
+        tables = {row[0] for row in conn.execute("SELECT name FROM sqlite_master WHERE type='table'")}
+        columns = {t: [row[1] for row in conn.execute(f"PRAGMA table_info({t})")] for t in tables}
+        for table in sorted(tables - {"training_runs"}):  # (when and by which command: not what was learned)
+            kept = [c for c in columns[table] if (table, c) not in _NOT_LEARNED]
+            order = "key" if table == "meta" else "rowid"
+            digest.update(f"{table}({','.join(kept)})".encode())
+            for row in conn.execute(f"SELECT {', '.join(kept)} FROM {table} ORDER BY {order}"):
+                digest.update(repr(row).encode())
+    return digest.hexdigest()
 
 
 def expected_lockers(pair_values: np.ndarray) -> float:

@@ -25,7 +25,9 @@ images first (``lab.calibration_run``); training stores only what the robot sens
 Everything is a task of ``puzzlebox.lab.runner`` (``--workers K``, or Ray): one training chain per start and
 seed (its memory file grows episode by episode in ``DIR/memories/``, and a copy of it is taken at each
 checkpoint, atomically: a chain killed part-way resumes from its file and its copies), then one trial per
-start, seed, checkpoint, test box and placement (``DIR/trials/``). The same command resumes. The summary
+start, seed, checkpoint, test box and placement (``DIR/trials/``), run once where memories hold the same (every
+seed's empty memory, a seed's symbolic and symbolic+twin memories at 0 h: ``same_trial_as`` in the summary names
+the trial that stands for another). The same command resumes. The summary
 is ``DIR/twin-learning.{json,md,png}``: mean actions and success against robot hours, mean and spread over
 seeds, with the paper's real-robot figures beside them.
 """
@@ -55,6 +57,7 @@ from puzzlebox.learning.dual_controller import DualControllerConfig
 from puzzlebox.learning.experiments.deep_protocols import TrainingJob, job_key
 from puzzlebox.learning.experiments.protocol import ProtocolConfig
 from puzzlebox.learning.memory import MemoryStore
+from puzzlebox.learning.memory.store import content_sha256
 from puzzlebox.models import PuzzleSpec
 from puzzlebox.models.atomic import apply_umask
 from puzzlebox.models.calibration import CellCalibration
@@ -259,18 +262,27 @@ def run_twin_learning(
         trained.raise_for_failures()
         phases["twin_training_s"] = time.perf_counter() - begin - sum(phases.values())
         trials, where = [], {}
+        same_trial_as: dict[str, str] = {}  # a checkpoint's trial -> the same trial of an identical memory
+        first_of: dict[tuple[str, str, int], str] = {}
         for chain in chains:
             record = trained.records[chain.key]
             for checkpoint in record["checkpoints"]:
+                # every start's 0 h memory of one seed is the same, the empty ones of every seed too: their trials
+                # are run once (a trial is a function of the memory's content, the box and its placement)
+                content = content_sha256(memories / checkpoint["memory"])
                 for box in tests:
                     for placement in range(config.placements):
                         key = f"{chain.key}@{checkpoint['hours']:g}h-{box.spec.name}-p{placement}"
+                        where[key] = (record["start"], record["seed"], checkpoint["hours"])
+                        first = first_of.setdefault((content, box.spec.name, placement), key)
+                        if first != key:
+                            same_trial_as[key] = first
+                            continue
                         trials.append(trial_task(
                             key, box.spec, config.eval_seed + placement, sim="twin", agent="memory",
                             max_actions=config.max_actions, memory=str(memories / checkpoint["memory"]),
                             reality=reality.to_dict(), calibration=calibration, max_lockers=box.max_lockers,
                         ))  # fmt: skip
-                        where[key] = (record["start"], record["seed"], checkpoint["hours"])
         for job in deep_jobs:
             record = deep_records[job.key]
             agent, seed = job.settings["job"]["agent"], job.settings["job"]["seed"]
@@ -287,8 +299,10 @@ def run_twin_learning(
                              postfix=lambda r: f"solved {sum(x['solved'] for x in r.values())}/{len(r)}")  # fmt: skip
         measured.raise_for_failures()
         phases["test_trials_s"] = time.perf_counter() - begin - sum(phases.values())
-    summary = _summary(config, reality.name, trained.records, measured.records, where, deep_records)
-    summary = with_optimum(summary, measured.records, where, tests, config.max_actions)
+    records = {**measured.records, **{key: measured.records[first] for key, first in same_trial_as.items()}}
+    summary = _summary(config, reality.name, trained.records, records, where, deep_records)
+    summary = with_optimum(summary, records, where, tests, config.max_actions)
+    summary["same_trial_as"] = same_trial_as
     summary["wall_time_s"] = time.perf_counter() - begin
     summary["wall_time_by_phase_s"] = phases
     write_json(out / "twin-learning.json", summary)

@@ -503,3 +503,29 @@ def test_memory_recalls_which_locker_state_at_the_pose_it_was_learned_and_not_fa
     # door state holds the slide (its independence is pooled per kind, so it is still held)
     assert near[1, 0, 1] > near[1, 0, 2] + 0.5
     assert far[1, 0, 1] == pytest.approx(far[1, 0, 2], abs=1e-6)
+
+
+def test_the_content_digest_says_what_a_memory_teaches_not_when_it_was_stored(tmp_path):
+    from puzzlebox.learning.memory.store import content_sha256
+
+    def trained(path, episodes):
+        store = MemoryStore(path)
+        for e in range(episodes):
+            spec = paper_variant(TRAIN_INDICES[e], seed=0)
+            run_episode(MemoryAgent(store, learn=True), SymbolicWorld(spec, e), spec.name, e, 30)
+        store.close()
+        return path
+
+    first, again = trained(tmp_path / "a.sqlite", 2), trained(tmp_path / "b.sqlite", 2)  # stored at other times
+    with sqlite3.connect(again) as conn:
+        assert conn.execute("SELECT COUNT(*) FROM episodes").fetchone()[0] == 2
+        conn.execute("UPDATE episodes SET created = created + 3600")
+    assert content_sha256(first) == content_sha256(again)
+    assert content_sha256(trained(tmp_path / "c.sqlite", 3)) != content_sha256(first)  # one episode more
+    with sqlite3.connect(again) as conn:  # one learned probability changed
+        rowid, value = conn.execute("SELECT rowid, value FROM pair_entries LIMIT 1").fetchone()
+        conn.execute("UPDATE pair_entries SET value = ? WHERE rowid = ?", (bytes(reversed(value)), rowid))
+    assert content_sha256(again) != content_sha256(first)
+    for name in ("empty.sqlite", "empty-too.sqlite"):
+        MemoryStore(tmp_path / name).close()
+    assert content_sha256(tmp_path / "empty.sqlite") == content_sha256(tmp_path / "empty-too.sqlite")

@@ -130,6 +130,9 @@ def test_quick_twin_learning_trains_each_start_in_the_twin_measures_its_checkpoi
                            ("symbolic+twin", 0.02), ("dqn", 0.0)}  # fmt: skip
     assert all(p["seeds"][0]["trials"] == 1 and p["success_rate"] in (0.0, 1.0) for p in points.values())
     # the deep agent ran the same test trial from the network it trained in the symbolic simulator
+    # the symbolic and symbolic+twin memories at 0 h hold the same: their trial is run once and stands for both
+    assert data["same_trial_as"] == {"symbolic+twin-s0@0h-paper-test-0-p0": "symbolic-s0@0h-paper-test-0-p0"}
+    assert not (tmp_path / "trials" / "symbolic+twin-s0@0h-paper-test-0-p0.json").exists()
     dqn_trial = json.loads((tmp_path / "trials" / "dqn-v9-s0-paper-test-0-p0.json").read_text())["record"]
     assert dqn_trial["spec"] == "paper-test-0" and dqn_trial["actions"], dqn_trial
     assert (tmp_path / "deep" / "jobs" / "dqn-v9-s0.pt").stat().st_size > 0
