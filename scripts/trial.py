@@ -23,8 +23,6 @@ from pathlib import Path
 from typing import Any
 
 from puzzlebox.lab.agent_class import check_agent
-from puzzlebox.lab.arm_trial_command import ArmTrialRequest, reach_arm, run_arm_trial
-from puzzlebox.lab.cells import CellError, load_cell
 from puzzlebox.lab.cli import fail, one_line
 from puzzlebox.lab.errors import AgentClassError, ArmTrialFailed, ArmTrialRefused, RunStoreError, TrialConfigError
 from puzzlebox.lab.run_store import RunStore
@@ -41,6 +39,8 @@ NOT_RESULTS = ("out", "resume", "force", "workers", "ray", "robot", "ip", "cell"
 
 def _arm_main(args, arm: Callable[[str, Any], Any] | None) -> int:
     """``--robot xarm``: one trial on the real arm, every twin-only flag refused first."""
+    from puzzlebox.lab.arm_trial_command import ArmTrialRequest, reach_arm, run_arm_trial  # (the arm's stack)
+
     if args.ip is None or args.cell is None:
         fail("--robot xarm needs --ip ADDRESS (the arm's controller) and --cell FILE (the cell config)")
     if args.sim != "twin":
@@ -152,6 +152,8 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
         fail(str(err))
     reality = calibration = None
     if args.sim == "twin":
+        from puzzlebox.lab.cells import CellError, load_cell  # (the twin's stack: not loaded for symbolic runs)
+
         try:  # a calibration belongs to one cell (its profile, cell seed and box height): the cell is taken from it
             reality, calibration = load_cell(args.reality, args.calibration, dict(zip(args.specs, specs, strict=True)))
         except CellError as err:
