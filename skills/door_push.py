@@ -124,13 +124,23 @@ class DoorPushConfig:
     the door's closed footprint (81 mm from the hinge), clear of any neighbour."""
     top_up_clearance: float = 0.010
     """Clearance between the pads' edge and the plate's top corner at ``top_up_from`` as the pads descend [m]."""
-    top_up_near_stop: float = math.radians(3.0)
-    """How close to its end stop the underside must be before ``end_force`` ends a top-up push [rad]: a damped
-    door pushed at 20 mm/s presses back with 20 N long before (it stopped a harsh door at 75 deg)."""
-    top_up_time: float = 4.5
-    """Time of the top-up push, from outside the plate's reach to its end stop (~15 mm/s) [s]: at the pads'
-    ``top_up_low`` a damped door turns ~1.5 times as fast for the same pad speed as at ``top_up_height``, and
-    presses back over a shorter lever (3 s: 61-66 N on harsh doors)."""
+    top_up_speed: float = 0.010
+    """Speed of the pads' edge towards the hinge during a top-up push, constant from outside the plate's reach
+    to its end stop [m/s]: wherever the door stands it may be held there (by a lock's latch, a jam) or already
+    in its stop, and pressed on, the force builds by the arm's stiffness times this speed every tick while the
+    harsh reading is ~60 ms late (F/T delay, the running median, the command latency). Eased in and out over
+    4.5 s (20 mm/s at the middle), a door held at 64 deg put 48 N on the wrist and one in its stop 40-50 N
+    before the late reading passed ``blocked_magnitude``. At the pads' ``top_up_low`` a damped door turns ~1.5
+    times as fast for the same pad speed as at ``top_up_height``, and presses back over a shorter lever (in
+    3 s: 61-66 N on harsh doors)."""
+    top_up_force: float = 15.0
+    """Force magnitude that ends a top-up push wherever the pads are [N]: the plate is held there, or in its
+    end stop. A free door at 64 deg turned at ``top_up_speed`` under the harsh profile's draws (damping,
+    friction, mass) pressed back with up to 12 N (12 draws). Stopped here, a door held at 56-72 deg or in its
+    stop took 18-24 N true under the harsh reading, against 40-50 N at ``blocked_magnitude`` (runs/s6/topup)..."""
+    top_up_noise_margin: float = 5.0
+    """... plus this many times the noise of the filtered force (:meth:`Toggler.filtered_noise_now`, per axis:
+    its magnitude over three axes reaches ~5 times it), up to ``blocked_magnitude``."""
     blocked_force: float = 30.0
     """Normal force on a handle's back face that, with little progress, means a latch [N] (a free door
     under the harsh profile's damping and friction took up to 13 N)."""
@@ -366,7 +376,9 @@ class DoorPushing:
         the hinge, diving to ``top_up_low`` once over the door's own footprint: it meets the plate's underside
         wherever the door stands and turns it up into its end stop. ``moved`` once the edge passed where the
         underside is at ``moved_fraction`` of the travel (a free door turns under less than 1 N: meeting the
-        plate is not felt, so this cannot tell a door that was not there)."""
+        plate is not felt, so this cannot tell a door that was not there). The edge moves in at a constant
+        ``top_up_speed`` and stops where the force passes ``top_up_force`` (and the noise's margin): wherever
+        the plate is met it may be held there, or in its stop."""
         c = self.config
         p = c.push
         door = DoorPush.of(jm, p.height)
@@ -374,7 +386,6 @@ class DoorPushing:
         free_edge = door.contact[0] + HANDLE_MARGIN - HANDLE_SIZE / 2  # the plate's far edge from the hinge
         x_start = free_edge * math.cos(p.top_up_from) + p.top_up_clearance
         x_end = p.top_up_low / math.tan(door.travel) - p.depth  # where the underside meets the pads at the stop
-        x_near_stop = p.top_up_low / math.tan(door.travel - p.top_up_near_stop)
 
         def height_at(edge_x: float) -> float:  # the pads' height above the hinge line with their edge at edge_x
             dive = min(max((x_start - edge_x) / p.top_up_dive, 0.0), 1.0)
@@ -389,18 +400,19 @@ class DoorPushing:
         finally:
             self.cautious = cautious
         self.phase = "actuating"
-        ticks = round(p.top_up_time * self.slowdown / c.tick)
+        path = math.hypot(x_start - x_end, p.top_up_height - p.top_up_low)  # (the dive is part of the way)
+        ticks = max(1, round(path / p.top_up_speed * self.slowdown / c.tick))
+        stop = min(c.blocked_magnitude, p.top_up_force + p.top_up_noise_margin * self.filtered_noise_now())
         forces: list[float] = []
         edge_x = x_start
         self.ik.set_joints(self.robot.joint_positions())
         for k in range(1, ticks + round(c.settle_time / c.tick) + 1):
-            u = min(k / ticks, 1.0)
-            self._tick(tcp_for(x_start + (x_end - x_start) * u * u * (3 - 2 * u)))
+            self._tick(tcp_for(x_start + (x_end - x_start) * min(k / ticks, 1.0)))  # at a constant speed
             edge_x = float((self._pad_edge(door, -p.pad_half_width) - door.origin) @ door.e_x)
             forces.append(float(-self.force_in_base @ door.e_x))
             magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
-            if magnitude > c.blocked_magnitude or (magnitude > p.end_force and edge_x <= x_near_stop):
-                break  # held, or in its end stop
+            if magnitude > stop:
+                break  # held where it stands, or in its end stop
         progress = math.atan2(height_at(edge_x), max(edge_x, 1e-6)) / door.travel  # the underside's angle there
         result = self._verdict(progress, forces)
         self._back_off(door, 0.0)  # off the plate (along e_x) before lifting
