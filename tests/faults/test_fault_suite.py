@@ -61,6 +61,7 @@ def test_the_quick_fault_suite_detects_survives_and_keeps_every_case(tmp_path):
         race = rows[f"two {kind}.py into one --out, started together"]
         assert race["data_kept"] == "0 summaries lost" and race["detected"].startswith("2/2 second writers refused")
     assert rows["memory with a trigger, a view, an extra table"]["detected"] == "3/3 refused in one line (exit 2)"
+    assert rows["malformed inputs"]["detected"] == "10/10 one line, exit 2"  # one of each command and loader
     blank = rows["twin: camera: every frame dropped"]
     assert blank["detected"].startswith("ended: MarkersNotFound") and blank["data_kept"] == "1/1 run recorded"
     bad = python(ROOT / "scripts/experiment.py", "faults", "--out", out, "--runs", "1")
