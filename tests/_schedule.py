@@ -7,7 +7,7 @@ next idle worker, in collection order. Collected longest first by the CPU second
 first): the run ends within about the shortest tests of each other instead of one worker idling while the other
 finishes a two-minute end-to-end experiment it picked up last.
 
-The table is only an ordering hint: a test missing from it (new, renamed) costs :data:`UNKNOWN_COST_S`, and a
+The table is only an ordering hint: a test missing from it (short, new, renamed) costs :data:`UNKNOWN_COST_S`, and a
 stale figure changes the order, never a result. Refresh it after the suite changes::
 
     PUZZLEBOX_TEST_COSTS=/tmp/costs.tsv make test && .venv/bin/python tests/_schedule.py /tmp/costs.tsv
@@ -29,8 +29,12 @@ import pytest
 COSTS = Path(__file__).with_name("durations.json")
 """Test node id -> CPU seconds of its setup, call and teardown (the test process and its children)."""
 
-UNKNOWN_COST_S = 1.0
-"""The cost assumed of a test the table does not list [s]."""
+UNKNOWN_COST_S = 0.1
+"""The cost assumed of a test the table does not list [s] (it lists those of :data:`LISTED_FROM_S` or more; the
+others averaged 0.06 s)."""
+
+LISTED_FROM_S = 0.5
+"""The table lists the tests that took at least this long [s]: the order of the rest hardly matters."""
 
 GROUPED = (
     "tests/lab/test_hard_sets.py",
@@ -100,13 +104,15 @@ def recording(item: pytest.Item) -> Iterator[None]:
 
 
 def refresh(log: Path, table: Path = COSTS) -> int:
-    """Write ``table`` from a recorded log (the last figure of each test); returns how many tests it lists."""
+    """Write ``table`` from a recorded log (the last figure of each test, those of :data:`LISTED_FROM_S` or more);
+    returns how many tests it lists."""
     costs: dict[str, float] = {}
     for line in log.read_text().splitlines():
         seconds, _, nodeid = line.partition("\t")
         costs[nodeid] = round(float(seconds), 1)
-    table.write_text(json.dumps(dict(sorted(costs.items())), indent=0) + "\n")
-    return len(costs)
+    listed = {k: v for k, v in sorted(costs.items()) if v >= LISTED_FROM_S}
+    table.write_text(json.dumps(listed, indent=0) + "\n")
+    return len(listed)
 
 
 if __name__ == "__main__":
