@@ -168,6 +168,18 @@ def _provenance(store: MemoryStore) -> dict[str, Any]:
     return cast("dict[str, Any]", store.provenance())
 
 
+def _checkpoint(copy: Path, hours: float) -> dict[str, Any]:
+    """The record of the checkpoint at ``hours`` [h] whose memory is ``copy``: what that copy holds (a chain resumed
+    after its copy was taken has a store that has grown since)."""
+    store = MemoryStore.open_existing(copy)
+    try:
+        provenance = _provenance(store)
+    finally:
+        store.close()
+    return {"hours": hours, "robot_hours": provenance["twin"]["robot_hours"], "memory": copy.name,
+            "twin_episodes": provenance["twin"]["episodes"], "episodes": provenance["episodes"]}  # fmt: skip
+
+
 def training_chain(settings: dict[str, Any], context: dict[str, Any]) -> dict[str, Any]:
     """One start's learning in the twin (a runner task): its memory grows in ``context['dir']`` and is copied
     at each checkpoint of ``settings['hours']``; a chain killed part-way goes on from its file."""
@@ -204,11 +216,7 @@ def training_chain(settings: dict[str, Any], context: dict[str, Any]) -> dict[st
             target = folder / f"{start}-s{seed}@{h:g}h.sqlite"
             if not target.exists():
                 _snapshot(path, target)
-            provenance = _provenance(store)
-            checkpoints.append({
-                "hours": h, "robot_hours": provenance["twin"]["robot_hours"], "memory": target.name,
-                "twin_episodes": provenance["twin"]["episodes"], "episodes": provenance["episodes"],
-            })  # fmt: skip
+            checkpoints.append(_checkpoint(target, h))
         log = store.training_log()  # each run's "episodes": a list
     finally:
         store.close()
