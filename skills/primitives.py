@@ -249,6 +249,14 @@ class PrimitiveConfig:
     the rest. Past the travel, a filtered force above ``overtravel_force`` stops the over-travel where the
     handle is. (Under the harsh grip the lag is a fifth of the fingers' turn, fingers at 98 deg leaving a
     door at 78: more over-travel met the end stop with 70 N jolts; a top-up push finishes those doors.)"""
+    overtravel_comply: bool = True
+    """Yield across the path in the over-travel too (:meth:`Toggler._yield_across`), until the end stop is felt
+    (``end_stop_force``), then return to the planned arc: the planned arc's mismatch with the door's true arc grows
+    past the travel (a door still rising, near upright), and held on the arc it loaded the grasp with ~32 N
+    *across* the motion (2-5 N along it), on which the handle's stick-slip in the pads put one-tick spikes of
+    45-48 N true (realistic: paper-test-2 seed 105, hard-chain8-s36004 seed 36100; runs/s6/pinch). Yielding,
+    the same pinches peaked at 27 and 22 N with the doors in their stops; a door that reaches its stop without
+    20 N felt is then topped up (``push.top_up``)."""
     end_stop_force: float = 20.0
     """Filtered force magnitude past the travel that tells a pinched door has reached its end stop [N] (a
     lagging handle pressed into it loads the grasp with 20-30 N, one that follows closely 47 N; weak pads
@@ -832,8 +840,11 @@ class Toggler(DoorPushing):
             self._tick(target)
             direction = sign * jm.motion_direction(fraction)
             opposing = float(-np.dot(self.force_in_base, direction))
-            if yields:  # past the travel, back to the planned arc: the end stop's load tells the door is open
-                across = self._yield_across(across, direction) if s <= 1.0 else across * returning
+            if yields:  # once the end stop is felt, back to the planned arc: its load tells the door is open
+                if s <= 1.0 or (c.overtravel_comply and not in_end_stop):
+                    across = self._yield_across(across, direction)
+                else:
+                    across = across * returning
             forces.append(opposing)
             progress = self.progress = self._progress(jm, sign, begin)
             if opposing >= max(forces):

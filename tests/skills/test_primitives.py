@@ -73,8 +73,8 @@ def test_a_free_slide_then_the_door_it_released_are_opened(chain):
     assert door.outcome == "moved", door.reason
     assert session.component_states()[1] == 1
     # a slow descent (its last touch_height at touch_speed), the over-travel into the end stop, a return through the
-    # transit
-    assert 5.0 < door.sim_time < 21.0
+    # transit (< 21 s), and a top-up push when the over-travel, yielding across its arc, did not feel the stop
+    assert 5.0 < door.sim_time < (45.0 if not door.end_stop_felt else 21.0)
 
 
 @pytest.mark.parametrize("seed", [0, 1])
