@@ -52,7 +52,7 @@ def _make_video_trial(folder: Path) -> None:
     for name, extra in (("video", ["--video"]), ("plain", [])):
         done = subprocess.run(
             [sys.executable, str(ROOT / "scripts/trial.py"), "--specs", str(specs / "paper-test-1.json"), "--sim",
-             "twin", "--agent", "oracle", "--runs", "1", "--seed", "3", "--max-actions", "8", "--out",
+             "twin", "--agent", "oracle", "--runs", "1", "--seed", "3", "--max-actions", "3", "--out",
              str(folder / name), "--workers", "1", *extra],
             capture_output=True, text=True, timeout=600,
         )  # fmt: skip
@@ -61,5 +61,6 @@ def _make_video_trial(folder: Path) -> None:
 
 def video_trial(factory: pytest.TempPathFactory) -> Path:
     """One twin trial with ``--video`` (``video/``) and the same trial without (``plain/``): paper-test-1 (in
-    ``specs/``), the oracle agent, seed 3."""
+    ``specs/``), the oracle agent, seed 3, its first 3 actions (a video costs ~7x its trial; three show every kind of
+    frame)."""
     return shared_output(factory, "video-trial", _make_video_trial)
