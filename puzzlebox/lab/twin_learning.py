@@ -275,8 +275,8 @@ def run_twin_learning(
         for chain in chains:
             record = trained.records[chain.key]
             for checkpoint in record["checkpoints"]:
-                # every start's 0 h memory of one seed is the same, the empty ones of every seed too: their trials
-                # are run once (a trial is a function of the memory's content, the box and its placement)
+                # a seed's symbolic and symbolic+twin memories at 0 h are one memory, every seed's empty one another:
+                # their trials are run once (a trial is a function of the memory's content, the box and its placement)
                 content = content_sha256(memories / checkpoint["memory"])
                 for box in tests:
                     for placement in range(config.placements):
