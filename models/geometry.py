@@ -56,6 +56,15 @@ def _axes(polygon: np.ndarray) -> np.ndarray:
     return normals / np.linalg.norm(normals, axis=1, keepdims=True)
 
 
+def _axis_gaps(a: np.ndarray, b: np.ndarray):
+    """The separation of two convex polygons along each edge normal of ``a``, then of ``b`` [m] (Python floats:
+    the same values as numpy's, min/max on a handful of them faster)."""
+    for polygon in (a, b):
+        for axis in _axes(polygon):
+            pa, pb = (a @ axis).tolist(), (b @ axis).tolist()
+            yield max(min(pb) - max(pa), min(pa) - max(pb))
+
+
 def polygon_gap(a: np.ndarray, b: np.ndarray) -> float:
     """Separation of two convex polygons along their best separating axis [m].
 
@@ -63,23 +72,13 @@ def polygon_gap(a: np.ndarray, b: np.ndarray) -> float:
     for the axis-aligned rectangles and near-circles used here). Zero or negative: they touch or
     overlap (the magnitude is the smallest penetration along the polygons' edge normals).
     """
-    best = -math.inf
-    for axis in np.concatenate([_axes(a), _axes(b)]):
-        pa, pb = a @ axis, b @ axis
-        gap = max(pb.min() - pa.max(), pa.min() - pb.max())
-        best = max(best, gap)
-    return float(best)
+    return float(max(_axis_gaps(a, b)))
 
 
 def polygons_clear(a: np.ndarray, b: np.ndarray, clearance: float) -> bool:
     """Whether ``polygon_gap(a, b) >= clearance`` [m], decided at the first axis that shows it (the same
     comparisons, so the same answer, in a fraction of the time for polygons far apart)."""
-    for polygon in (a, b):
-        for axis in _axes(polygon):
-            pa, pb = (a @ axis).tolist(), (b @ axis).tolist()  # (Python floats: the same values, min/max faster)
-            if max(min(pb) - max(pa), min(pa) - max(pb)) >= clearance:
-                return True
-    return False
+    return any(gap >= clearance for gap in _axis_gaps(a, b))
 
 
 def clip_below_x(polygon: np.ndarray, x_max: float) -> np.ndarray:
