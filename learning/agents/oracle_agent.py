@@ -8,7 +8,6 @@ shuffled) and replans from the observed state after every action (so a jam costs
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from puzzlebox.learning.errors import LearningError
 from puzzlebox.models import LockTable, PuzzleSpec, SceneObservation, TryResult
@@ -38,6 +37,8 @@ class OracleAgent:
         cost = np.linalg.norm(seen_xy[:, None, :] - true_xy[None, :, :], axis=2)
         true_kinds = np.array(self.spec.kinds)
         cost += KIND_MISMATCH_COST * (np.array(observation.kinds)[:, None] != true_kinds[None, :])
+        from scipy.optimize import linear_sum_assignment  # scipy on first use (start-up time)
+
         rows, cols = linear_sum_assignment(cost)
         self._spec_of_obs = cols[np.argsort(rows)]
 

@@ -116,13 +116,13 @@ class TwinLearningConfig:
     """Runs per unseen variant of their symbolic evaluation at the end of training (reported, not used)."""
 
     def quick(self) -> TwinLearningConfig:
-        """CI size: checkpoints at 0 and 0.02 h, one seed, one placement of one test box, 8 actions; DQN
+        """CI size: checkpoints at 0 and 0.02 h, one seed, one placement of one test box, 6 actions; DQN
         trained 10 episodes. With ``hard``: one box of each family, 16 actions, 2 training boxes of each family,
         no deep agent."""
         if self.test_set == "hard":
             return dataclasses.replace(self, hours=(0.0, 0.02), seeds=(0,), placements=1, max_actions=16,
                                        test_boxes=1, train_boxes=2, symbolic_episodes=6)  # fmt: skip
-        return dataclasses.replace(self, hours=(0.0, 0.02), seeds=(0,), placements=1, max_actions=8, test_boxes=1,
+        return dataclasses.replace(self, hours=(0.0, 0.02), seeds=(0,), placements=1, max_actions=6, test_boxes=1,
                                    deep_agents=("dqn",), deep_episodes=10, deep_eval_runs=1)  # fmt: skip
 
     def hard(self) -> TwinLearningConfig:
