@@ -72,8 +72,8 @@ class KindsConfig:
     unlike the chains the memory was trained on."""
 
     def quick(self) -> KindsConfig:
-        """A smoke-sized run (a minute): 10 random boxes, 1 seed, the ideal twin only, 2 random boxes in it."""
-        return replace(self, random_boxes=10, runs=1, profiles=("ideal",), twin_random=2)
+        """A smoke-sized run (a minute): 10 random boxes, 1 seed, the ideal twin only, 1 random box in it."""
+        return replace(self, random_boxes=10, runs=1, profiles=("ideal",), twin_random=1)
 
 
 def five_kind_chains() -> list[tuple[str, ...]]:

@@ -137,7 +137,7 @@ def test_a_video_killed_in_mid_write_never_appears_under_its_final_name(specs, t
 
     out = tmp_path / "out"
     command = [sys.executable, ROOT / "scripts/trial.py", "--specs", specs / "paper-test-0.json", "--sim", "twin",
-               "--agent", "oracle", "--runs", 1, "--seed", 0, "--max-actions", 2, "--video", "--out", out]  # fmt: skip
+               "--agent", "oracle", "--runs", 1, "--seed", 0, "--max-actions", 1, "--video", "--out", out]  # fmt: skip
     proc = subprocess.Popen(list(map(str, command)), stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 300
     while time.monotonic() < deadline and proc.poll() is None and not list(out.glob(".rollout.*.mp4")):
