@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from world_fixtures import TrueForceWatch
 
+from puzzlebox.lab.observers import ObservedRobot, TrialObserver
 from puzzlebox.lab.twin_trial import evaluation_world
 from puzzlebox.models.generator import generate_chain, paper_family
 from puzzlebox.models.placement import placed
@@ -90,6 +91,34 @@ def test_a_locked_lever_pressed_by_a_weak_grip_reads_blocked_at_a_light_force():
         assert pressed.outcome == "blocked", pressed
         assert robot.peak < PrimitiveConfig().blocked_force, robot.peak_during  # lighter than a latch elsewhere
         assert session.component_states()[lever] == 0
+
+
+class _ActuatingTime(TrialObserver):
+    """Simulated time the toggler spends actuating [s], summed over its control ticks."""
+
+    def __init__(self) -> None:
+        self.world, self.seconds, self._last = None, 0.0, None
+
+    def waited(self, now: float) -> None:
+        if self._last is not None and self.world is not None and self.world.toggler.phase == "actuating":
+            self.seconds += now - self._last
+        self._last = now
+
+
+def test_a_free_lever_pressed_along_its_post_is_actuated_at_press_pace_and_opens():
+    # a locked lever's post let the harsh grip's pads slide 8 mm at 6-9 N along the motion (a free lever is pressed
+    # with ~4 N: no force tells the two apart) until the fingers met its arm: +12 N true in the first tick at the usual
+    # pace, 46.5 N before the late reading showed it; the pace of the meeting sets that rise, so pressed handles go at
+    # press_pace (runs/s7/lever-force)
+    spec = generate_chain(["lever", "wheel"], seed=4)
+    lever = spec.index_of("lever-0")
+    config = PrimitiveConfig()
+    with TwinSession(spec, seed=0) as session:
+        watch = _ActuatingTime()
+        world = watch.world = evaluation_world(session, ObservedRobot(session.robot, [watch]))
+        opened = world.try_toggle(world.markers.index(spec.components[lever].marker))
+        assert opened.moved and session.component_states()[lever] == 1, opened
+    assert watch.seconds >= config.actuate_time / config.press_pace, watch.seconds  # 6.95 s (4.08 at the usual pace)
 
 
 @pytest.mark.parametrize("held_at", [64.0, None], ids=["held at 64 deg", "in its end stop"])
