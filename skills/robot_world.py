@@ -101,6 +101,15 @@ class WorldConfig:
     0: never."""
     other_kind_rounds: int = 2
     """Most tries of one part in which it is tried as other kinds."""
+    other_kinds_cautious: bool = True
+    """Descend cautiously (``toggle(cautious=True)``) onto another kind's grasp point that an open door may overhang
+    (:meth:`RobotWorld._doors_overhanging`), the part's own door included: tried as other kinds after its tries as a
+    door failed part-way, the part may stand raised over their handles. Tried as a slide at the normal descent
+    (~3 cm/s, careful), a pad met the handle of the part's own door (left part-way by a pinch that slipped, sunk to
+    57 deg) 47 mm above the slide's grasp point (the light touch watches the last 18 mm only), pushed it up to 77 deg,
+    where a downward push has little lever about the hinge, and the load rose ~1.1 N a tick to 66.8 N true before the
+    late, filtered reading passed the 60 N guard (hard-chain8-s36016 seed 36100, harsh). Cautious, the same descent
+    stopped at 17.8 N true (runs/s7/door-descent)."""
     lift_tolerance: float = 0.012
     """A kind fits a marker perceived this close to the kind's ``lift`` above the lid [m] (a lever's marker stands
     30 mm up; close up, markers are measured within ~1 mm)."""
@@ -369,11 +378,21 @@ class RobotWorld:
         blocked = [first] if first.outcome == "blocked" else []
         adopt: JointModel | None = None
         tried: list[str] = []
+        own_door = None  # the lowest fraction of its travel the part, as the door in use, may stand at, if any
+        if in_use.handling.swings_up and (marker in self.unsettled or not opening):
+            own_door = self.toggler.config.blocked_progress if marker in self.unsettled else c.open_door_from
         for kind in candidates:
             tried.append(kind)
             self.joint_models[marker] = jm = self._joint_model(marker, kind)
             self.kinds[marker] = kind
-            result = self.toggler.toggle(jm, opening, where_is=lambda: self._fraction_open(marker), careful=True)
+            grasp = jm.grasp_point_at(0.0 if opening else 1.0)
+            cautious = c.other_kinds_cautious and (
+                bool(self._doors_overhanging(marker, opening))
+                or (own_door is not None and near_open_door(in_use, own_door, grasp, c.door_clearance))
+            )
+            result = self.toggler.toggle(
+                jm, opening, where_is=lambda: self._fraction_open(marker), careful=True, cautious=cautious
+            )
             if result.outcome == "failed" and result.progress >= self.toggler.config.moved_fraction:
                 if self._overview_verdict(marker, opening, unseen_moved=not jm.handling.swings_up).moved:
                     result.outcome, result.reason = "moved", ""
