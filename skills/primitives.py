@@ -816,8 +816,8 @@ class Toggler(DoorPushing):
         c = self.config
         pressed = float(sign * jm.motion_direction(begin) @ at_grasp[:3, 2]) > math.cos(c.press_angle)
         slowdown = self.slowdown
-        if pressed:  # at press_pace: a careful toggle's slowdown already holds careful_pace
-            slowdown = max(slowdown, slowdown * (c.careful_pace if self.careful else 1.0) / c.press_pace)
+        if pressed:  # at press_pace at the most (a careful toggle may already go slower)
+            slowdown *= max(1.0, (c.careful_pace if self.careful else 1.0) / c.press_pace)
         ticks = round(c.actuate_time * slowdown / c.tick)
         forces: list[float] = []
         progress = 0.0

@@ -378,9 +378,8 @@ class RobotWorld:
         blocked = [first] if first.outcome == "blocked" else []
         adopt: JointModel | None = None
         tried: list[str] = []
-        own_door = None  # the lowest fraction of its travel the part, as the door in use, may stand at, if any
-        if in_use.handling.swings_up and (marker in self.unsettled or not opening):
-            own_door = self.toggler.config.blocked_progress if marker in self.unsettled else c.open_door_from
+        # the part itself, as the door in use, may stand open over the other kinds' grasp points
+        own_door = self._lowest_open(marker, 0 if opening else 1) if in_use.handling.swings_up else None
         for kind in candidates:
             tried.append(kind)
             self.joint_models[marker] = jm = self._joint_model(marker, kind)
@@ -428,21 +427,23 @@ class RobotWorld:
         """The other doors that may stand open (believed open, or left part-way by a failed try) over where
         ``marker``'s part is grasped (:mod:`skills.door_clearance`): its descents are then made slowly and
         stopped at a light touch."""
-        jm = self.joint_models[marker]
+        c, jm = self.config, self.joint_models[marker]
         grasp = jm.grasp_point_at(0.0 if opening else 1.0)
         doors = []
         for other, state in zip(self.markers, self.states, strict=True):
             if other == marker or not self._swings_up(other):
                 continue
-            if other in self.unsettled:
-                lowest = self.toggler.config.blocked_progress
-            elif state == 1:
-                lowest = self.config.open_door_from
-            else:
-                continue
-            if near_open_door(self.joint_models[other], lowest, grasp, self.config.door_clearance):
+            lowest = self._lowest_open(other, int(state))
+            if lowest is not None and near_open_door(self.joint_models[other], lowest, grasp, c.door_clearance):
                 doors.append(other)
         return doors
+
+    def _lowest_open(self, marker: int, state: int) -> float | None:
+        """The lowest fraction of its travel the door on ``marker``, believed in ``state``, may stand open at: left
+        part-way by a failed try (``blocked_progress``), believed open (``open_door_from``), or None: shut."""
+        if marker in self.unsettled:
+            return self.toggler.config.blocked_progress
+        return self.config.open_door_from if state == 1 else None
 
     def _door_stayed_shut(self, outcome: TryResult, marker: int) -> bool:
         """Whether a pinch that carried its fingers the whole way left a door seen shut (its marker where
