@@ -854,7 +854,17 @@ class Toggler(DoorPushing):
 
     def _actuate(self, jm: JointModel, sign: float, begin: float, at_grasp: np.ndarray) -> ToggleResult:
         c = self.config
-        pressed = float(sign * jm.motion_direction(begin) @ at_grasp[:3, 2]) > math.cos(c.press_angle)
+        along_post = float(sign * jm.motion_direction(begin) @ at_grasp[:3, 2])  # cosine to the approach axis
+        pressed = along_post > math.cos(c.press_angle)
+        # pulled up along its post (a lever lifted; not a door, which swings up under a pinch of its own): the pads
+        # carry it by friction alone, and a lever held open by its lock, lifted through the lock's play (~28 %), stood
+        # while they slid up its post at 15-19 N along the motion, short of ``blocked_force`` and never stalled (the
+        # TCP kept rising), until they slid off its top: "slipped" or "moved" and seen standing at 73-75 %; a free
+        # lever is lifted with 3-4 N (realistic, hard-multi8-s0, runs/s8/lever-close). Not from a head start of
+        # MAX_HEAD_START: a part seen that far along is not where its state says, and may be lifted into its stop
+        pulled = (
+            along_post < -math.cos(c.press_angle) and not jm.handling.swings_up and self.head_start < MAX_HEAD_START
+        )
         slowdown = self.slowdown
         if pressed:  # at press_pace at the most (a careful toggle may already go slower)
             slowdown *= max(1.0, (c.careful_pace if self.careful else 1.0) / c.press_pace)
@@ -880,7 +890,9 @@ class Toggler(DoorPushing):
         yields = jm.handling.swings_up  # (slides and wheels yielding too were read latched while free)
         returning = 1.0 - c.tick / c.comply_return_time  # the offset kept per tick past the travel
         window = max(2, round(c.stall_window * slowdown / c.tick))
-        press_limit = max(c.press_force, c.press_noise_margin * self.filtered_noise_now()) if pressed else math.inf
+        press_limit = (
+            max(c.press_force, c.press_noise_margin * self.filtered_noise_now()) if pressed or pulled else math.inf
+        )
         recent: collections.deque[float] = collections.deque(maxlen=window)  # progress over the last stall_window
         self.ik.set_joints(self.robot.joint_positions())
         for k in range(1, last_tick + 1):
