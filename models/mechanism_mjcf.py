@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import mujoco
 import numpy as np
@@ -111,6 +111,17 @@ def add_mechanisms(
     return layout
 
 
+def _carried(part: mjcf.Element, name: str, **attributes: Any) -> mjcf.Element:
+    """A body ``name`` on a part's moving body ``part``, balanced as that body is (its ``gravcomp``): a lever's arm is
+    balanced on its pin (``models.kinds.lever``), and the walls, rods, lugs and pawls it carries unbalanced turned it
+    (0.06-0.5 g each, 0.2-0.9 mN·m in all, 2-8 % of its weight's moment, past MuJoCo's soft dry friction: a free lever
+    of a hard box crept open at 0.14-0.32 % of its travel per second, up to its stop in a training episode, where a
+    grasp aimed at its closed handle closed on nothing above it; runs/s8/lever-grasp)."""
+    if part.gravcomp is not None:
+        attributes["gravcomp"] = part.gravcomp
+    return part.add("body", name=name, **attributes)
+
+
 def _quat(rotation: np.ndarray) -> list[float]:
     quat = np.zeros(4)
     mujoco.mju_mat2Quat(quat, np.ascontiguousarray(rotation).ravel())
@@ -132,8 +143,11 @@ def _add_latch(root, latch: OneWayLatch, bodies, prefixes, by_name, bit: int) ->
     }  # fmt: skip
     # the pawl: its frame is (e1, e2, e3) at X, written in the locker's moving body frame
     rotation_a = np.column_stack([a.direction_to_body(latch.frame[:, i], q_a) for i in range(3)])
-    pawl = bodies[latch.locker].add(
-        "body", name=f"{base}:pawl", pos=a.to_body(latch.crossing[None], q_a)[0].tolist(), quat=_quat(rotation_a)
+    pawl = _carried(
+        bodies[latch.locker],
+        f"{base}:pawl",
+        pos=a.to_body(latch.crossing[None], q_a)[0].tolist(),
+        quat=_quat(rotation_a),
     )
     pawl.add(
         "joint", name=f"{base}:spring", type="slide", axis=[0, 0, 1], range=[-(TOOTH_RISE + PAWL_PLAY), 0.0],
@@ -149,7 +163,7 @@ def _add_latch(root, latch: OneWayLatch, bodies, prefixes, by_name, bit: int) ->
     centre, half = latch.lug_box()
     rotation_b = np.column_stack([b.direction_to_body(latch.frame[:, i], q_b) for i in range(3)])
     lug_world = latch.crossing + latch.frame @ centre
-    bodies[latch.locked].add("body", name=f"{base}:lug").add(
+    _carried(bodies[latch.locked], f"{base}:lug").add(
         "geom", name=f"{base}:lug", type="box", size=half.tolist(), pos=b.to_body(lug_world[None], q_b)[0].tolist(),
         quat=_quat(rotation_b), density=PART_DENSITY, **contact,
     )  # fmt: skip
@@ -161,7 +175,7 @@ def _add_chain(body: mjcf.Element, name: str, chains: list[np.ndarray], interloc
     # a body of its own, fixed to the part: its contact bit alone, so MuJoCo's broad phase pairs it with its
     # partner and nothing else (in the part's own body, the part's plate bit let every neighbour's geoms through:
     # a paper scene stepped 1.7x slower)
-    body = body.add("body", name=name)
+    body = _carried(body, name)
     for k, (p, q) in enumerate(segments):
         body.add(
             "geom",
