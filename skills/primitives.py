@@ -240,7 +240,11 @@ class PrimitiveConfig:
     the progress short of ``moved_fraction`` [N]: the pads hold a post along its length by friction alone, and
     under the harsh grip they slid down a locked lever's post at 13 N (the lever still) until the fingers met its
     arm, where the load rose 4.5 N a tick to 56 N true before the stall was read; a free lever is pressed with
-    ~5 N (harsh), and past ``moved_fraction`` more force is its end stop (runs/s5/force-descent/locked_lever.py)."""
+    ~5 N (harsh), and past ``moved_fraction`` more force is its end stop (runs/s5/force-descent/locked_lever.py).
+    The same for a handle pulled up its post (a lever lifted; a door swings up under a pinch of its own): a lever held
+    open by its lock stopped after the lock's play while the realistic pads slid up its post at 15-19 N along the
+    motion, never stalling (the hand kept rising), until they slid off its top, seen at 73-89 % and given up; a free
+    lever is lifted with 3-4 N (runs/s8/lever-close)."""
     press_noise_margin: float = 3.0
     """... or this many times the filtered F/T noise of the toggle, if larger: noise must not read as a hold."""
     press_pace: float = 0.5
@@ -856,12 +860,8 @@ class Toggler(DoorPushing):
         c = self.config
         along_post = float(sign * jm.motion_direction(begin) @ at_grasp[:3, 2])  # cosine to the approach axis
         pressed = along_post > math.cos(c.press_angle)
-        # pulled up along its post (a lever lifted; not a door, which swings up under a pinch of its own): the pads
-        # carry it by friction alone, and a lever held open by its lock, lifted through the lock's play (~28 %), stood
-        # while they slid up its post at 15-19 N along the motion, short of ``blocked_force`` and never stalled (the
-        # TCP kept rising), until they slid off its top: "slipped" or "moved" and seen standing at 73-75 %; a free
-        # lever is lifted with 3-4 N (realistic, hard-multi8-s0, runs/s8/lever-close). Not from a head start of
-        # MAX_HEAD_START: a part seen that far along is not where its state says, and may be lifted into its stop
+        # pulled up along its post (``press_force``), but not from a head start of MAX_HEAD_START: a part seen that far
+        # along is not where its state says, and may be lifted into its stop
         pulled = (
             along_post < -math.cos(c.press_angle) and not jm.handling.swings_up and self.head_start < MAX_HEAD_START
         )
