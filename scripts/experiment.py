@@ -7,6 +7,8 @@ the reality gap in the twin.
     python scripts/experiment.py faults --out DIR [--quick] [--runs R]
     python scripts/experiment.py twin-learning --out DIR [--quick] [--runs R] [--seeds S] [--workers W | --ray ...]
                                  [--agents memory,dqn,model-based] [--test-set paper|hard]
+    python scripts/experiment.py hard-sets --out DIR [--profile realistic|harsh|FILE] [--boxes B] [--runs R]
+                                 [--memory MEM.sqlite] [--quick] [--workers W | --ray ...]
     python scripts/experiment.py sysid --out DIR [--workers W] [--cells 0,1,2] [--quick]
     python scripts/experiment.py disassembly --agents memory,dual,dqn,model-based --out DIR [--quick] [--runs R]
                                  [--seeds S] [--workers W | --ray ...] [--validation] [--no-holding-rule]
@@ -39,6 +41,12 @@ robot hours from an empty memory, a symbolic one, and a symbolic one with twin e
 ``DIR/twin-learning.{json,md,png}``, the test boxes' optimum beside every figure. ``--test-set hard`` tests on
 eight-part boxes of every kind (random, multi-locker, chains: ``puzzlebox/lab/hard_sets.py``) held out from training
 on boxes of the same families.
+
+``hard-sets`` (``puzzlebox/lab/hard_grid.py``) runs the memory agent end to end in the twin on ``--boxes`` boxes
+(default 20) of each hard family at ``--runs`` random reachable placements each (default 2) under ``--profile``
+(default ``realistic``), its memory the twin-learning ``symbolic`` start (40 generated training boxes per family, or
+``--memory``): ``DIR/hard-sets.{json,md,png}``, per family solved, mean actions against the optimum, peak true wrist
+force and runs over 45 N, outcome agreement; every trial in ``DIR/trials/``: the same command resumes.
 
 ``sysid`` (``puzzlebox/lab/sysid.py``) identifies the box's per-kind joint damping, joint friction and latch
 compliance from logged robot data of toggles (oracle trials in the twin under ``realistic``, three cells) and
@@ -114,6 +122,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--steps", type=int, default=None, help="manipulation: env steps per run (default 60000)")
     parser.add_argument("--algo", default=None, help="manipulation: ppo (default) or sac")
     parser.add_argument("--test-set", choices=TEST_SETS, default=None, help="twin-learning: paper (default) or hard")
+    parser.add_argument(
+        "--profile", default=None, help="hard-sets: the cell's reality profile, a preset or a JSON file (realistic)"
+    )
+    parser.add_argument("--boxes", type=int, default=None, help="hard-sets: test boxes of each family (default 20)")
     args = parser.parse_args(argv)
     try:  # SIGINT or SIGTERM, whatever this process inherited: stop now, in one line; every saved job is kept
         with AbortOnSignal():

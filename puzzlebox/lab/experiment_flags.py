@@ -21,17 +21,21 @@ DISASSEMBLY = "disassembly"
 REALITY = "reality"
 FAULTS = "faults"
 TWIN_LEARNING = "twin-learning"
+HARD_SETS = "hard-sets"
 SYSID = "sysid"
 KINDS = "kinds"
 MANIPULATION = "manipulation"
 ALL = "all"
-PROTOCOL_NAMES = (*PROTOCOLS, ALL, REALITY, FAULTS, TWIN_LEARNING, SYSID, DISASSEMBLY, KINDS, MANIPULATION)
+PROTOCOL_NAMES = (*PROTOCOLS, ALL, REALITY, FAULTS, TWIN_LEARNING, HARD_SETS, SYSID, DISASSEMBLY, KINDS, MANIPULATION)
 """Every protocol ``experiment.py`` runs: the paper's symbolic ones, all three of them, and the twin's."""
 AGENTS = (*SYMBOLIC_AGENTS, *DEEP_AGENTS)
 """The agents of the paper's symbolic protocols."""
 
 MAX_RUNS, MAX_SEEDS, MAX_WORKERS = 100_000, 1000, 1024
 """Bounds of ``--runs``, ``--seeds`` and ``--workers``: far above any experiment's, below what exhausts memory."""
+
+MAX_BOXES = 1000
+"""Bound of ``--boxes``: a hard family's test range (:attr:`puzzlebox.lab.hard_sets.HardSetConfig.max_boxes`)."""
 
 Config = TypeVar("Config", bound="DataclassInstance")  # a protocol's config, a dataclass (see with_runs)
 
@@ -56,6 +60,8 @@ class ExperimentFlags:
     steps: int | None = None
     algo: str | None = None
     test_set: str | None = None
+    profile: str | None = None
+    boxes: int | None = None
 
     def check(self) -> None:
         """The flags that belong to one protocol only are not given to another; sizes are bounded."""
@@ -71,6 +77,10 @@ class ExperimentFlags:
             raise ExperimentSettingsError("--steps and --algo go with the manipulation protocol")
         if self.test_set is not None and self.protocol != TWIN_LEARNING:
             raise ExperimentSettingsError("--test-set goes with the twin-learning protocol")
+        if (self.profile is not None or self.boxes is not None) and self.protocol != HARD_SETS:
+            raise ExperimentSettingsError("--profile and --boxes go with the hard-sets protocol")
+        if self.boxes is not None and not 1 <= self.boxes <= MAX_BOXES:
+            raise ExperimentSettingsError(f"--boxes must be >= 1 and <= {MAX_BOXES}, got {self.boxes}")
 
     def agent_names(self, available: tuple[str, ...]) -> list[str]:
         """The ``--agents`` of a protocol that needs them, each one of ``available``."""

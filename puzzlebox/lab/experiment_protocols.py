@@ -1,5 +1,6 @@
 """Every protocol of ``experiment.py`` from its settings (:class:`ExperimentFlags`): the paper's symbolic ones
-(``puzzlebox.lab.paper_protocols``) and the twin's — ``reality`` (``reality_sweep``), ``twin-learning``,
+(``puzzlebox.lab.paper_protocols``) and the twin's — ``reality`` (``reality_sweep``), ``twin-learning``, ``hard-sets``
+(``hard_grid``),
 ``kinds`` (``kinds_experiment``), ``manipulation`` (``manipulation_experiment``), ``sysid``, ``disassembly``
 (``disassembly_run``) and ``faults``. Each checks the flags it takes, writes ``DIR/<name>.config.json``, runs
 (resuming what a previous run of the same command finished) and hands its report (``DIR/<name>.md``) and wall time
@@ -18,6 +19,7 @@ from puzzlebox.lab.errors import ExperimentFailed, ExperimentSettingsError
 from puzzlebox.lab.experiment_flags import (
     DISASSEMBLY,
     FAULTS,
+    HARD_SETS,
     KINDS,
     MANIPULATION,
     REALITY,
@@ -36,7 +38,8 @@ Echo = Callable[[str], object]
 def run_experiment(flags: ExperimentFlags, echo: Echo = print) -> None:
     """Check ``flags`` and run its protocol."""
     flags.check()
-    runs = {REALITY: run_reality, FAULTS: run_faults, TWIN_LEARNING: run_twin_learning, SYSID: run_sysid,
+    runs = {REALITY: run_reality, FAULTS: run_faults, TWIN_LEARNING: run_twin_learning, HARD_SETS: run_hard_sets,
+            SYSID: run_sysid,
             DISASSEMBLY: run_disassembly, KINDS: run_kinds, MANIPULATION: run_manipulation}  # fmt: skip
     try:
         runs.get(flags.protocol, run_paper_protocols)(flags, echo)
@@ -54,13 +57,7 @@ def run_reality(flags: ExperimentFlags, echo: Echo = print) -> None:
         raise ExperimentSettingsError("--seeds is for the symbolic protocols")
     flags.check_workers()
     config = flags.with_runs(SweepConfig().quick() if flags.quick else SweepConfig(), "placements", 1)
-    memory = None
-    if flags.memory is not None:
-        memory = Path(flags.memory)
-        if not memory.is_file():
-            raise ExperimentSettingsError(
-                f"--memory {memory}: no such file (train one with scripts/train.py, or leave it out)"
-            )
+    memory = _memory_file(flags.memory)
     out = flags.out_dir()
     flags.write_config(out, REALITY, sweep=asdict(config))
     try:
@@ -100,6 +97,46 @@ def run_twin_learning(flags: ExperimentFlags, echo: Echo = print) -> None:
     except LearningError as err:
         raise ExperimentFailed(str(err)) from err
     report(out, TWIN_LEARNING, summary, echo)
+
+
+def run_hard_sets(flags: ExperimentFlags, echo: Echo = print) -> None:
+    """The hard test sets in the twin: eight-part boxes of every kind, the symbolic memory agent, one profile."""
+    from puzzlebox.lab.hard_grid import HardGridConfig, run_hard_grid
+    from puzzlebox.twin.errors import ProfileError
+    from puzzlebox.twin.reality import load_profile
+
+    flags.only("--out, --profile, --boxes, --runs, --memory, --workers, --ray and --quick", "agents", "seeds")
+    flags.check_workers(show=True)
+    config = HardGridConfig().quick() if flags.quick else HardGridConfig()
+    if flags.profile is not None:
+        try:
+            load_profile(flags.profile)  # a preset's name or a profile file, checked before any work
+        except ProfileError as err:
+            raise ExperimentSettingsError(f"--profile: {err}") from err
+        config = replace(config, profile=flags.profile)
+    if flags.boxes is not None:
+        config = replace(config, boxes=flags.boxes)
+    config = flags.with_runs(config, "placements", 1)
+    memory = _memory_file(flags.memory)
+    out = flags.out_dir()
+    flags.write_config(out, HARD_SETS, hard_sets=asdict(config))
+    try:
+        summary = run_hard_grid(out, config, memory, flags.workers, flags.ray)
+    except LearningError as err:
+        raise ExperimentFailed(str(err)) from err
+    report(out, HARD_SETS, summary, echo)
+
+
+def _memory_file(memory: str | None) -> Path | None:
+    """``--memory`` as an existing file, or None."""
+    if memory is None:
+        return None
+    path = Path(memory)
+    if not path.is_file():
+        raise ExperimentSettingsError(
+            f"--memory {path}: no such file (train one with scripts/train.py, or leave it out)"
+        )
+    return path
 
 
 def run_kinds(flags: ExperimentFlags, echo: Echo = print) -> None:

@@ -27,7 +27,7 @@ from typing import Any
 from puzzlebox.lab.calibration_run import calibrate_cell
 from puzzlebox.lab.cli import write_json
 from puzzlebox.lab.run_store import Periodic
-from puzzlebox.lab.runner import RecordStore, Task, make_executor, run_tasks
+from puzzlebox.lab.runner import Executor, RecordStore, Task, make_executor, run_tasks
 from puzzlebox.lab.trial_figures import twin_figures
 from puzzlebox.lab.trial_task import trial_task
 from puzzlebox.learning import MemoryAgent, SymbolicWorld, run_episode, summarise
@@ -155,6 +155,16 @@ def run_sweep(
     result = summary()
     write_report(result, out)
     return result
+
+
+def calibrated_cell(reality: RealityProfile, folder: Path, executor: Executor) -> dict[str, Any]:
+    """The cell of ``reality`` calibrated once from ChArUco images, whatever box it then meets (a runner task whose
+    record is kept in ``folder``: a rerun reuses it); its ``CellCalibration.to_dict()``."""
+    board = paper_family("test", seed=0)[0]
+    done = run_tasks([Task(reality.name, calibration_task, {"spec": board.to_dict(), "profile": reality.to_dict()})],
+                     RecordStore(folder), executor, desc="calibration")  # fmt: skip
+    done.raise_for_failures()
+    return done.records[reality.name]["calibration"]
 
 
 def calibration_task(settings: dict[str, Any]) -> dict[str, Any]:

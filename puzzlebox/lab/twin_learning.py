@@ -48,7 +48,7 @@ from puzzlebox.lab.cli import write_json
 from puzzlebox.lab.deep_protocols_run import job_task
 from puzzlebox.lab.learning_boxes import LearningBox, test_boxes, training_boxes
 from puzzlebox.lab.learning_optimum import family_table, with_optimum
-from puzzlebox.lab.reality_sweep import calibration_task
+from puzzlebox.lab.reality_sweep import calibrated_cell
 from puzzlebox.lab.runner import RecordStore, Task, make_executor, run_tasks
 from puzzlebox.lab.trial_task import trial_task
 from puzzlebox.lab.twin_training import TwinTraining
@@ -151,7 +151,7 @@ def _snapshot(store_path: Path, target: Path) -> None:
             os.unlink(name)
 
 
-def _symbolic_training(
+def symbolic_training(
     store: MemoryStore, seed: int, episodes: int, max_actions: int, train: list[PuzzleSpec], lockers: list[int]
 ) -> None:
     """The ``symbolic`` starts' memory: ``episodes`` symbolic episodes on the training boxes ``train`` (box ``i``
@@ -193,7 +193,7 @@ def training_chain(settings: dict[str, Any], context: dict[str, Any]) -> dict[st
     lockers = settings.get("train_max_lockers", [1] * len(train))
     try:
         if start != "empty" and store.num_episodes == 0:
-            _symbolic_training(store, seed, settings["symbolic_episodes"], settings["max_actions"], train, lockers)
+            symbolic_training(store, seed, settings["symbolic_episodes"], settings["max_actions"], train, lockers)
         twin = TwinTraining(RealityProfile.from_dict(settings["reality"]),
                             CellCalibration.from_dict(settings["calibration"]))  # fmt: skip
         hours = [0.0] if start == "symbolic" else sorted(settings["hours"])
@@ -242,12 +242,7 @@ def run_twin_learning(
     phases: dict[str, float] = {}
     deep_records: dict[str, Any] = {}
     with make_executor(workers, ray) as executor:
-        board = paper_family("test", seed=0)[0]  # the cell is calibrated once, whatever box it then meets
-        calibrations = run_tasks([Task(reality.name, calibration_task,
-                                       {"spec": board.to_dict(), "profile": reality.to_dict()})],
-                                 RecordStore(out / "calibrations"), executor, desc="calibration")  # fmt: skip
-        calibrations.raise_for_failures()
-        calibration = calibrations.records[reality.name]["calibration"]
+        calibration = calibrated_cell(reality, out / "calibrations", executor)
         memories = out / "memories"
         chains = [
             Task(f"{start}-s{seed}", training_chain, {
