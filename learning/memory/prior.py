@@ -2,8 +2,9 @@
 
 For a new task, every block ``Z[j, s_j]`` gets weight ``w_indep`` = the mean stored independence of
 ``kind_j`` in ``s_j`` and, for every other component i and state s_i, ``w[i, s_i]`` = the mean of the
-k nearest stored blocks in bucket ``(kind_i, kind_j)`` around j's pose in i's frame (kernel-weighted,
-with the uninformed prior as a pseudo-neighbour: see :class:`MemoryConfig`). The weights are
+stored blocks of the k nearest pairs in bucket ``(kind_i, kind_j)`` around j's pose in i's frame (kernel-weighted,
+with the uninformed prior as a pseudo-neighbour: see :class:`MemoryConfig`); a pair of a box met in several
+episodes is one of the k, its meetings averaged into one neighbour (:func:`nearest_pairs`). The weights are
 normalised, then ``uniform_mass`` is added to every possible hypothesis and the block renormalised, so
 a bad prior can still be unlearned. A bucket the memory has never filled falls back to the
 uninformed prior's value, or — with ``back_off`` — is recalled from all pairs at a similar pose.
@@ -130,9 +131,7 @@ def _recalled_weights(
                 weights[j, :, 1 + 2 * i : 3 + 2 * i] = fallback[j, :, 1 + 2 * i : 3 + 2 * i]
                 continue
             distances = np.linalg.norm(bucket.keys - keys[i, j], axis=1)
-            # Rounded before ranking: equidistant memories (layouts on a grid make many) must rank in
-            # storage order, not by 1e-15 of rounding noise that depends on where the box stands.
-            nearest = np.argsort(np.round(distances, KEY_DECIMALS), kind="stable")[: config.k]
+            nearest = nearest_pairs(distances, bucket.pairs, config.k)
             values = bucket.values[nearest, :4].reshape(-1, 2, 2)  # (k, s_j, s_i)
             # per neighbour and row s_j: kernel x confidence (ones for the paper's plain average)
             neighbour_weights = np.ones((len(nearest), 2))
@@ -140,12 +139,43 @@ def _recalled_weights(
                 neighbour_weights *= np.exp(-0.5 * (distances[nearest] / config.bandwidth) ** 2)[:, None]
             if config.weight_by_confidence:
                 neighbour_weights *= bucket.values[nearest, 4:6]
+            # a pair met in several episodes is one neighbour: its meetings share one neighbour's weight (their
+            # mean), so meeting a box again sharpens what is recalled of it but does not make it count more
+            _, group, meetings = np.unique(bucket.pairs[nearest], return_inverse=True, return_counts=True)
+            if len(meetings) < len(nearest):
+                neighbour_weights /= meetings[group][:, None]
             uninformed = fallback[j, :, 1 + 2 * i : 3 + 2 * i]  # (s_j, s_i)
             prior_weight = config.prior_weight if config.bandwidth is not None or config.weight_by_confidence else 0.0
             total = neighbour_weights.sum(axis=0)[:, None] + prior_weight  # (s_j, 1)
             block = (np.einsum("kr,krs->rs", neighbour_weights, values) + prior_weight * uninformed) / total
             weights[j, :, 1 + 2 * i : 3 + 2 * i] = block
     return weights
+
+
+def nearest_pairs(distances: np.ndarray, pairs: np.ndarray, k: int) -> np.ndarray:
+    """Indices of the entries of the ``k`` nearest distinct pairs: the ``k`` pair ids (``pairs``, one per pair of a
+    box: :func:`learning.memory.store.pair_ids`) whose nearest entry is nearest, then every entry of those pairs. A
+    box met again thus adds its new meeting to what is recalled of it, and never pushes another
+    box's pair out of the ``k`` (a robot's episode on a box the simulator also met, perceived a millimetre off,
+    would otherwise rank just before the simulator's, and push out whichever box ranked ``k``-th). With no box met
+    twice, these are the ``k`` nearest entries, in rank order.
+
+    Distances are rounded to :data:`KEY_DECIMALS` before ranking: equidistant memories (layouts on a grid make
+    many) rank in storage order, not by 1e-15 of rounding noise that depends on where the box stands."""
+    order = np.argsort(np.round(distances, KEY_DECIMALS), kind="stable")
+    if (pairs == np.arange(len(pairs))).all():  # no pair met twice (a pair's id is its first entry's index)
+        return order[:k]
+    ranked = pairs[order]
+    chosen: list[int] = []
+    for pair in ranked:  # a pair's rank is that of its nearest entry
+        if pair not in chosen:
+            chosen.append(int(pair))
+            if len(chosen) == k:
+                break
+    members = ranked == chosen[0]
+    for pair in chosen[1:]:
+        members |= ranked == pair
+    return order[members]  # in rank order
 
 
 def _recalls(store: MemoryStore, kinds: tuple[str, ...]) -> bool:

@@ -72,6 +72,10 @@ SCHEMA_VERSION = 4
 READABLE_SCHEMAS = ("1", "2", "3", "4")
 LEGACY_KEY_SCHEMAS = ("1", "2", "3")
 """Schemas whose pair keys are compact (4 or 9 numbers), converted to SE(3) keys when read."""
+SAME_PAIR_RADIUS = 0.5
+"""Key distance within which two episodes' entries of one box and kind pair are one pair met twice [key units, ~1 cm
+at the default scale]: the twin keys a pair by the poses the robot perceived (1-2 mm off the spec's), and two pairs
+of one box that differ stand a part apart (>= 5 cm)."""
 SOURCES = ("symbolic", "twin")
 """Where an episode was experienced: the symbolic simulator, or end to end in the twin."""
 SEVERAL_LOCKERS_LEARNED = 1.9
@@ -165,10 +169,13 @@ BUSY_TIMEOUT = 120.0
 
 @dataclass(frozen=True)
 class Bucket:
-    """Entries of one bucket: ``keys`` ``(M, K)`` and ``values`` ``(M, V)``."""
+    """Entries of one bucket: ``keys`` ``(M, K)``, ``values`` ``(M, V)`` and ``pairs`` ``(M,)``: which pair of which
+    box each entry is a meeting of (:func:`pair_ids`: entries with one id are one pair of one box, met in several
+    episodes)."""
 
     keys: np.ndarray
     values: np.ndarray
+    pairs: np.ndarray
 
 
 class MemoryStore:
@@ -201,7 +208,9 @@ class MemoryStore:
         self.path = Path(path) if path is not None else None
         self.position_scale = position_scale
         self.rotation_weight = rotation_weight
-        self._pairs: dict[tuple[str, str], list[tuple[np.ndarray, np.ndarray]]] = defaultdict(list)
+        self._pairs: dict[tuple[str, str], list[tuple[np.ndarray, np.ndarray, str, int]]] = defaultdict(list)
+        """Per bucket (kind_i, kind_j): every stored (key, value, box, episode) in storage order; ``box`` the spec
+        name the episode was stored with (an unnamed one: the episode's own), ``episode`` its id."""
         self._independence: dict[str, list[np.ndarray]] = defaultdict(list)
         self.most_lockers = 0.0
         """The largest expected number of lockers of one component in one state over the stored episodes [-]
@@ -298,6 +307,7 @@ class MemoryStore:
         else:
             self._provenance = [("symbolic", None, None)] * self.num_episodes
         sizes = dict(conn.execute("SELECT episode, COUNT(*) FROM independence_entries GROUP BY episode"))
+        boxes = dict(conn.execute("SELECT id, spec FROM episodes"))
         by_episode: dict[int, list[np.ndarray]] = defaultdict(list)
         for episode, kind_i, kind_j, key, value in conn.execute(
             "SELECT episode, kind_i, kind_j, key, value FROM pair_entries ORDER BY rowid"
@@ -316,7 +326,7 @@ class MemoryStore:
                 except ValueError as err:
                     raise MemoryFileError(f"{path} has a malformed pair key ({kind_i} -> {kind_j}): {err}") from None
             _check_probabilities(value_arr, f"{path} has a pair entry ({kind_i} -> {kind_j})")
-            self._pairs[(kind_i, kind_j)].append((key_arr, value_arr))
+            self._pairs[(kind_i, kind_j)].append((key_arr, value_arr, _box(boxes.get(episode), episode), episode))
             by_episode[episode].append(value_arr)
         for episode, values in by_episode.items():
             self.most_lockers = max(self.most_lockers, _stored_expected_lockers(values, sizes.get(episode, 0)))
@@ -463,6 +473,7 @@ class MemoryStore:
             if i != j
         ]
         singles = [(kinds[j], independence[j].astype(np.float64)) for j in range(n)]
+        episode_id = self.num_episodes + 1  # (an episode stored without a box name is a box of its own: _box)
         if self._conn is not None:
             self.migrate()
             with self._conn:  # one transaction: the episode (log row included) is stored whole or not at all
@@ -473,6 +484,7 @@ class MemoryStore:
                     (spec, int(solved), num_actions, time.time(), seed, training_run, source, profile, robot_time),
                 )
                 episode = cursor.lastrowid
+                episode_id = int(episode or episode_id)
                 self._conn.executemany(
                     "INSERT INTO pair_entries VALUES (?, ?, ?, ?, ?)",
                     [(episode, ki, kj, k.tobytes(), v.tobytes()) for ki, kj, k, v in pairs],
@@ -482,7 +494,7 @@ class MemoryStore:
                     [(episode, kind, v.tobytes()) for kind, v in singles],
                 )
         for ki, kj, k, v in pairs:
-            self._pairs[(ki, kj)].append((k, v))
+            self._pairs[(ki, kj)].append((k, v, _box(spec, episode_id), episode_id))
         self.most_lockers = max(self.most_lockers, expected_lockers(pair_values))
         for kind, v in singles:
             self._independence[kind].append(v)
@@ -512,7 +524,7 @@ class MemoryStore:
             return None
         cache_key = ("pair", kind_i, kind_j)
         if cache_key not in self._cache:
-            self._cache[cache_key] = Bucket(np.stack([k for k, _ in entries]), np.stack([v for _, v in entries]))
+            self._cache[cache_key] = _bucket([(kind_i, kind_j, *entry) for entry in entries])
         return self._cache[cache_key]
 
     def all_pairs_bucket(self, family: str) -> Bucket | None:
@@ -521,14 +533,14 @@ class MemoryStore:
         cache_key = ("all-pairs", family)
         if cache_key not in self._cache:
             entries = [
-                entry
-                for (kind_i, _), bucket in self._pairs.items()
+                (kind_i, kind_j, *entry)
+                for (kind_i, kind_j), bucket in self._pairs.items()
                 if kind_family(kind_i) == family
                 for entry in bucket
             ]
             if not entries:
                 return None
-            self._cache[cache_key] = Bucket(np.stack([k for k, _ in entries]), np.stack([v for _, v in entries]))
+            self._cache[cache_key] = _bucket(entries)
         return self._cache[cache_key]
 
     def holds_family(self, family: str) -> bool:
@@ -578,6 +590,42 @@ def content_sha256(path: str | Path) -> str:
             for row in conn.execute(f"SELECT {', '.join(kept)} FROM {table} ORDER BY {order}"):
                 digest.update(repr(row).encode())
     return digest.hexdigest()
+
+
+def _box(spec: str | None, episode: int) -> str:
+    """The box an episode met: its spec name, or for an episode stored without one, a box of its own."""
+    return spec or f"#episode {episode}"
+
+
+def _bucket(entries: list[tuple[str, str, np.ndarray, np.ndarray, str, int]]) -> Bucket:
+    """A bucket of (kind_i, kind_j, key, value, box, episode) entries, with their :func:`pair_ids`."""
+    keys = np.stack([e[2] for e in entries])
+    return Bucket(keys, np.stack([e[3] for e in entries]),
+                  pair_ids(keys, [(e[0], e[1], e[4]) for e in entries], [e[5] for e in entries]))  # fmt: skip
+
+
+def pair_ids(keys: np.ndarray, boxes: list[tuple[str, str, str]], episodes: list[int]) -> np.ndarray:
+    """``(M,)``: which pair of which box each entry is a meeting of, as the index of the pair's first entry.
+
+    Entries are one pair when they are of the same box and kinds (``boxes``: kind_i, kind_j, box), their keys within
+    :data:`SAME_PAIR_RADIUS` of the pair's first entry, and from different episodes (two pairs one episode stored are
+    two pairs, however alike their poses: a box laid out on a grid has many). Component indices cannot tell: the
+    twin lists a box's parts in the order the robot found them."""
+    ids = np.arange(len(boxes), dtype=np.int64)
+    firsts: dict[tuple[str, str, str], list[int]] = defaultdict(list)  # box -> the first entry of each of its pairs
+    met: dict[int, set[int]] = {}  # a pair's first entry -> the episodes that met it
+    for m, (box, episode) in enumerate(zip(boxes, episodes, strict=True)):
+        candidates = firsts[box]
+        if candidates:
+            near = np.linalg.norm(keys[candidates] - keys[m], axis=1) <= SAME_PAIR_RADIUS
+            first = next((c for c, n in zip(candidates, near, strict=True) if n and episode not in met[c]), None)
+            if first is not None:
+                ids[m] = first
+                met[first].add(episode)
+                continue
+        candidates.append(m)
+        met[m] = {episode}
+    return ids
 
 
 def expected_lockers(pair_values: np.ndarray) -> float:

@@ -50,7 +50,7 @@ def test_a_twin_episode_stores_the_poses_the_robot_perceived_not_the_simulators(
     n = len(spec.components)
     off_diagonal = ~np.eye(n, dtype=bool)
     perceived = se3_pose_keys(agent._observation.poses, store.position_scale)[off_diagonal]
-    stored = np.stack([key for bucket in store._pairs.values() for key, _ in bucket])
+    stored = np.stack([key for bucket in store._pairs.values() for key, *_ in bucket])
     assert sorted(map(tuple, stored)) == sorted(map(tuple, perceived))
     truth = se3_pose_keys(spec.poses_in_world(), store.position_scale)[off_diagonal]  # (relative: placement-free)
     assert 1e-4 < np.abs(np.sort(stored, axis=0) - np.sort(truth, axis=0)).max()
