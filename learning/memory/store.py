@@ -208,9 +208,12 @@ class MemoryStore:
         self.path = Path(path) if path is not None else None
         self.position_scale = position_scale
         self.rotation_weight = rotation_weight
-        self._pairs: dict[tuple[str, str], list[tuple[np.ndarray, np.ndarray, str, int]]] = defaultdict(list)
-        """Per bucket (kind_i, kind_j): every stored (key, value, box, episode) in storage order; ``box`` the spec
-        name the episode was stored with (an unnamed one: the episode's own), ``episode`` its id."""
+        self._pairs: dict[tuple[str, str], list[tuple[np.ndarray, np.ndarray, int]]] = defaultdict(list)
+        """Per bucket (kind_i, kind_j): every stored (key, value, episode id) in storage order."""
+        self._boxes: dict[int, str] = {}
+        """Episode id -> the box it met (:meth:`_box`)."""
+        self._layouts: dict[str, list[np.ndarray]] = defaultdict(list)
+        """Spec name -> the layout signature of each box of that name met so far (:meth:`_box`)."""
         self._independence: dict[str, list[np.ndarray]] = defaultdict(list)
         self.most_lockers = 0.0
         """The largest expected number of lockers of one component in one state over the stored episodes [-]
@@ -307,8 +310,9 @@ class MemoryStore:
         else:
             self._provenance = [("symbolic", None, None)] * self.num_episodes
         sizes = dict(conn.execute("SELECT episode, COUNT(*) FROM independence_entries GROUP BY episode"))
-        boxes = dict(conn.execute("SELECT id, spec FROM episodes"))
+        names = dict(conn.execute("SELECT id, spec FROM episodes"))
         by_episode: dict[int, list[np.ndarray]] = defaultdict(list)
+        offsets: dict[int, list[np.ndarray]] = defaultdict(list)
         for episode, kind_i, kind_j, key, value in conn.execute(
             "SELECT episode, kind_i, kind_j, key, value FROM pair_entries ORDER BY rowid"
         ):
@@ -326,10 +330,13 @@ class MemoryStore:
                 except ValueError as err:
                     raise MemoryFileError(f"{path} has a malformed pair key ({kind_i} -> {kind_j}): {err}") from None
             _check_probabilities(value_arr, f"{path} has a pair entry ({kind_i} -> {kind_j})")
-            self._pairs[(kind_i, kind_j)].append((key_arr, value_arr, _box(boxes.get(episode), episode), episode))
+            self._pairs[(kind_i, kind_j)].append((key_arr, value_arr, episode))
             by_episode[episode].append(value_arr)
+            offsets[episode].append(key_arr[:3])
         for episode, values in by_episode.items():
             self.most_lockers = max(self.most_lockers, _stored_expected_lockers(values, sizes.get(episode, 0)))
+        for episode in sorted(offsets):
+            self._boxes[episode] = self._box(names.get(episode), episode, np.array(offsets[episode]))
         for kind, value in conn.execute("SELECT kind, value FROM independence_entries ORDER BY rowid"):
             value_arr = _decode(value, path)
             if value_arr.size != 2:
@@ -473,7 +480,7 @@ class MemoryStore:
             if i != j
         ]
         singles = [(kinds[j], independence[j].astype(np.float64)) for j in range(n)]
-        episode_id = self.num_episodes + 1  # (an episode stored without a box name is a box of its own: _box)
+        episode_id = self.num_episodes + 1  # (unique in this store: a RAM memory has no row ids)
         if self._conn is not None:
             self.migrate()
             with self._conn:  # one transaction: the episode (log row included) is stored whole or not at all
@@ -494,7 +501,8 @@ class MemoryStore:
                     [(episode, kind, v.tobytes()) for kind, v in singles],
                 )
         for ki, kj, k, v in pairs:
-            self._pairs[(ki, kj)].append((k, v, _box(spec, episode_id), episode_id))
+            self._pairs[(ki, kj)].append((k, v, episode_id))
+        self._boxes[episode_id] = self._box(spec, episode_id, np.array([k[:3] for _, _, k, _ in pairs]))
         self.most_lockers = max(self.most_lockers, expected_lockers(pair_values))
         for kind, v in singles:
             self._independence[kind].append(v)
@@ -524,8 +532,29 @@ class MemoryStore:
             return None
         cache_key = ("pair", kind_i, kind_j)
         if cache_key not in self._cache:
-            self._cache[cache_key] = _bucket([(kind_i, kind_j, *entry) for entry in entries])
+            self._cache[cache_key] = self._bucket([(kind_i, kind_j, *entry) for entry in entries])
         return self._cache[cache_key]
+
+    def _bucket(self, entries: list[tuple[str, str, np.ndarray, np.ndarray, int]]) -> Bucket:
+        """A bucket of (kind_i, kind_j, key, value, episode) entries, with their :func:`pair_ids`."""
+        keys = np.stack([e[2] for e in entries])
+        boxes = [(e[0], e[1], self._boxes.get(e[4], f"#episode {e[4]}")) for e in entries]
+        return Bucket(keys, np.stack([e[3] for e in entries]), pair_ids(keys, boxes, [e[4] for e in entries]))
+
+    def _box(self, name: str | None, episode: int, offsets: np.ndarray) -> str:
+        """The box an episode met: its spec name and layout. Layouts of one name (the paper's variants are laid
+        out anew for each episode) are told apart by their sorted pair distances (``offsets``: the position part
+        of every key, in key units), equal within :data:`SAME_PAIR_RADIUS`; an episode stored without a name is a
+        box of its own."""
+        if not name:
+            return f"#episode {episode}"
+        signature = np.sort(np.linalg.norm(offsets.reshape(-1, 3), axis=1))
+        layouts = self._layouts[name]
+        for n, other in enumerate(layouts):
+            if len(other) == len(signature) and np.abs(other - signature).max(initial=0.0) <= SAME_PAIR_RADIUS:
+                return f"{name} #{n}"
+        layouts.append(signature)
+        return f"{name} #{len(layouts) - 1}"
 
     def all_pairs_bucket(self, family: str) -> Bucket | None:
         """Every stored pair of a kind family (``models.disassembly_kinds.kind_family``), whatever its kinds (for
@@ -540,7 +569,7 @@ class MemoryStore:
             ]
             if not entries:
                 return None
-            self._cache[cache_key] = _bucket(entries)
+            self._cache[cache_key] = self._bucket(entries)
         return self._cache[cache_key]
 
     def holds_family(self, family: str) -> bool:
@@ -590,18 +619,6 @@ def content_sha256(path: str | Path) -> str:
             for row in conn.execute(f"SELECT {', '.join(kept)} FROM {table} ORDER BY {order}"):
                 digest.update(repr(row).encode())
     return digest.hexdigest()
-
-
-def _box(spec: str | None, episode: int) -> str:
-    """The box an episode met: its spec name, or for an episode stored without one, a box of its own."""
-    return spec or f"#episode {episode}"
-
-
-def _bucket(entries: list[tuple[str, str, np.ndarray, np.ndarray, str, int]]) -> Bucket:
-    """A bucket of (kind_i, kind_j, key, value, box, episode) entries, with their :func:`pair_ids`."""
-    keys = np.stack([e[2] for e in entries])
-    return Bucket(keys, np.stack([e[3] for e in entries]),
-                  pair_ids(keys, [(e[0], e[1], e[4]) for e in entries], [e[5] for e in entries]))  # fmt: skip
 
 
 def pair_ids(keys: np.ndarray, boxes: list[tuple[str, str, str]], episodes: list[int]) -> np.ndarray:

@@ -91,3 +91,12 @@ def test_a_memory_file_recalls_its_repeated_boxes_as_it_did_before_it_was_closed
     assert _held(again) == recalled
     bucket = again.pair_bucket("door", "slide")
     assert bucket is not None and len(set(bucket.pairs.tolist())) == 6
+
+
+def test_layouts_of_one_name_are_boxes_of_their_own():
+    store = MemoryStore()  # the paper's variants keep their name and are laid out anew for each episode
+    _meet(store, "paper-train-0", 0.0, held=0.2)
+    _meet(store, "paper-train-0", 0.03, held=0.6)  # the slide 3 cm further: another layout
+    _meet(store, "paper-train-0", 0.0004, held=0.4)  # the first layout again, 0.4 mm off
+    bucket = store.pair_bucket("door", "slide")
+    assert bucket is not None and bucket.pairs.tolist() == [0, 1, 0]
