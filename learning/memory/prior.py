@@ -131,7 +131,7 @@ def _recalled_weights(
                 weights[j, :, 1 + 2 * i : 3 + 2 * i] = fallback[j, :, 1 + 2 * i : 3 + 2 * i]
                 continue
             distances = np.linalg.norm(bucket.keys - keys[i, j], axis=1)
-            nearest = nearest_pairs(distances, bucket.pairs, config.k)
+            nearest = nearest_pairs(distances, bucket.pairs, config.k, bucket.distinct)
             values = bucket.values[nearest, :4].reshape(-1, 2, 2)  # (k, s_j, s_i)
             # per neighbour and row s_j: kernel x confidence (ones for the paper's plain average)
             neighbour_weights = np.ones((len(nearest), 2))
@@ -141,8 +141,8 @@ def _recalled_weights(
                 neighbour_weights *= bucket.values[nearest, 4:6]
             # a pair met in several episodes is one neighbour: its meetings share one neighbour's weight (their
             # mean), so meeting a box again sharpens what is recalled of it but does not make it count more
-            _, group, meetings = np.unique(bucket.pairs[nearest], return_inverse=True, return_counts=True)
-            if len(meetings) < len(nearest):
+            if not bucket.distinct:
+                _, group, meetings = np.unique(bucket.pairs[nearest], return_inverse=True, return_counts=True)
                 neighbour_weights /= meetings[group][:, None]
             uninformed = fallback[j, :, 1 + 2 * i : 3 + 2 * i]  # (s_j, s_i)
             prior_weight = config.prior_weight if config.bandwidth is not None or config.weight_by_confidence else 0.0
@@ -152,7 +152,7 @@ def _recalled_weights(
     return weights
 
 
-def nearest_pairs(distances: np.ndarray, pairs: np.ndarray, k: int) -> np.ndarray:
+def nearest_pairs(distances: np.ndarray, pairs: np.ndarray, k: int, distinct: bool | None = None) -> np.ndarray:
     """Indices of the entries of the ``k`` nearest distinct pairs: the ``k`` pair ids (``pairs``, one per pair of a
     box: :func:`learning.memory.store.pair_ids`) whose nearest entry is nearest, then every entry of those pairs. A
     box met again thus adds its new meeting to what is recalled of it, and never pushes another
@@ -161,9 +161,11 @@ def nearest_pairs(distances: np.ndarray, pairs: np.ndarray, k: int) -> np.ndarra
     twice, these are the ``k`` nearest entries, in rank order.
 
     Distances are rounded to :data:`KEY_DECIMALS` before ranking: equidistant memories (layouts on a grid make
-    many) rank in storage order, not by 1e-15 of rounding noise that depends on where the box stands."""
+    many) rank in storage order, not by 1e-15 of rounding noise that depends on where the box stands.
+
+    ``distinct``: whether no pair was met twice (:attr:`learning.memory.store.Bucket.distinct`; None: checked here)."""
     order = np.argsort(np.round(distances, KEY_DECIMALS), kind="stable")
-    if (pairs == np.arange(len(pairs))).all():  # no pair met twice (a pair's id is its first entry's index)
+    if distinct if distinct is not None else (pairs == np.arange(len(pairs))).all():
         return order[:k]
     ranked = pairs[order]
     chosen: list[int] = []

@@ -50,6 +50,7 @@ import tempfile
 import time
 from collections import defaultdict
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -176,6 +177,12 @@ class Bucket:
     keys: np.ndarray
     values: np.ndarray
     pairs: np.ndarray
+
+    @cached_property
+    def distinct(self) -> bool:
+        """Whether every entry is a pair of its own (no pair met twice: a pair's id is its first entry's index),
+        checked once per bucket rather than at every recall of one of its pairs."""
+        return bool((self.pairs == np.arange(len(self.pairs))).all())
 
 
 class MemoryStore:

@@ -31,6 +31,7 @@ from puzzlebox.lab.runner import RecordStore, Task, make_executor, run_tasks
 from puzzlebox.lab.trial_figures import twin_figures
 from puzzlebox.lab.trial_task import file_sha256, trial_task
 from puzzlebox.lab.twin_learning import symbolic_training
+from puzzlebox.learning import summarise
 from puzzlebox.learning.memory import MemoryStore
 from puzzlebox.models.spec_loading import spec_from_dict
 from puzzlebox.twin.reality import load_profile
@@ -154,17 +155,16 @@ def summarise_grid(
 
 
 def _row(name: str, runs: list[dict[str, Any]], best: dict[str, LearningBox], max_actions: int) -> dict[str, Any]:
-    figures = twin_figures(runs)
-    actions = [r["num_actions"] if r["solved"] else max_actions for r in runs]
+    figures, results = twin_figures(runs), summarise(list(runs), max_actions)  # (unsolved: max_actions)
     optimum = statistics.fmean(best[r["spec"]].optimum for r in runs)
     return {
         "set": name,
         "trials": len(runs),
         "solved": sum(r["solved"] for r in runs),
-        "success_rate": statistics.fmean(r["solved"] for r in runs),
-        "mean_actions": statistics.fmean(actions),
+        "success_rate": results["success_rate"],
+        "mean_actions": results["mean_actions"],
         "optimum": optimum,
-        "ratio_to_optimum": statistics.fmean(actions) / optimum,
+        "ratio_to_optimum": results["mean_actions"] / optimum,
         "peak_true_wrist_force_n": figures["peak_true_wrist_force_n"],
         "runs_over_margin": sum(r["peak_true_wrist_force_n"] > FORCE_MARGIN_N for r in runs),
         "outcome_agreement": figures["outcome_agreement"],
