@@ -77,6 +77,15 @@ class DoorPushConfig:
     45 s), a latch holds it wherever it was when engaged, and one that fell shut is only met on the lid; until
     the pads have pressed on the plate, a closing push moves at this speed all the way (searching down to 50
     deg only, the pads met a door fallen shut at ~40 mm/s with 72 N)."""
+    press_speed: float = 0.004
+    """Speed of the pads along the arc once they press on the plate, until the door has followed them by
+    ``blocked_progress`` of its travel (:meth:`DoorPushing._push_door_closed`) [m/s]: a door held open by its
+    locker rests on the lock's pin (it sinks onto it under its own weight), and the pads, pressed into a plate that
+    does not give, load the wrist by the arm's stiffness (15-35 N/mm) times their speed while the harsh reading is
+    ~60 ms late. Sped up to the schedule's pace as the contact was felt, a door held at 61 deg put 56-104 N true on
+    the wrist before the latch was read (hard-chain8-s36004 seed 36101; a door-slide chain, seed 1); at
+    ``search_speed`` on, 44 N, most of it the arm's lag behind its command (~1.5 mm at ``search_speed``), which is
+    why the command is first sent back to where the pads are; then, at this speed, 28-30 N."""
     end_force: float = 20.0
     """Force magnitude at which a door pushed most of the way closed is taken to lie on the lid and the push
     stops there [N] (pressed on by a TCP a few mm off, the lid put 80-130 N on the wrist)."""
@@ -314,11 +323,23 @@ class DoorPushing:
         end = 1.0  # closed
         ticks = round(p.close_time * self.slowdown / c.tick)
         contact = max(p.contact_force, p.contact_noise_margin * self.filtered_noise_now())
-        search_step = p.search_speed / self.slowdown * c.tick / (door.travel * p.close_x)  # per tick, of the travel
+        per_tick = c.tick / (self.slowdown * door.travel * p.close_x)  # of the travel per tick, for 1 m/s at the pads
 
         def scheduled(k: float) -> float:  # where the pads are sent at (schedule) tick k: slow onto the lid
             u = min(1.0, k / ticks)
             return start + (end - start) * u * u * (3 - 2 * u)
+
+        def schedule_at(s: float) -> float:  # the schedule tick at which the pads are sent to s (bisection)
+            low, high = 0.0, float(ticks)
+            for _ in range(40):
+                low, high = (low, (low + high) / 2) if scheduled((low + high) / 2) >= s else ((low + high) / 2, high)
+            return low
+
+        # A command s sends the pads' edge to ``depth`` into the plate, and their progress is measured from where they
+        # were first, ``gap`` above it: pads that follow the command exactly measure s + held_offset, so pads measured
+        # at progress q are where the command q - held_offset sends them.
+        held_offset = math.atan2(door.plate_top + p.gap, p.close_x) - math.atan2(door.plate_top - p.depth, p.close_x)
+        held_offset /= door.travel
 
         forces: list[float] = []
         progress = 0.0
@@ -331,9 +352,11 @@ class DoorPushing:
         while schedule < ticks + round(2 * c.settle_time / c.tick):
             k += 1
             step = 1.0
-            if pressed_from is None:
+            engaged = pressed_from is not None and progress - max(pressed_from, start) >= c.blocked_progress
+            if not engaged:  # searching for the plate, or pressed on it but not yet seen to follow the pads
                 nominal = scheduled(schedule + 1.0) - scheduled(schedule)
-                step = min(1.0, search_step / nominal) if nominal > 0 else 1.0
+                speed = p.search_speed if pressed_from is None else p.press_speed
+                step = min(1.0, speed * per_tick / nominal) if nominal > 0 else 1.0
             schedule += step
             s = min(scheduled(schedule), max(progress, start) + lead)
             closing_in = max(0.0, 1.0 - k * c.tick / (p.approach_time * self.slowdown)) * (p.gap + p.depth)
@@ -345,6 +368,11 @@ class DoorPushing:
             magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
             if pressed_from is None and forces[-1] > contact:
                 pressed_from = progress
+                # the command runs the arm's tracking lag ahead of the pads (~1.5 mm at ``search_speed``): pressed
+                # on a plate that does not give, it loads the wrist by the arm's stiffness times that lag whatever
+                # is sent next, while the reading is late. Sent back to where the pads are, they press on from
+                # there at ``press_speed``.
+                schedule = min(schedule, schedule_at(progress - held_offset))
             if progress >= c.moved_fraction and magnitude > p.end_force:
                 # the plate is on the lid: stop at once. (Easing on to where the pads were, a door that fell
                 # shut and was met on the lid at 15 mm/s loaded the wrist by 5-8 N per tick to 71 N.)
