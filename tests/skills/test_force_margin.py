@@ -24,6 +24,14 @@ from puzzlebox.twin.session import TwinSession
 FORCE_MARGIN = 45.0
 """Largest true wrist force a try may put on the wrist [N]."""
 
+LATE_READING = RealityProfile(
+    name="late F/T",
+    force_torque=ForceTorqueReality(rate_hz=100.0, delay=0.030),
+    arm=ArmReality(command_latency=0.010),
+)
+"""The harsh profile's late reading alone: the F/T 30 ms late at 100 Hz (with the toggler's running median), commands
+10 ms late."""
+
 
 def test_a_part_held_open_by_a_lock_with_play_reads_blocked_within_the_margin_and_is_taken_back():
     spec = generate_chain(["slide", "wheel"], seed=1)  # open, wheel-1 keeps slide-0 open
@@ -182,10 +190,9 @@ def test_a_top_up_push_against_a_door_that_does_not_turn_stops_at_a_light_touch(
     # where it stands (a jam, a latch: here it jams at every move) or already in its stop presses back at once, and
     # under the harsh profile's late reading (F/T 30 ms late, a 5-tick median, commands 10 ms late) the push went on
     # to 40-50 N true before it was felt (paper-test-2 seeds 100 and 101): here 48 N held, 40 N in the stop
-    late_and_sticky = RealityProfile(
+    late_and_sticky = dataclasses.replace(
+        LATE_READING,
         name="late F/T, sticky door",
-        force_torque=ForceTorqueReality(rate_hz=100.0, delay=0.030),
-        arm=ArmReality(command_latency=0.010),
         physics=PhysicsReality(jam_probability=0.0 if held_at is None else 1.0),
     )
     spec = placed(paper_family("test", seed=0)[0], (0.38, 0.12, -0.9))
@@ -213,14 +220,9 @@ def test_a_door_pinched_into_its_end_stop_under_a_late_reading_stays_in_the_marg
     # the pads put 45-48 N true spikes on it: here, with the F/T 30 ms late and commands 10 ms late, 56 N in the
     # stop, and with the hinge seen 8 mm off 71 N with the door left at 66 deg. The path yields across itself there
     # as on the arc, until the end stop is felt; a door that reaches it unfelt is topped up.
-    late = RealityProfile(
-        name="late F/T",
-        force_torque=ForceTorqueReality(rate_hz=100.0, delay=0.030),
-        arm=ArmReality(command_latency=0.010),
-    )
     spec = placed(paper_family("test", seed=0)[0], (0.38, 0.12, -0.9))
     door = spec.index_of("door-0")
-    with TwinSession(spec, seed=0, reality=late) as session:
+    with TwinSession(spec, seed=0, reality=LATE_READING) as session:
         robot = TrueForceWatch(session.robot, session)
         world = evaluation_world(session, robot)
         jm = world.joint_models[spec.components[door].marker]
@@ -242,13 +244,8 @@ def test_a_door_held_open_by_its_locker_pushed_closed_under_a_late_reading_reads
     # stiffness (15-35 N/mm), and sped up to the schedule's pace as the contact was felt the push put 91-104 N true on
     # the wrist (the guard stopped it at 61-65 N sensed; under harsh, hard-chain8-s36004 seed 36101: 56 N). Sent back
     # to where the pads are and pressed on at press_speed, the latch is read at ~30 N true.
-    late = RealityProfile(
-        name="late F/T",
-        force_torque=ForceTorqueReality(rate_hz=100.0, delay=0.030),
-        arm=ArmReality(command_latency=0.010),
-    )
     spec = generate_chain(["door", locker], seed=1)  # open, the locker keeps door-0 open
-    with TwinSession(spec, seed=0, reality=late) as session:
+    with TwinSession(spec, seed=0, reality=LATE_READING) as session:
         robot = TrueForceWatch(session.robot, session)
         world = evaluation_world(session, robot)
         door, other = (world.markers.index(c.marker) for c in spec.components)
