@@ -329,11 +329,9 @@ class DoorPushing:
             u = min(1.0, k / ticks)
             return start + (end - start) * u * u * (3 - 2 * u)
 
-        def schedule_at(s: float) -> float:  # the schedule tick at which the pads are sent to s (bisection)
-            low, high = 0.0, float(ticks)
-            for _ in range(40):
-                low, high = (low, (low + high) / 2) if scheduled((low + high) / 2) >= s else ((low + high) / 2, high)
-            return low
+        def schedule_at(s: float) -> float:  # the schedule tick at which the pads are sent to s: scheduled's inverse
+            x = min(max((s - start) / (end - start), 0.0), 1.0) if end > start else 1.0
+            return ticks * (0.5 - math.sin(math.asin(1.0 - 2.0 * x) / 3.0))  # the smoothstep's inverse
 
         # A command s sends the pads' edge to ``depth`` into the plate, and their progress is measured from where they
         # were first, ``gap`` above it: pads that follow the command exactly measure s + held_offset, so pads measured

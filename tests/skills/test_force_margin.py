@@ -4,6 +4,7 @@ A lock's pins leave play: a part held open closes up to ~30 % of its travel befo
 the pace of a free part, a slide was driven on to the 60 N guard (63 N true) and left part-way, where the next try
 descended onto its post (65 N); a stall past the breakaway is now read as a hold, and the handle taken back."""
 
+import contextlib
 import dataclasses
 import math
 
@@ -33,15 +34,23 @@ LATE_READING = RealityProfile(
 10 ms late."""
 
 
-def test_a_part_held_open_by_a_lock_with_play_reads_blocked_within_the_margin_and_is_taken_back():
-    spec = generate_chain(["slide", "wheel"], seed=1)  # open, wheel-1 keeps slide-0 open
-    with TwinSession(spec, seed=0) as session:
+@contextlib.contextmanager
+def _closed_against_its_locker(kinds: list[str], reality: RealityProfile | None = None):
+    """A chain of two ``kinds`` (seed 1) in the twin: its first part opened, then its second, which then holds the first
+    open, and the first tried again (closing it). Yields the session, the watched robot (``peak`` counted from that
+    last try), the world, the first part's index in it and that try's result."""
+    spec = generate_chain(kinds, seed=1)
+    with TwinSession(spec, seed=0, reality=reality) as session:
         robot = TrueForceWatch(session.robot, session)
         world = evaluation_world(session, robot)
-        slide, wheel = (world.markers.index(c.marker) for c in spec.components)
-        assert world.try_toggle(slide).moved and world.try_toggle(wheel).moved
+        held, locker = (world.markers.index(c.marker) for c in spec.components)
+        assert world.try_toggle(held).moved and world.try_toggle(locker).moved
         robot.peak = 0.0
-        held = world.try_toggle(slide)  # closing it: held open by the wheel
+        yield session, robot, world, held, world.try_toggle(held)
+
+
+def test_a_part_held_open_by_a_lock_with_play_reads_blocked_within_the_margin_and_is_taken_back():
+    with _closed_against_its_locker(["slide", "wheel"]) as (session, robot, world, slide, held):
         assert held.outcome == "blocked" and held.reason.startswith(HELD_PART_WAY), held
         assert robot.peak <= FORCE_MARGIN, robot.peak_during
         assert session.component_states()[0] == 1 and world.log[-1].progress > 0.1  # taken back where it was
@@ -244,14 +253,7 @@ def test_a_door_held_open_by_its_locker_pushed_closed_under_a_late_reading_reads
     # stiffness (15-35 N/mm), and sped up to the schedule's pace as the contact was felt the push put 91-104 N true on
     # the wrist (the guard stopped it at 61-65 N sensed; under harsh, hard-chain8-s36004 seed 36101: 56 N). Sent back
     # to where the pads are and pressed on at press_speed, the latch is read at ~30 N true.
-    spec = generate_chain(["door", locker], seed=1)  # open, the locker keeps door-0 open
-    with TwinSession(spec, seed=0, reality=LATE_READING) as session:
-        robot = TrueForceWatch(session.robot, session)
-        world = evaluation_world(session, robot)
-        door, other = (world.markers.index(c.marker) for c in spec.components)
-        assert world.try_toggle(door).moved and world.try_toggle(other).moved
-        robot.peak = 0.0
-        held = world.try_toggle(door)  # closing it: held open by its locker
+    with _closed_against_its_locker(["door", locker], LATE_READING) as (session, robot, _, _, held):
         assert held.outcome == "blocked" and held.reason == PUSHED_IN_VAIN, held
         assert robot.peak <= 35.0, robot.peak  # a margin under 45 N: another pose may meet a stiffer arm
         assert list(session.component_states()) == [1, 1]
