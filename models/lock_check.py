@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from puzzlebox.models.lock_mechanisms import paired_rules
 from puzzlebox.models.lock_table import LockTable
 from puzzlebox.models.spec import PuzzleSpec
 
@@ -55,15 +56,24 @@ MAX_STATES = 4096
 """Most reachable states checked (all of them up to 12 parts)."""
 
 
+BAND_OFFSETS = (0.0, 0.1, 0.2)
+"""Where the band check rests every part it does not push, as a fraction of its travel from the end stop of its
+state (0: at the stop; 0.2: a part counted closed at 20 % of its travel, one counted open at 80 %): inside the twin's
+bands (closed below 25 %, open above 75 %), where a mechanism must already behave as the state says."""
+
+
 @dataclass(frozen=True)
 class Transition:
-    """One push: ``component`` from ``state`` (bitmask over spec order) toward its other state."""
+    """One push: ``component`` from ``state`` (bitmask over spec order) toward its other state, every other part
+    resting ``offset`` of its travel away from the end stop of its state."""
 
     state: int
     component: str
     expected_free: bool
     moved: float
     """Largest fraction of the travel the part reached toward its other state."""
+    offset: float = 0.0
+    """How far from their end stops the other parts rested [fraction of their travel] (:data:`BAND_OFFSETS`)."""
 
     @property
     def agrees(self) -> bool:
@@ -118,14 +128,22 @@ def check_locks(
     model: mujoco.MjModel,
     joint_names: dict[str, str],
     limit: int = MAX_STATES,
-    open_rest: float = 1.0,
+    offsets: tuple[float, ...] = (0.0,),
 ) -> LockCheck:
     """Push every part from every reachable state (module docstring) in ``model``, whose joint of each
-    component is ``joint_names[component name]``; an open part rests at ``open_rest`` of its travel (1: its end
-    stop; the twin counts a part open from 0.75, and a door opened by a pinch may rest anywhere past that). Other
-    joints of the model (a robot's) are held where they stand at reset, but for joints that belong to no component
-    and carry a spring (a mechanism's own sprung pawls), which move freely."""
+    component is ``joint_names[component name]``, once per offset in ``offsets``: every other part rests that
+    fraction of its travel away from the end stop of its state, toward its other state (0: at its stop; the band
+    check, :data:`BAND_OFFSETS`, rests them inside the twin's bands, where a locker counts as in its state without
+    standing at its stop); the pushed part starts at its stop. Other joints of the model (a robot's) are held where
+    they stand at reset, but for joints that belong to no component and carry a spring (a mechanism's own sprung
+    pawls), which move freely."""
+    if not offsets or any(not 0.0 <= p < 1.0 - FREE_FRACTION for p in offsets):
+        raise ValueError(f"offsets must lie in [0, {1.0 - FREE_FRACTION:g}) (inside a state's band), got {offsets}")
     table = LockTable.from_spec(spec)
+    index = {c.name: k for k, c in enumerate(spec.components)}
+    # (A, a, B, b) of every unpaired rule: a one-way latch, whose tooth lets B rest nowhere but at its stop while A
+    # is at a and B at b (an interlock's held part may rest anywhere short of where its rod meets the wall)
+    one_way = [(index[r.locker], r.locker_state, index[r.locked], r.locked_state) for r in paired_rules(spec)[1]]
     joints = [model.joint(joint_names[c.name]) for c in spec.components]
     qadr = np.array([int(j.qposadr[0]) for j in joints])
     dadr = np.array([int(j.dofadr[0]) for j in joints])
@@ -146,11 +164,14 @@ def check_locks(
     steps = int(round(PUSH_TIME / model.opt.timestep))
     transitions: list[Transition] = []
     for state in reachable_states(spec, limit):
-        bits = np.array([(state >> c) & 1 for c in range(len(joints))])
-        for c in range(len(joints)):
+        bits = np.array([(state >> k) & 1 for k in range(len(joints))])
+        latched = [b for a, sa, b, sb in one_way if bits[a] == sa and bits[b] == sb]
+        for offset, c in ((p, c) for p in offsets for c in range(len(joints))):
             mujoco.mj_resetData(model, data)
-            q0 = np.where(bits == 1, open_rest * travel, 0.0)
-            data.qpos[qadr] = q0
+            rest = np.where(bits == 1, (1.0 - offset) * travel, offset * travel)
+            rest[latched] = travel[latched] * bits[latched]
+            rest[c] = travel[c] * bits[c]  # the pushed part from its stop
+            data.qpos[qadr] = rest
             mujoco.mj_forward(model, data)
             hold_q = data.qpos.copy()
             sign = 1.0 if bits[c] == 0 else -1.0
@@ -181,5 +202,5 @@ def check_locks(
                 if best >= 0.98:
                     break
             free = bool(table.can_move(state, c))
-            transitions.append(Transition(state, spec.components[c].name, free, best))
+            transitions.append(Transition(state, spec.components[c].name, free, best, offset))
     return LockCheck(spec.name, tuple(transitions))

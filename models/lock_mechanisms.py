@@ -63,11 +63,19 @@ MIN_CROSSING_SINE = 0.5
 """Smallest sine of the angle between the two motions at X (30 deg): below it a blocked push would need twice its
 own force at the contact, and the tubes would have to be long to clear each other."""
 FREE_FROM = 0.75
-"""A part counts as having left a state once it moved this fraction of its travel (the twin's state threshold):
-a locker that far toward 1-a, wherever it rests past that (a door opened by a pinch may stop short of its end
-stop), must have freed the part it held."""
-MAX_BLOCKING = 0.08
-"""Largest fraction of its travel a held part may move before its tube meets the other's."""
+"""A part counts as having left a state once it moved this fraction of its travel (the twin's open threshold,
+``twin.HysteresisConfig``): a locker that far toward 1-a, wherever it rests past that (a door opened by a pinch may
+stop short of its end stop), must have freed the part it held."""
+IN_STATE = 0.25
+"""A part counts as still in a state while within this fraction of its travel from the state's end stop (the twin's
+close threshold): a locked part resting anywhere in that band must not be met by its locker, and a locker anywhere
+in it must hold its partner. So a held part's rod first meets the wall past this fraction (held part-way)."""
+HOLD_MARGIN = 0.08
+"""How far past :data:`IN_STATE` a wall still covers X [fraction of the travel]: a locker at the edge of its band
+meets the rod with this much of the wall beyond X, not with the wall's end cap."""
+MAX_BLOCKING = 0.45
+"""Largest fraction of its travel a held part may move before its tube meets the other's (the lock check's held
+part moves less than half its travel)."""
 SAMPLES = 121
 """Points along each motion's path over [-1.2, 1.2] of its travel (every 2 % of the travel)."""
 STEP = 0.02
@@ -153,6 +161,8 @@ LUG_HEIGHT = 0.004
 """Height of the lug above its underside (e3) [m]."""
 LATCH_GAP = 0.001
 """Gap between the lug and the tooth's flat face with A at a and B at b [m]."""
+TOOTH_SPACING = 0.003
+"""Largest distance between neighbouring teeth of a latch's row along A's path [m] (a tooth is 4 mm wide)."""
 LATCH_CLEARANCE = 0.0007
 """Smallest gap between tooth and lug on every free move [m]."""
 MAX_WORK_COSINE = 0.15
@@ -171,6 +181,10 @@ class OneWayLatch:
         crossing: X, lid frame [m], with A at a and B at b.
         frame: ``(3, 3)`` columns e1, e2, e3 in the lid frame, with A at a and B at b.
         crossing_cosine: cosine of the angle between A's and B's motions at X.
+        tooth_shifts: the tooth is a row of teeth along A's path, one where X's material point of A stands after
+            each of these displacements back toward a [fraction of A's travel] (0: the tooth at X): a locker
+            anywhere in its state's band (up to :data:`IN_STATE` plus :data:`HOLD_MARGIN` of its travel from a)
+            still stands a tooth in the lug's path.
     """
 
     name: str
@@ -182,6 +196,25 @@ class OneWayLatch:
     crossing: np.ndarray = field(repr=False, compare=False)
     frame: np.ndarray = field(repr=False, compare=False)
     crossing_cosine: float
+    tooth_shifts: tuple[float, ...] = (0.0,)
+
+    def tooth_vertices(self, a: JointMotion) -> list[np.ndarray]:
+        """Each tooth of the row as ``(k, 3)`` vertices in the (e1, e2, e3) frame at X with A at a [m], given A's
+        motion ``a``: the profile extruded ±:data:`TOOTH_HALF_WIDTH` along e2 and carried back along A's path; the
+        last ends, toward a, in a ramp at 45 degrees down to its underside, so that A coming back to a over a
+        lug left inside its band presses the pawl down and passes, as the lug coming back does over the bevel."""
+        direction = 1.0 if self.locker_state == 0 else -1.0
+        w = TOOTH_HALF_WIDTH
+        profile = self.tooth_profile()
+        teeth = []
+        for k, shift in enumerate(self.tooth_shifts):
+            local = [(u, side, v) for side in (-w, w) for u, v in profile]
+            if k == len(self.tooth_shifts) - 1:  # the ramp, from the top down to the tooth's underside
+                local += [(u, -w - TOOTH_RISE - TOOTH_DEPTH, -TOOTH_DEPTH) for u in (0.0, TOOTH_LENGTH)]
+            world = self.crossing + np.asarray(local) @ self.frame.T
+            carried = a.move(world, -direction * a.travel * shift)
+            teeth.append((carried - self.crossing) @ self.frame)
+        return teeth
 
     def tooth_profile(self) -> np.ndarray:
         """``(5, 2)`` the tooth's outline in the (e1, e3) plane [m], counter-clockwise: flat face at e1 = 0 toward
@@ -298,7 +331,8 @@ def _design_latch(spec, rule: LockRule, a: JointMotion, b: JointMotion, by_name)
         e2 = va[k] - (va[k] @ e1) * e1
         e2 /= np.linalg.norm(e2)
         frame = np.column_stack([e1, e2, np.cross(e1, e2)])
-        why = _latch_clear(x0, frame, a, b, dir_a, dir_b, lo, hi)
+        shifts = _tooth_shifts(a, x0)
+        why = _latch_clear(x0, frame, a, b, dir_a, dir_b, lo, hi, shifts)
         if why is not None:
             reasons[why] = reasons.get(why, 0) + 1
             continue
@@ -312,38 +346,53 @@ def _design_latch(spec, rule: LockRule, a: JointMotion, b: JointMotion, by_name)
             crossing=x0,
             frame=frame,
             crossing_cosine=float(cosine[k]),
+            tooth_shifts=tuple(shifts),
         )
     common = max(reasons, key=reasons.__getitem__) if reasons else "no candidate"
     return f"no point serves a one-way latch (mostly: {common})"
 
 
-def _latch_clear(x, frame, a, b, dir_a, dir_b, lo, hi) -> str | None:
-    """Why a one-way latch at ``x`` with ``frame`` would meet itself on a free move or leave the box, or None.
+def _tooth_shifts(a: JointMotion, x: np.ndarray) -> np.ndarray:
+    """Displacements [fraction of A's travel] of the row of teeth (:attr:`OneWayLatch.tooth_shifts`): from 0 to
+    :data:`IN_STATE` plus :data:`HOLD_MARGIN`, neighbours at most :data:`TOOTH_SPACING` apart along A's path."""
+    reach = IN_STATE + HOLD_MARGIN
+    length = float(np.linalg.norm(_velocities(a, np.asarray(x)[None])[0])) * a.travel * reach
+    return np.linspace(0.0, reach, max(1, int(np.ceil(length / TOOTH_SPACING))) + 1)
 
-    The tooth and the lug are boxes in the (e1, e2, e3) frame, carried by their parts' motions; a rotation of a
-    part is allowed for by widening its box by the turn times its largest half size."""
+
+def _latch_clear(x, frame, a, b, dir_a, dir_b, lo, hi, shifts=(0.0,)) -> str | None:
+    """Why a one-way latch at ``x`` with ``frame`` and its row of teeth at ``shifts`` (:func:`_tooth_shifts`) would
+    meet itself on a free move or leave the box, or None.
+
+    The lug and each tooth are boxes in the (e1, e2, e3) frame, each carried rigidly by its part's motion; a
+    rotation of a part is allowed for by widening its box by the turn times its largest half size."""
     tooth_centre = np.array([TOOTH_LENGTH / 2, 0.0, (TOOTH_RISE - TOOTH_DEPTH) / 2])
     tooth_half = np.array([TOOTH_LENGTH / 2, TOOTH_HALF_WIDTH, (TOOTH_RISE + TOOTH_DEPTH) / 2])
     lug_centre = np.array([-LATCH_GAP - LUG_LENGTH / 2, 0.0, LUG_HEIGHT / 2])
     lug_half = np.array([LUG_LENGTH / 2, LUG_HALF_WIDTH, LUG_HEIGHT / 2])
-    tooth_world = x + frame @ tooth_centre
-    lug_world = x + frame @ lug_centre
     ts = np.linspace(0.0, 1.0, 51)
-    tooth_path = a.move(tooth_world, dir_a * a.travel * ts)  # A from a to 1-a
-    lug_path = b.move(lug_world, dir_b * b.travel * ts)  # B from b to 1-b
-    turn_a = ts * a.travel if a.joint == "hinge" else 0 * ts
+    n = len(ts)
+    tooth_paths = [
+        a.move(a.move(x + frame @ tooth_centre, -dir_a * a.travel * shift), dir_a * a.travel * ts) for shift in shifts
+    ]  # each tooth as A goes from a to 1-a
+    lug_path = b.move(x + frame @ lug_centre, dir_b * b.travel * ts)  # B from b to 1-b
+    hinge_a = 1.0 if a.joint == "hinge" else 0.0
+    # each tooth's turn away from the design frame: it was carried back by its shift, so it stands as designed at X
+    turns_a = [hinge_a * np.abs(ts - shift) * a.travel for shift in shifts]
     turn_b = ts * b.travel if b.joint == "hinge" else 0 * ts
-    every = np.vstack([tooth_path, lug_path])
+    every = np.vstack([*tooth_paths, lug_path])
     reach = max(np.linalg.norm(tooth_half), np.linalg.norm(lug_half))
     if np.any(every < lo + reach) or np.any(every > hi - reach):
         return "it leaves the box"
 
     def overlap(tooth_i: np.ndarray, lug_i: np.ndarray) -> bool:  # whether any pair (tooth_i[k], lug_i[k]) overlaps
-        d = (lug_path[lug_i] - tooth_path[tooth_i]) @ frame
-        grow = turn_a[tooth_i] * tooth_half.max() + turn_b[lug_i] * lug_half.max()
-        return bool(np.any(np.all(np.abs(d) < tooth_half + lug_half + grow[:, None] + LATCH_CLEARANCE, axis=1)))
+        for path, turn_a in zip(tooth_paths, turns_a, strict=True):  # each carried rigidly: its turn widens it
+            d = (lug_path[lug_i] - path[tooth_i]) @ frame
+            grow = turn_a[tooth_i] * tooth_half.max() + turn_b[lug_i] * lug_half.max()
+            if np.any(np.all(np.abs(d) < tooth_half + lug_half + grow[:, None] + LATCH_CLEARANCE, axis=1)):
+                return True
+        return False
 
-    n = len(ts)
     leaving = np.arange(1, n)
     if overlap(leaving, np.zeros_like(leaving)):
         return "the tooth meets the lug as the locker leaves"
@@ -437,32 +486,35 @@ def _free_edges_clear(paths: _Paths, theta: float, delta: float) -> bool:
     need = 2 * TUBE_RADIUS + GAP + CHORD_SAGITTA
     ts, d = paths.ts, paths.distance
     i_m1, i_p1 = _index(ts, -1.0), _index(ts, 1.0)
-    at_b = d[_index(ts, -theta) : i_p1 + 1, i_m1 : _index(ts, -delta) + 1]
+    in_b = d[_index(ts, -theta) : i_p1 + 1, i_m1 : _index(ts, IN_STATE - delta) + 1]
     anywhere = d[_index(ts, FREE_FROM - theta) : i_p1 + 1, i_m1 : _index(ts, 1.0 - delta) + 1]
-    return bool(at_b.min() >= need and anywhere.min() >= need)
+    return bool(in_b.min() >= need and anywhere.min() >= need)
 
 
 def _fractions(paths: _Paths) -> tuple[float, float] | None:
     """``(theta, delta)``: the largest theta and smallest delta on the :data:`STEP` grid for which the free edges
-    of the configuration square are clear (module docstring), or None: delta within :data:`MAX_BLOCKING`, theta
-    within :data:`MAX_BLOCKING` short of :data:`FREE_FROM`.
+    of the configuration square are clear (module docstring), or None. The bands decide the range: delta past
+    :data:`IN_STATE` (a locked part anywhere in its state's band does not meet the wall) and at most
+    :data:`MAX_BLOCKING`; theta short of :data:`FREE_FROM` (a locker past its open threshold has let go) and at
+    least :data:`HOLD_MARGIN` past :data:`IN_STATE` (a locker anywhere in its state's band holds).
 
-    Free edges, with t the displacement (fraction of travel) that carries X through a part: B at b and A anywhere
-    (wall ``t`` in [-theta, 1], rod in [-1, -delta]) and A past :data:`FREE_FROM` and B anywhere (wall in
-    [FREE_FROM - theta, 1], rod in [-1, 1-delta])."""
+    Free edges, with t the displacement (fraction of travel) that carries X through a part: B within IN_STATE of b
+    and A anywhere (wall ``t`` in [-theta, 1], rod in [-1, IN_STATE - delta]) and A past :data:`FREE_FROM` and B
+    anywhere (wall in [FREE_FROM - theta, 1], rod in [-1, 1 - delta])."""
     need = 2 * TUBE_RADIUS + GAP + CHORD_SAGITTA
     ts, d = paths.ts, paths.distance
     i_m1, i_p1 = _index(ts, -1.0), _index(ts, 1.0)
-    blockings = np.arange(STEP, MAX_BLOCKING + 1e-9, STEP)
-    for delta in blockings:
-        # per wall sample, its nearest rod sample: B at b (rod [-1, -delta]) and B anywhere (rod [-1, 1-delta])
-        at_b = d[: i_p1 + 1, i_m1 : _index(ts, -delta) + 1].min(axis=1)
+    deltas = np.arange(IN_STATE + STEP, MAX_BLOCKING + 1e-9, STEP)
+    thetas = np.arange(FREE_FROM - STEP, IN_STATE + HOLD_MARGIN - 1e-9, -STEP)
+    for delta in deltas:
+        # per wall sample, its nearest rod sample: B in b's band (rod [-1, IN_STATE - delta]) and B anywhere
+        # (rod [-1, 1 - delta])
+        in_b = d[: i_p1 + 1, i_m1 : _index(ts, IN_STATE - delta) + 1].min(axis=1)
         anywhere = d[: i_p1 + 1, i_m1 : _index(ts, 1.0 - delta) + 1].min(axis=1)
-        clear_at_b = np.minimum.accumulate(at_b[::-1])[::-1]  # min over wall samples i..t=1
+        clear_in_b = np.minimum.accumulate(in_b[::-1])[::-1]  # min over wall samples i..t=1
         clear_anywhere = np.minimum.accumulate(anywhere[::-1])[::-1]
-        for blocking_a in blockings:
-            theta = FREE_FROM - blocking_a  # A frees B wherever it rests past FREE_FROM
-            if clear_at_b[_index(ts, -theta)] >= need and clear_anywhere[_index(ts, FREE_FROM - theta)] >= need:
+        for theta in thetas:  # largest first: A frees B wherever it rests past FREE_FROM
+            if clear_in_b[_index(ts, -theta)] >= need and clear_anywhere[_index(ts, FREE_FROM - theta)] >= need:
                 return float(theta), float(delta)
     return None
 
@@ -480,7 +532,7 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
     keep = (na > 1e-6) & (nb > 1e-6) & (sine >= MIN_CROSSING_SINE)
     # the clearance across the motions alone asks at least this much of each part's travel: hopeless beyond
     with np.errstate(divide="ignore", invalid="ignore"):
-        keep &= (2 * TUBE_RADIUS + GAP) / (sine * np.minimum(na, nb)) <= MAX_BLOCKING * 1.25
+        keep &= (2 * TUBE_RADIUS + GAP) / (sine * np.minimum(na, nb)) <= (MAX_BLOCKING - IN_STATE) * 1.25
     # every tube lies on X's paths through A and B over a whole travel each way: inside the box?
     top = np.full(len(grid), -np.inf)
     for t in np.linspace(-1.0, 1.0, 9):

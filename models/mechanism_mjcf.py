@@ -1,7 +1,8 @@
 """The lock mechanisms of a spec (:mod:`models.lock_mechanisms`) as MJCF geoms on the components' moving bodies.
 
-Each one-way latch is a sprung pawl body ``<A>:latch:<B>:pawl`` (slide joint ``...:spring`` along its e3, a convex
-mesh tooth ``...:tooth``) on the locker's moving body and a box lug ``<A>:latch:<B>:lug`` on the locked part's.
+Each one-way latch is a sprung pawl body ``<A>:latch:<B>:pawl`` (slide joint ``...:spring`` along its e3, a row of
+convex mesh teeth ``...:tooth:<k>`` along the locker's path) on the locker's moving body and a box lug
+``<A>:latch:<B>:lug`` on the locked part's.
 Each interlock's wall is a chain of capsules in the locker's moving body, its rod a chain in the locked part's,
 named ``<A>:interlock:<B>:wall:<k>`` and ``<A>:interlock:<B>:rod:<k>`` (MJCF component names). They collide
 with each other only: both have the contact bit of their interlock alone (``contype = conaffinity = 2**k``,
@@ -23,7 +24,6 @@ from puzzlebox.models.joint_motion import JointMotion
 from puzzlebox.models.kinds.parts import PART_DENSITY
 from puzzlebox.models.kinds.registry import get_kind
 from puzzlebox.models.lock_mechanisms import (
-    TOOTH_HALF_WIDTH,
     TOOTH_RISE,
     Interlock,
     MechanismLayout,
@@ -154,11 +154,9 @@ def _add_latch(root, latch: OneWayLatch, bodies, prefixes, by_name, bit: int) ->
         limited=True, stiffness=PAWL_STIFFNESS, springref=PAWL_PRELOAD, damping=PAWL_DAMPING, armature=PAWL_ARMATURE,
         solreflimit=list(MECHANISM_SOLREF), solimplimit=list(MECHANISM_SOLIMP),
     )  # fmt: skip
-    profile = latch.tooth_profile()
-    w = TOOTH_HALF_WIDTH
-    vertices = [(u, side * w, v) for side in (-1.0, 1.0) for u, v in profile]
-    mesh = root.asset.add("mesh", name=f"{base}:tooth", vertex=np.asarray(vertices).ravel().tolist())
-    pawl.add("geom", name=f"{base}:tooth", type="mesh", mesh=mesh, density=STEEL_DENSITY, **contact)
+    for k, vertices in enumerate(latch.tooth_vertices(a)):  # the row of teeth along A's path
+        mesh = root.asset.add("mesh", name=f"{base}:tooth:{k}", vertex=np.asarray(vertices).ravel().tolist())
+        pawl.add("geom", name=f"{base}:tooth:{k}", type="mesh", mesh=mesh, density=STEEL_DENSITY, **contact)
     # the lug, on the locked part
     centre, half = latch.lug_box()
     rotation_b = np.column_stack([b.direction_to_body(latch.frame[:, i], q_b) for i in range(3)])

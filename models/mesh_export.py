@@ -15,7 +15,7 @@ turned into triangles at its pose. Parts:
   without mechanisms): the geoms whose name holds ``:interlock:`` or ``:latch:`` (:mod:`models.mechanism_mjcf`),
   wherever they are in the box, grouped by name up to a trailing ``:<index>``: ``<A>:interlock:<B>:wall:<k>``
   make the part ``<A>-interlocks-<B>-wall`` (``A``, ``B`` the spec names of the locker and the locked part),
-  ``<A>:latch:<B>:tooth`` the part ``<A>-latches-<B>-tooth``; after the components, by locker (spec order),
+  ``<A>:latch:<B>:tooth:<k>`` the part ``<A>-latches-<B>-tooth``; after the components, by locker (spec order),
   locked part and role. A mechanism is exported as MuJoCo collides with it: a chain of capsules as one tube
   along their axes (the capsules' union: every vertex on its surface, round ends, the outside of a bend on the
   ball of the joint, its inside the crease where the cylinders meet), a mesh geom (a latch's tooth) as its

@@ -8,6 +8,7 @@
     python scripts/generate.py mjcf SPEC --out DIR [--box-only] [--locks {contact,latch}]
                                                     # DIR/scene.xml (or DIR/box.xml) + assets, loadable by mujoco
     python scripts/generate.py check-locks SPEC... [--with-robot] [--locks {contact,latch}] [--json FILE]
+                                               [--stops-only]
                                                     # exit 1 if a model alone does not hold its lock rules
     python scripts/generate.py mesh SPEC --out DIR  # DIR/<name>.glb|.obj|.stl + <name>-<part>.stl
 
@@ -16,12 +17,14 @@
 the spec's lock rules mechanisms that block by contact; a rule no mechanism realizes is named on one line (the
 twin holds it with a latch; in ``box.xml`` nothing holds it). ``--locks latch`` builds no mechanism at all.
 
-``check-locks`` pushes every part of each box from every state reachable from all-closed, in plain MuJoCo, with
-the box alone (or with ``--with-robot`` in the whole scene), and compares what moved with what the spec allows
-(``models.lock_check``): one line per box (transitions that agree, how far a held part moved at most [% of its
-travel], rules without a mechanism), one indented line per disagreement, then a total. Exit 1 if any transition
-disagrees, 2 if a spec is invalid (one line each) or a box cannot be built. ``--json FILE`` writes every box's
-result (moves as fractions of the travel).
+``check-locks`` pushes every part of each box from every state reachable from all-closed, in plain MuJoCo, with the
+box alone (or with ``--with-robot`` in the whole scene), and compares what moved with what the spec allows
+(``models.lock_check``), the parts not pushed resting at their end stops and at 10 % and 20 % of their travel inside
+their states' bands (the band check: the twin counts a part closed below 25 % and open above 75 %, and a locker
+anywhere there must hold or free as its state says; ``--stops-only``: at the stops alone): one line per box
+(transitions that agree, how far a held part moved at most [% of its travel], rules without a mechanism), one
+indented line per disagreement, then a total. Exit 1 if any transition disagrees, 2 if a spec is invalid (one line
+each) or a box cannot be built. ``--json FILE`` writes every box's result (moves as fractions of the travel).
 
 ``mesh`` exports the box as the MuJoCo model has it (at start, every component closed): one part per
 component plus ``box`` (the shell) and one per lock mechanism's piece (``<A>-interlocks-<B>-wall``, ``-rod``;
@@ -95,7 +98,9 @@ def _check_locks(args: argparse.Namespace) -> int:
         for problem in err.problems[:-1]:
             print(f"error: {problem}", file=sys.stderr)
         fail(err.problems[-1])  # one line per invalid file, exit 2
-    checks = LockChecks(args.locks, args.with_robot)
+    from puzzlebox.models.lock_check import BAND_OFFSETS
+
+    checks = LockChecks(args.locks, args.with_robot, (0.0,) if args.stops_only else BAND_OFFSETS)
     checks.run(tqdm(specs, desc="check-locks", unit="box", disable=None), say=tqdm.write,
                warn=lambda line: tqdm.write(line, file=sys.stderr))  # fmt: skip
     if args.json:
@@ -172,6 +177,9 @@ def main(argv: list[str] | None = None) -> int:
     check.add_argument("--with-robot", action="store_true", help="check the whole scene (table, robot, box)")
     check.add_argument("--locks", **locks)
     check.add_argument("--json", default=None, metavar="FILE", help="also write every box's result to FILE")
+    check.add_argument("--stops-only", action="store_true", help="rest the parts not pushed at their end stops "
+                       "only (default: also 10 %% and 20 %% inside their states' bands, where the twin already counts "
+                       "them in their states)")  # fmt: skip
     check.set_defaults(run=_check_locks)
 
     mesh = verbs.add_parser("mesh", help="the box as meshes: DIR/<name>.glb, .obj, .stl and one STL per part "

@@ -22,11 +22,14 @@ if TYPE_CHECKING:
 
 
 class LockChecks:
-    """The checks of several boxes with ``locks`` (contact or latch), the box alone or ``with_robot``."""
+    """The checks of several boxes with ``locks`` (contact or latch), the box alone or ``with_robot``; every other
+    part resting at each of ``offsets`` of its travel from the end stop of its state (the band check,
+    ``models.lock_check.BAND_OFFSETS``; ``(0.0,)``: at the stops only)."""
 
-    def __init__(self, locks: LockMode, with_robot: bool) -> None:
+    def __init__(self, locks: LockMode, with_robot: bool, offsets: tuple[float, ...] = (0.0,)) -> None:
         self.locks: LockMode = locks
         self.with_robot = with_robot
+        self.offsets = offsets
         self.boxes: list[dict[str, Any]] = []
         self.errors: list[dict[str, str]] = []
 
@@ -40,13 +43,15 @@ class LockChecks:
         except ModelsError as err:
             self.errors.append({"file": str(file), "spec": spec.name, "error": one_line(err)})
             raise BoxBuildError(f"{file}: {one_line(err)}") from err
-        box = box_record(file, spec, check_locks(spec, model, joints), latch_only(spec, self.locks))
+        check = check_locks(spec, model, joints, offsets=self.offsets)
+        box = box_record(file, spec, check, latch_only(spec, self.locks))
         self.boxes.append(box)
         lines = [box_line(box)]
         for t in box["disagreements"]:
             opened = ", ".join(t["open"]) or "none"
             moved = f"moved {100 * t['moved']:.1f} % of its travel"
-            lines.append(f"  open [{opened}]: {t['component']} should be {t['expected']}, {moved}")
+            rest = "at their stops" if t["offset"] == 0 else f"{100 * t['offset']:.0f} % inside their bands"
+            lines.append(f"  open [{opened}], the others {rest}: {t['component']} should be {t['expected']}, {moved}")
         return lines
 
     def run(self, specs: Iterable[tuple[str, PuzzleSpec]], say: Callable[[str], object],
@@ -72,7 +77,8 @@ class LockChecks:
 
     def record(self) -> dict[str, Any]:
         """Every box's result, as ``--json FILE`` writes it."""
-        record = {"locks": self.locks, "with_robot": self.with_robot, "agreeing": self.agreeing, "total": self.total}
+        record = {"locks": self.locks, "with_robot": self.with_robot, "offsets": list(self.offsets),
+                  "agreeing": self.agreeing, "total": self.total}  # fmt: skip
         return {**record, "boxes": self.boxes, "errors": self.errors}
 
     def total_line(self) -> str:
@@ -122,6 +128,7 @@ def box_record(file: str, spec: PuzzleSpec, result: LockCheck, unrealized: list[
                 "component": t.component,
                 "expected": "free" if t.expected_free else "held",
                 "moved": t.moved,
+                "offset": t.offset,
             }
             for t in result.disagreements()
         ],

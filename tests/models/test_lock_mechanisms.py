@@ -1,5 +1,6 @@
-"""Locks made of matter (issue 33): the lock rules of a spec are mechanisms that block by contact, so the model
-alone, in plain MuJoCo with no latch engaged, behaves as the spec says."""
+"""Locks made of matter: the lock rules of a spec are mechanisms that block by contact, so the model alone, in plain
+MuJoCo with no latch engaged, behaves as the spec says — with every locker at its end stop and anywhere inside the
+band where the twin already counts it in its state (the band check)."""
 
 from __future__ import annotations
 
@@ -12,8 +13,8 @@ import pytest
 
 from puzzlebox.models.box_export import compile_box
 from puzzlebox.models.generator import BoxConfig, RandomGraphConfig, generate_chain, generate_random, paper_family
-from puzzlebox.models.lock_check import HELD_FRACTION, check_locks
-from puzzlebox.models.lock_mechanisms import design_mechanisms, paired_rules
+from puzzlebox.models.lock_check import BAND_OFFSETS, HELD_FRACTION, check_locks
+from puzzlebox.models.lock_mechanisms import IN_STATE, design_mechanisms, paired_rules
 from puzzlebox.models.scene import SceneConfig, build_scene
 from puzzlebox.models.spec import Component, Goal, LockRule, PuzzleSpec
 
@@ -25,22 +26,24 @@ def _box(spec: PuzzleSpec, locks: str = "contact"):
     return compile_box(spec, locks)
 
 
-def _check(spec: PuzzleSpec, locks: str = "contact"):
+@functools.cache
+def _check(spec: PuzzleSpec, locks: str = "contact", offsets: tuple[float, ...] = BAND_OFFSETS):
     model, joints = _box(spec, locks)
-    return check_locks(spec, model, joints)
+    return check_locks(spec, model, joints, offsets=offsets)
 
 
 @pytest.mark.parametrize("name", sorted(PAPER))
-def test_paper_box_alone_behaves_as_its_spec_says(name):
+def test_paper_box_alone_behaves_as_its_spec_says_wherever_its_parts_stand_in_their_bands(name):
     spec = PAPER[name]
     check = _check(spec)
     assert check.disagreements() == []
-    assert len(check.transitions) == 30
-    # a bolt holds a closed part within a few percent of its travel; an open part held open rests short of the
-    # open threshold (0.75), where its locker's pin stands so that the locker frees it wherever it rests past that
+    assert len(check.transitions) == 30 * len(BAND_OFFSETS)
+    # a held closed part moves out of its state's band before its rod meets the wall (anywhere in the band it must
+    # not: its locker is free to move while it counts as closed), and stops well short of half its travel; an open
+    # part held open rests short of the open threshold (0.75), so that its locker frees it wherever it rests past that
     closed = [t.moved for t in check.transitions if not t.expected_free and not (t.state >> _index(spec, t) & 1)]
     opened = [t.moved for t in check.transitions if not t.expected_free and t.state >> _index(spec, t) & 1]
-    assert closed and max(closed) < 0.08
+    assert closed and IN_STATE < min(closed) and max(closed) < HELD_FRACTION
     assert opened and max(opened) < 0.35
 
 
@@ -81,17 +84,17 @@ def test_seeded_multi_locker_box_with_one_way_latches_behaves_as_its_spec_says()
 
 
 def test_a_one_way_latch_holds_a_wheel_pushed_close_to_its_axis():
-    # random-n8-s32: slide-2 closed keeps wheel-5 closed through a lug 12 mm from the wheel's axis, where the
-    # 1.5 N m push meets the tooth with > 100 N; with MuJoCo's default contact softness the lug sank through
-    spec = generate_random(RandomGraphConfig(8, family=_all_kinds()), seed=32)
+    # random-n8-s32 as first drawn: slide-2 closed keeps wheel-5 closed through a lug 12 mm from the wheel's axis,
+    # where the 1.5 N m push meets the tooth with > 100 N; with MuJoCo's default contact softness the lug sank through
+    # (the generator now redraws that box: two of its other latches find no place for a row of teeth)
+    spec = generate_random(RandomGraphConfig(8, family=_all_kinds()), seed=32, box=BoxConfig(realizable=False))
     latch = next(latch for latch in design_mechanisms(spec).latches if latch.locked == "wheel-5")
     assert latch.locker == "slide-2"
     model, joints = _box(spec)
-    check = check_locks(spec, model, joints, limit=4)
+    check = check_locks(spec, model, joints, limit=4, offsets=BAND_OFFSETS)
     wheel = [t for t in check.transitions if t.component == "wheel-5"]
     assert wheel and not any(t.expected_free for t in wheel)
     assert max(t.moved for t in wheel) < 0.1
-    assert check.disagreements() == []
 
 
 def test_a_chain_of_all_five_kinds_behaves_as_its_spec_says():
@@ -119,10 +122,10 @@ def _two_part_box(rules: list[tuple[str, int, str, int]]) -> PuzzleSpec:
     )
 
 
-def _push(spec, component: str, states: dict[str, int], steps: int = 500) -> float:
-    """Push ``component`` toward its other state from ``states`` with the check's bounded push, the others held;
-    the largest fraction of its travel it reached."""
-    check = _check(spec)
+def _push(spec, component: str, states: dict[str, int], offset: float = 0.0) -> float:
+    """Push ``component`` toward its other state from ``states`` with the check's bounded push, the others held
+    ``offset`` of their travel inside their states' bands; the largest fraction of its travel it reached."""
+    check = _check(spec, offsets=(offset,))
     index = {c.name: i for i, c in enumerate(spec.components)}
     state = sum(states[n] << index[n] for n in states)
     matches = [t for t in check.transitions if t.state == state and t.component == component]
@@ -134,8 +137,8 @@ def test_a_paired_interlock_blocks_both_ways():
     spec = _two_part_box([("door-a", 0, "slide-b", 0), ("slide-b", 1, "door-a", 1)])
     layout = design_mechanisms(spec)
     assert len(layout.interlocks) == 1 and layout.complete
-    # the closed door keeps the slide in ...
-    assert _push(spec, "slide-b", {"door-a": 0, "slide-b": 0}) < 0.08
+    # the closed door keeps the slide in, short of its open threshold and past its closed band ...
+    assert IN_STATE < _push(spec, "slide-b", {"door-a": 0, "slide-b": 0}) < HELD_FRACTION
     # ... and the open slide keeps the door open, near open (not a tongue it falls onto)
     assert _push(spec, "door-a", {"door-a": 1, "slide-b": 1}) < 0.35  # within 0.25 of the open threshold
     # free moves stay free
@@ -143,8 +146,7 @@ def test_a_paired_interlock_blocks_both_ways():
     assert _push(spec, "slide-b", {"door-a": 1, "slide-b": 0}) > 0.9
 
 
-def test_a_one_way_latch_lets_the_part_in_and_not_out():
-    # unpaired: the closed door keeps the slide closed, but an open slide may close while the door is closed
+def _latch_box() -> PuzzleSpec:
     spec = _two_part_box([("door-a", 0, "slide-b", 0)])
     layout = design_mechanisms(spec)
     if not layout.latches:  # this pair's motions never cross squarely under the lid: a wheel instead
@@ -154,11 +156,37 @@ def test_a_one_way_latch_lets_the_part_in_and_not_out():
         )
         layout = design_mechanisms(spec)
     assert len(layout.latches) == 1 and layout.complete
+    return spec
+
+
+def test_a_one_way_latch_lets_the_part_in_and_not_out():
+    # unpaired: the closed door keeps the slide closed, but an open slide may close while the door is closed
+    spec = _latch_box()
     assert paired_rules(spec)[1] == list(spec.locks)
     assert _push(spec, "slide-b", {"door-a": 0, "slide-b": 0}) < 0.08  # not out
     assert _push(spec, "slide-b", {"door-a": 0, "slide-b": 1}) > 0.75  # but in, past the sprung pawl
     assert _push(spec, "door-a", {"door-a": 0, "slide-b": 1}) > 0.75  # the door is free
     assert _push(spec, "door-a", {"door-a": 1, "slide-b": 1}) > 0.75
+
+
+def test_a_paired_interlock_follows_the_states_inside_their_bands():
+    # the issue's cases: a locker at 80-95 % (open for the twin) frees its partner; a locked part at 5-20 % (closed
+    # for the twin) keeps nobody from closing; a locker at 5-20 % (closed) still holds
+    spec = _two_part_box([("door-a", 0, "slide-b", 0), ("slide-b", 1, "door-a", 1)])
+    for offset in (0.05, 0.1, 0.2):
+        assert _push(spec, "slide-b", {"door-a": 1, "slide-b": 0}, offset) > 0.9  # door open at 1 - offset
+        assert _push(spec, "door-a", {"door-a": 1, "slide-b": 0}, offset) > 0.9  # slide closed at offset
+        assert _push(spec, "slide-b", {"door-a": 0, "slide-b": 0}, offset) < HELD_FRACTION  # door closed at offset
+        assert _push(spec, "door-a", {"door-a": 1, "slide-b": 1}, offset) < 0.35  # slide open at 1 - offset
+
+
+def test_a_one_way_latch_follows_its_lockers_state_inside_its_band():
+    spec = _latch_box()
+    for offset in (0.05, 0.1, 0.2):
+        assert _push(spec, "slide-b", {"door-a": 0, "slide-b": 0}, offset) < 0.08  # the door closed at offset holds
+        assert _push(spec, "slide-b", {"door-a": 1, "slide-b": 0}, offset) > 0.9  # open at 1 - offset frees
+        # the door closing over a slide left inside its closed band presses the pawl down on the tooth's ramp
+        assert _push(spec, "door-a", {"door-a": 1, "slide-b": 0}, offset) > 0.9
 
 
 @pytest.mark.parametrize("locks", ["contact", "latch"])
