@@ -91,11 +91,15 @@ def decide(
     rng: np.random.Generator,
     config: DualControllerConfig,
     h_max: float,
+    avoid: np.ndarray | None = None,
 ) -> Decision:
-    """The dual controller's choice in joint state ``states``."""
+    """The dual controller's choice in joint state ``states``; ``avoid`` (bool per component) marks components not
+    to choose while any other may be chosen (the robot could not try them in this state: a failed try)."""
     q_info = information_values(belief, states, config.info_threshold)
     q_exploit = exploit_values(belief, states, goal, goal_state, config.planner)
     weight = float(np.clip(belief.entropy() / h_max, 0.0, 1.0)) if h_max > 0.0 else 0.0
     q = weight * q_info + (1.0 - weight) * q_exploit
+    if avoid is not None and avoid.any() and not avoid.all():
+        q = np.where(avoid, -np.inf, q)
     best = np.flatnonzero(q >= q.max() - TIE_TOLERANCE)
     return Decision(int(rng.choice(best)), q_info, q_exploit, weight)

@@ -13,8 +13,9 @@ from puzzlebox.learning.agents.base import Agent
 from puzzlebox.models import World
 
 MAX_FAILURES_IN_A_ROW = 3
-"""A run ends when one component fails this many tries in a row (each already retried by the world):
-a component the robot cannot try is reported, not looped on."""
+"""A run ends when one component fails this many tries in a row (each already retried by the world), or when every
+component failed since the joint state last changed: a component the robot cannot try is a failed try for the agent
+to weigh (the dual agents try something else), and the run goes on while anything else can be tried."""
 
 
 @dataclass(frozen=True)
@@ -66,10 +67,14 @@ def run_episode(
     actions: list[ActionRecord] = []
     ended = ""
     failures_in_a_row = 0  # of the component tried last
+    failed_here: set[str] = set()  # components whose last try failed since the joint state last changed
     while not observation.solved and len(actions) < max_actions:
         index = agent.choose(observation)
+        before = observation.states
         result = world.try_toggle(index)
         observation = world.observe()
+        if not np.array_equal(before, observation.states):
+            failed_here = set()
         agent.record(index, result, observation)
         name = name_of(index) if name_of else str(index)
         actions.append(ActionRecord(name, result.moved, result.outcome, result.reason))
@@ -77,7 +82,9 @@ def run_episode(
             on_action(actions[-1])
         repeated = len(actions) > 1 and actions[-2].component == name and actions[-2].outcome == "failed"
         failures_in_a_row = (failures_in_a_row + 1 if repeated else 1) if result.outcome == "failed" else 0
-        if result.give_up or failures_in_a_row >= MAX_FAILURES_IN_A_ROW:
+        if result.outcome == "failed":
+            failed_here.add(name)
+        if failures_in_a_row >= MAX_FAILURES_IN_A_ROW or len(failed_here) == len(observation.states):
             ended = f"could not try {name}: {result.reason}"
             break
     agent.end_episode(observation.solved)

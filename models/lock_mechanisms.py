@@ -208,8 +208,13 @@ class OneWayLatch:
         profile = self.tooth_profile()
         teeth = []
         for k, shift in enumerate(self.tooth_shifts):
-            local = [(u, side, v) for side in (-w, w) for u, v in profile]
-            if k == len(self.tooth_shifts) - 1:  # the ramp, from the top down to the tooth's underside
+            local = [(u, w, v) for u, v in profile]
+            if k < len(self.tooth_shifts) - 1:
+                local += [(u, -w, v) for u, v in profile]
+            else:  # the ramp, from the top down to the tooth's underside (every vertex a corner of the hull: the
+                # profile's underside at -w would lie on the hull's edges, which a convex hull's triangulation
+                # turns into slivers)
+                local += [(u, -w, v) for u, v in profile if v > -TOOTH_DEPTH]
                 local += [(u, -w - TOOTH_RISE - TOOTH_DEPTH, -TOOTH_DEPTH) for u in (0.0, TOOTH_LENGTH)]
             world = self.crossing + np.asarray(local) @ self.frame.T
             carried = a.move(world, -direction * a.travel * shift)

@@ -139,9 +139,12 @@ class PrimitiveConfig:
     servo alone snaps the fingers shut at ~2/s, and pads meeting a post at that speed put a 30 ms,
     60 N impact on the wrist."""
     actuate_time: float = 2.5
-    breakaway_fraction: float = 0.10
-    """Start of the travel commanded at ``breakaway_pace`` (fraction of the travel): where a latch or a sticky
-    part is met, so that it is met slowly (the same span as ``blocked_progress``)."""
+    breakaway_fraction: float = 0.5
+    """Start of the travel commanded at ``breakaway_pace`` (fraction of the travel): where a lock or a sticky part
+    is met, so that it is met slowly — a one-way latch within ``blocked_progress``, an interlock's rod once the held
+    part has left its closed band (25-45 % of its travel: ``models.lock_mechanisms``). Met at full pace there, a door
+    held part-way at 32 % put 91 N on the wrist before the stall was read; at this pace 30 N, and a try takes ~7 %
+    longer."""
     breakaway_pace: float = 0.4
     """Pace of the start of the travel, as a fraction of the pace of the rest [-]: a part that sticks after
     moving 2 % of its travel stops the grasp dead, and at full pace (a door handle at ~4 cm/s) the arm drove

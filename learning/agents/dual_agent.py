@@ -27,6 +27,9 @@ class DualAgent:
     A world that finds a part's kind wrong (a misread marker: ``skills.robot_world``) observes it by the kind that
     moved it from then on: the belief is then made again from the prior of the kinds observed, and the episode's
     evidence replayed into it (:meth:`record`).
+
+    A component the robot could not try (a ``failed`` try: no evidence about locks) is not chosen again in the same
+    joint state while another may be: the agent tries something else and comes back to it once a state changed.
     """
 
     name = "dual"
@@ -41,6 +44,9 @@ class DualAgent:
         self._kinds: tuple[str, ...] = ()
         self._evidence: list[tuple[np.ndarray, int, bool]] = []
         """The episode's informative tries: the joint state before the try, the component, whether it moved."""
+        self._failed: set[int] = set()
+        """Components whose last try failed in :attr:`_failed_in` (the joint state it was made in)."""
+        self._failed_in = np.zeros(0, dtype=np.int64)
 
     def initial_prior(self, observation: SceneObservation) -> np.ndarray:
         """The one-locker prior ``(N, 2, 1 + 2N)`` of a new task."""
@@ -69,10 +75,15 @@ class DualAgent:
         self.decisions = []
         self._kinds = observation.kinds
         self._evidence = []
+        self._failed = set()
 
     def choose(self, observation: SceneObservation) -> int:
         assert self.belief is not None, "begin_episode() first"
         self._states = observation.states.copy()
+        avoid = None
+        if self._failed and np.array_equal(self._failed_in, self._states):
+            avoid = np.zeros(len(self._states), dtype=bool)
+            avoid[sorted(self._failed)] = True
         decision = decide(
             self.belief,
             self._states,
@@ -81,6 +92,7 @@ class DualAgent:
             self._rng,
             self.config,
             self._h_max,
+            avoid,
         )
         self.decisions.append(decision)
         return decision.action
@@ -90,6 +102,12 @@ class DualAgent:
         if result.informative:  # a failed try (no grasp, IK, marker lost) says nothing about locks
             self.belief.update(self._states, index, result.moved)  # the state in which the try was made
             self._evidence.append((self._states.copy(), index, result.moved))
+            self._failed.discard(index)
+        else:  # not chosen again in this state while another may be (choose)
+            if not np.array_equal(self._failed_in, self._states):
+                self._failed = set()
+            self._failed.add(index)
+            self._failed_in = self._states.copy()
         if observation.kinds != self._kinds:  # the world found a part's kind: its prior, the same evidence
             self._kinds = observation.kinds
             self.belief = self.initial_belief(observation)

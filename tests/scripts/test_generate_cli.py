@@ -255,22 +255,34 @@ def test_mjcf_box_only_writes_a_box_without_robot_that_plain_mujoco_steps_withou
     assert all(data.warning[i].number == 0 for i in range(len(data.warning)))
 
 
-def test_check_locks_finds_every_transition_of_a_paper_box_agrees(tmp_path, paper_box):
+def test_check_locks_finds_every_transition_of_a_paper_box_agrees_wherever_its_parts_stand_in_their_bands(
+    tmp_path, paper_box
+):
     result = generate("check-locks", paper_box, "--json", tmp_path / "check.json")
     assert result.returncode == 0, result.stderr
-    assert "paper-test-0: 30/30 transitions agree" in result.stdout and "0 rule(s) without a mechanism" in result.stdout
-    assert result.stdout.strip().splitlines()[-1].startswith("total (1 box(es)): 30/30")
+    # the band check: each of the 30 pushes with the others at their stops, 10 % and 20 % inside their bands
+    assert "paper-test-0: 90/90 transitions agree" in result.stdout and "0 rule(s) without a mechanism" in result.stdout
+    assert result.stdout.strip().splitlines()[-1].startswith("total (1 box(es)): 90/90")
     record = json.loads((tmp_path / "check.json").read_text())
     (box,) = record["boxes"]
-    assert (box["agreeing"], box["total"], box["disagreements"], box["unrealized"]) == (30, 30, [], [])
+    assert (box["agreeing"], box["total"], box["disagreements"], box["unrealized"]) == (90, 90, [], [])
+    assert record["offsets"] == [0.0, 0.1, 0.2]
     assert box["held_move_max"] < 0.5
+
+
+def test_check_locks_at_the_stops_only_makes_each_push_once(paper_box):
+    result = generate("check-locks", paper_box, "--stops-only")
+    assert result.returncode == 0, result.stderr
+    assert "paper-test-0: 30/30 transitions agree" in result.stdout
 
 
 def test_check_locks_without_mechanisms_finds_held_parts_moving_and_exits_1(paper_box):
     result = generate("check-locks", paper_box, "--locks", "latch")
     assert result.returncode == 1, result.stderr
-    assert "paper-test-0: 10/30 transitions agree" in result.stdout, result.stdout
-    assert "  open [none]: slide-1 should be held, moved" in result.stdout  # nothing holds the slide under a door
+    assert "paper-test-0: 30/90 transitions agree" in result.stdout, result.stdout
+    # nothing holds the slide under a door, wherever the door stands in its band
+    assert "  open [none], the others at their stops: slide-1 should be held, moved" in result.stdout
+    assert "  open [none], the others 20 % inside their bands: slide-1 should be held, moved" in result.stdout
 
 
 def test_check_locks_names_an_invalid_spec_in_one_line_and_exits_2(tmp_path, paper_box):

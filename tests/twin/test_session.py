@@ -39,13 +39,12 @@ def clear_pushes(session: TwinSession) -> None:
     session.data.xfrc_applied[:] = 0.0
 
 
-# a lock mechanism has play: a held part moves until its pin meets the other's (within 5 % of its travel), then
-# stays put, however hard it is pushed
+# a held part moves until its rod meets its locker's wall — past its closed band (the twin's 25 %: anywhere in it the
+# part must leave its locker free) and short of half its travel — and then stays put, however hard it is pushed
 @pytest.mark.parametrize(
-    ("name", "tolerance"),
-    [("door-1", 0.05 * np.radians(85)), ("slide-2", 0.05 * 0.05), ("wheel-3", 0.05 * np.radians(85))],
+    ("name", "travel"), [("door-1", np.radians(85)), ("slide-2", 0.05), ("wheel-3", np.radians(85))]
 )
-def test_latched_joint_stays_put_under_a_20_newton_push(chain_session, name, tolerance):
+def test_latched_joint_stays_put_under_a_20_newton_push(chain_session, name, travel):
     session = chain_session
     session.reset()
     j = session.spec.index_of(name)
@@ -53,8 +52,11 @@ def test_latched_joint_stays_put_under_a_20_newton_push(chain_session, name, tol
     before = session.component_positions()[j]
     handle_push(session, name, PUSH_N)
     session.advance(0.5)
+    met = session.component_positions()[j]
+    session.advance(0.5)
     clear_pushes(session)
-    assert abs(session.component_positions()[j] - before) < tolerance
+    assert abs(met - before) < 0.5 * travel  # the state stays closed: held part-way
+    assert abs(session.component_positions()[j] - met) < 0.01 * travel  # and no further
 
 
 def test_released_joint_moves_freely_once_its_locker_opens(chain_session):
@@ -224,18 +226,21 @@ def test_robot_interface_offers_the_robot_protocol_alone_and_hands_out_copies():
 def test_a_rule_no_mechanism_serves_is_named_in_a_warning_and_held_by_a_latch():
     from puzzlebox.models.generator import BoxConfig, RandomGraphConfig, generate_random
     from puzzlebox.models.kinds import family_named
+    from puzzlebox.models.lock_mechanisms import design_mechanisms
     from puzzlebox.twin.latches import UnrealizedLockWarning
 
     # a lever whose pivot stands 33 mm above the lid cannot latch a slide that moves along its length one way:
     # the generator, told not to redraw, keeps that box; the twin runs it with a latch for exactly that rule
     spec = generate_random(RandomGraphConfig(6, family=family_named("all")), seed=2, box=BoxConfig(realizable=False))
+    unrealized = [(u.rule.locker, u.rule.locked) for u in design_mechanisms(spec).unrealized]
     with pytest.warns(UnrealizedLockWarning, match=r"lever-0 in 0 keeps slide-2 in 0") as caught:
         session = TwinSession(spec, seed=0)
     with session:
         assert len(caught) == 1
         table = session.latches.table
         pairs = zip(table.locker, table.locked, strict=True)
-        assert [(spec.components[i].name, spec.components[j].name) for i, j in pairs] == [("lever-0", "slide-2")]
+        latched = [(spec.components[i].name, spec.components[j].name) for i, j in pairs]
+        assert ("lever-0", "slide-2") in latched and all(lock in unrealized for lock in latched)
         slide = spec.index_of("slide-2")
         assert session.held_by_rules()[slide] and session.latches.engaged[slide]
         handle_push(session, "slide-2", PUSH_N)

