@@ -4,7 +4,6 @@ a failed try the agent weighs (it tries something else first), not the end of th
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from puzzlebox.learning import DualAgent, SymbolicWorld, run_episode
 from puzzlebox.learning.trial import MAX_FAILURES_IN_A_ROW
