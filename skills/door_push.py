@@ -24,6 +24,7 @@ from puzzlebox.models.kinds import HANDLE_HEIGHT, HANDLE_MARGIN, HANDLE_SIZE
 from puzzlebox.skills.errors import IKFailure
 from puzzlebox.skills.joint_model import GRASP_DEPTH, JointModel, cross
 from puzzlebox.skills.kinematics import ArmKinematics, top_down
+from puzzlebox.skills.pacing import Pacing
 from puzzlebox.skills.toggle_result import ToggleResult
 
 if TYPE_CHECKING:
@@ -482,8 +483,8 @@ class DoorPushing:
         ticks = round(c.actuate_time * self.slowdown / c.tick)
         pace = (end - start) / ticks  # of the travel per tick, past the slow start
         slow_span = max(0.0, c.breakaway_fraction - start)  # the start of the travel, driven slowly as a pinch's
-        slow = slow_span / (pace * c.breakaway_pace)  # ticks of the slow start
-        last_tick = math.ceil(slow + (end - start - slow_span) / pace - 1e-9)
+        pacing = Pacing(pace, pace * c.breakaway_pace, slow_span)  # slow start, then a ramp up
+        last_tick = pacing.ticks_to(end - start)
         forces: list[float] = []
         progress = 0.0
         pressed_at: tuple[float, float] | None = None  # (progress, face angle) when the pad first pressed
@@ -491,7 +492,7 @@ class DoorPushing:
         self.ik.set_joints(self.robot.joint_positions())
         turn_at_start = door.turn_of(self._pad_edge(door, p.pad_offset))
         for k in range(1, last_tick + 1 + round(2 * c.settle_time / c.tick)):
-            paced = pace * c.breakaway_pace * k if k <= slow else slow_span + pace * (k - slow)
+            paced = pacing.at(k)
             s = min(start + paced, end, max(progress, start) + lead)
             closing_in = max(0.0, 1.0 - k * c.tick / (p.approach_time * self.slowdown)) * (p.gap + p.depth)
             self._tick(tcp_for(door.point_at(s * door.travel, pressed(k) + np.array([closing_in, 0.0]))))
