@@ -161,6 +161,9 @@ LUG_HEIGHT = 0.004
 """Height of the lug above its underside (e3) [m]."""
 LATCH_GAP = 0.001
 """Gap between the lug and the tooth's flat face with A at a and B at b [m]."""
+LUG_DIP = 0.0003
+"""Lowest a lug may stand below its underside's place at b (along -e3) anywhere in B's band [m]: a locker coming back
+over it presses the pawl down by the tooth's rise plus the pawl's 0.5 mm of play at the most."""
 TOOTH_SPACING = 0.003
 """Largest distance between neighbouring teeth of a latch's row along A's path [m] (a tooth is 4 mm wide)."""
 LATCH_CLEARANCE = 0.0007
@@ -200,22 +203,20 @@ class OneWayLatch:
 
     def tooth_vertices(self, a: JointMotion) -> list[np.ndarray]:
         """Each tooth of the row as ``(k, 3)`` vertices in the (e1, e2, e3) frame at X with A at a [m], given A's
-        motion ``a``: the profile extruded ±:data:`TOOTH_HALF_WIDTH` along e2 and carried back along A's path; the
-        last ends, toward a, in a ramp at 45 degrees down to its underside, so that A coming back to a over a
-        lug left inside its band presses the pawl down and passes, as the lug coming back does over the bevel."""
+        motion ``a``: the profile extruded ±:data:`TOOTH_HALF_WIDTH` along e2 and carried back along A's path; each
+        ends, toward a, in a ramp at 45 degrees down to its underside, so that A coming back to a over a lug left
+        inside its band presses the pawl down and passes, as the lug coming back does over the bevel."""
         direction = 1.0 if self.locker_state == 0 else -1.0
         w = TOOTH_HALF_WIDTH
         profile = self.tooth_profile()
         teeth = []
-        for k, shift in enumerate(self.tooth_shifts):
+        for shift in self.tooth_shifts:
+            # each tooth ends toward a in the ramp, from the top down to the tooth's underside (the row bends with A's
+            # arc, so a lug in its band may meet any tooth's end); every vertex a corner of the hull: the profile's
+            # underside at -w would lie on the hull's edges, which a convex hull's triangulation turns into slivers
             local = [(u, w, v) for u, v in profile]
-            if k < len(self.tooth_shifts) - 1:
-                local += [(u, -w, v) for u, v in profile]
-            else:  # the ramp, from the top down to the tooth's underside (every vertex a corner of the hull: the
-                # profile's underside at -w would lie on the hull's edges, which a convex hull's triangulation
-                # turns into slivers)
-                local += [(u, -w, v) for u, v in profile if v > -TOOTH_DEPTH]
-                local += [(u, -w - TOOTH_RISE - TOOTH_DEPTH, -TOOTH_DEPTH) for u in (0.0, TOOTH_LENGTH)]
+            local += [(u, -w, v) for u, v in profile if v > -TOOTH_DEPTH]
+            local += [(u, -w - TOOTH_RISE - TOOTH_DEPTH, -TOOTH_DEPTH) for u in (0.0, TOOTH_LENGTH)]
             world = self.crossing + np.asarray(local) @ self.frame.T
             carried = a.move(world, -direction * a.travel * shift)
             teeth.append((carried - self.crossing) @ self.frame)
@@ -398,6 +399,14 @@ def _latch_clear(x, frame, a, b, dir_a, dir_b, lo, hi, shifts=(0.0,)) -> str | N
                 return True
         return False
 
+    # B anywhere in its band: its lug, met by a locker coming back to a, presses the pawl down on the last tooth's
+    # ramp only if it stands no lower than the pawl can retract past the tooth's rise (a lug carried down by B's arc
+    # stops the locker instead)
+    in_band = ts[ts <= IN_STATE]
+    corners = x + (lug_centre + lug_half * np.array(np.meshgrid(*[[-1, 1]] * 3)).reshape(3, -1).T) @ frame.T
+    lowest = min(float(((b.move(corners, dir_b * b.travel * t) - x) @ frame[:, 2]).min()) for t in in_band)
+    if lowest < -LUG_DIP:
+        return "the lug dips under the teeth inside its band"
     leaving = np.arange(1, n)
     if overlap(leaving, np.zeros_like(leaving)):
         return "the tooth meets the lug as the locker leaves"
@@ -500,8 +509,9 @@ def _fractions(paths: _Paths) -> tuple[float, float] | None:
     """``(theta, delta)``: the largest theta and smallest delta on the :data:`STEP` grid for which the free edges
     of the configuration square are clear (module docstring), or None. The bands decide the range: delta past
     :data:`IN_STATE` (a locked part anywhere in its state's band does not meet the wall) and at most
-    :data:`MAX_BLOCKING`; theta short of :data:`FREE_FROM` (a locker past its open threshold has let go) and at
-    least :data:`HOLD_MARGIN` past :data:`IN_STATE` (a locker anywhere in its state's band holds).
+    :data:`MAX_BLOCKING`; theta short of :data:`FREE_FROM` (a locker past its open threshold has let go), at least
+    :data:`HOLD_MARGIN` past :data:`IN_STATE` (a locker anywhere in its state's band holds) and at least
+    ``1 - MAX_BLOCKING`` (a part held open by the rod moves back less than that).
 
     Free edges, with t the displacement (fraction of travel) that carries X through a part: B within IN_STATE of b
     and A anywhere (wall ``t`` in [-theta, 1], rod in [-1, IN_STATE - delta]) and A past :data:`FREE_FROM` and B
@@ -510,7 +520,9 @@ def _fractions(paths: _Paths) -> tuple[float, float] | None:
     ts, d = paths.ts, paths.distance
     i_m1, i_p1 = _index(ts, -1.0), _index(ts, 1.0)
     deltas = np.arange(IN_STATE + STEP, MAX_BLOCKING + 1e-9, STEP)
-    thetas = np.arange(FREE_FROM - STEP, IN_STATE + HOLD_MARGIN - 1e-9, -STEP)
+    # theta at least HOLD_MARGIN past IN_STATE (a locker in its band holds) and 1 - MAX_BLOCKING (a part held open
+    # by the rod moves back less than MAX_BLOCKING)
+    thetas = np.arange(FREE_FROM - STEP, max(IN_STATE + HOLD_MARGIN, 1.0 - MAX_BLOCKING) - 1e-9, -STEP)
     for delta in deltas:
         # per wall sample, its nearest rod sample: B in b's band (rod [-1, IN_STATE - delta]) and B anywhere
         # (rod [-1, 1 - delta])
