@@ -35,6 +35,7 @@ the lid centre on its top face, x along the length, z up) [m].
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -164,6 +165,10 @@ LATCH_GAP = 0.001
 LUG_DIP = 0.0003
 """Lowest a lug may stand below its underside's place at b (along -e3) anywhere in B's band [m]: a locker coming back
 over it presses the pawl down by the tooth's rise plus the pawl's 0.5 mm of play at the most."""
+LATCH_GAPS = (LATCH_GAP, 2 * LATCH_GAP, 3 * LATCH_GAP)
+"""The lug's distances from the tooth's face a latch's design tries, in order [m]: a row of teeth along an arc that
+bends toward the lug (a door's, under its hinge line) passes it closer than a straight row, and a lug a little
+further off lets it pass; the locked part then moves up to that far before the tooth holds it."""
 TOOTH_SPACING = 0.003
 """Largest distance between neighbouring teeth of a latch's row along A's path [m] (a tooth is 4 mm wide)."""
 LATCH_CLEARANCE = 0.0007
@@ -188,6 +193,8 @@ class OneWayLatch:
             each of these displacements back toward a [fraction of A's travel] (0: the tooth at X): a locker
             anywhere in its state's band (up to :data:`IN_STATE` plus :data:`HOLD_MARGIN` of its travel from a)
             still stands a tooth in the lug's path.
+        gap: the lug's distance from the tooth's face with A at a and B at b [m]: :data:`LATCH_GAP`, or a multiple
+            of it where A's path bends toward the lug along the row (:data:`LATCH_GAPS`).
     """
 
     name: str
@@ -200,6 +207,7 @@ class OneWayLatch:
     frame: np.ndarray = field(repr=False, compare=False)
     crossing_cosine: float
     tooth_shifts: tuple[float, ...] = (0.0,)
+    gap: float = LATCH_GAP
 
     def tooth_vertices(self, a: JointMotion) -> list[np.ndarray]:
         """Each tooth of the row as ``(k, 3)`` vertices in the (e1, e2, e3) frame at X with A at a [m], given A's
@@ -208,15 +216,18 @@ class OneWayLatch:
         inside its band presses the pawl down and passes, as the lug coming back does over the bevel."""
         direction = 1.0 if self.locker_state == 0 else -1.0
         w = TOOTH_HALF_WIDTH
+        # the side of the tooth that meets a lug as A comes back to a: -e2, or +e2 in a mirrored frame (e2 and e3
+        # turned over, for a lug whose arc would otherwise dip under the teeth: see _design_latch)
+        back = -1.0 if float(direction * a.velocity(self.crossing) @ self.frame[:, 1]) > 0 else 1.0
         profile = self.tooth_profile()
         teeth = []
         for shift in self.tooth_shifts:
             # each tooth ends toward a in the ramp, from the top down to the tooth's underside (the row bends with A's
             # arc, so a lug in its band may meet any tooth's end); every vertex a corner of the hull: the profile's
             # underside at -w would lie on the hull's edges, which a convex hull's triangulation turns into slivers
-            local = [(u, w, v) for u, v in profile]
-            local += [(u, -w, v) for u, v in profile if v > -TOOTH_DEPTH]
-            local += [(u, -w - TOOTH_RISE - TOOTH_DEPTH, -TOOTH_DEPTH) for u in (0.0, TOOTH_LENGTH)]
+            local = [(u, -back * w, v) for u, v in profile]
+            local += [(u, back * w, v) for u, v in profile if v > -TOOTH_DEPTH]
+            local += [(u, back * (w + TOOTH_RISE + TOOTH_DEPTH), -TOOTH_DEPTH) for u in (0.0, TOOTH_LENGTH)]
             world = self.crossing + np.asarray(local) @ self.frame.T
             carried = a.move(world, -direction * a.travel * shift)
             teeth.append((carried - self.crossing) @ self.frame)
@@ -230,7 +241,7 @@ class OneWayLatch:
 
     def lug_box(self) -> tuple[np.ndarray, np.ndarray]:
         """The lug with B at b: centre in the (e1, e2, e3) frame at X and half sizes [m]."""
-        centre = np.array([-LATCH_GAP - LUG_LENGTH / 2, 0.0, LUG_HEIGHT / 2])
+        centre = np.array([-self.gap - LUG_LENGTH / 2, 0.0, LUG_HEIGHT / 2])
         return centre, np.array([LUG_LENGTH / 2, LUG_HALF_WIDTH, LUG_HEIGHT / 2])
 
 
@@ -329,8 +340,13 @@ def _design_latch(spec, rule: LockRule, a: JointMotion, b: JointMotion, by_name)
     # prefer long paths (a small blocking fraction for B, a tooth that leaves fast), then nearness, then hidden
     score = LATCH_GAP / nb + 0.01 / na + _distance_cost(grid, by_name, rule) + np.where(top > 0, 0.5 + 200 * top, 0)
     order = np.argsort(np.where(keep, score, np.inf))[: int(keep.sum())]
+    # then the most nearly square crossings: a row of teeth passes within LATCH_GAP of the lug only where A's path
+    # runs across B's (a cosine of 0.15 carries a tooth 0.7 mm toward the lug over the lug's width)
+    squarest = np.argsort(np.where(keep, np.abs(cosine) + 1e-3 * score, np.inf), kind="stable")[: int(keep.sum())]
+    tried = order[: MAX_TRIED * 5]
+    again = squarest[~np.isin(squarest, tried)][: MAX_TRIED * 5]
     reasons: dict[str, int] = {}
-    for k in order[: MAX_TRIED * 5]:
+    for gap, k in itertools.product(LATCH_GAPS, np.concatenate([tried, again])):
         x0 = grid[k]  # with every part closed; move it to the design state (A at a, B at b): X is fixed in space,
         # and the grid is a grid of space points, so X = x0 whatever the parts' states
         e1 = vb[k] / nb[k]
@@ -338,7 +354,11 @@ def _design_latch(spec, rule: LockRule, a: JointMotion, b: JointMotion, by_name)
         e2 /= np.linalg.norm(e2)
         frame = np.column_stack([e1, e2, np.cross(e1, e2)])
         shifts = _tooth_shifts(a, x0)
-        why = _latch_clear(x0, frame, a, b, dir_a, dir_b, lo, hi, shifts)
+        why = _latch_clear(x0, frame, a, b, dir_a, dir_b, lo, hi, shifts, gap)
+        if why == LUG_DIPS:  # B's arc carries the lug down the pawl's way: the pawl turned over retracts upward
+            mirrored = frame * np.array([1.0, -1.0, -1.0])  # (e1, -e2, -e3): right-handed still
+            why = _latch_clear(x0, mirrored, a, b, dir_a, dir_b, lo, hi, shifts, gap)
+            frame = mirrored if why is None else frame
         if why is not None:
             reasons[why] = reasons.get(why, 0) + 1
             continue
@@ -353,6 +373,7 @@ def _design_latch(spec, rule: LockRule, a: JointMotion, b: JointMotion, by_name)
             frame=frame,
             crossing_cosine=float(cosine[k]),
             tooth_shifts=tuple(shifts),
+            gap=gap,
         )
     common = max(reasons, key=reasons.__getitem__) if reasons else "no candidate"
     return f"no point serves a one-way latch (mostly: {common})"
@@ -366,47 +387,52 @@ def _tooth_shifts(a: JointMotion, x: np.ndarray) -> np.ndarray:
     return np.linspace(0.0, reach, max(1, int(np.ceil(length / TOOTH_SPACING))) + 1)
 
 
-def _latch_clear(x, frame, a, b, dir_a, dir_b, lo, hi, shifts=(0.0,)) -> str | None:
-    """Why a one-way latch at ``x`` with ``frame`` and its row of teeth at ``shifts`` (:func:`_tooth_shifts`) would
-    meet itself on a free move or leave the box, or None.
+LUG_DIPS = "the lug dips under the teeth inside its band"
+"""Why a latch's frame is refused when B's arc carries the lug down under the teeth (:func:`_latch_clear`)."""
+
+
+def _latch_clear(x, frame, a, b, dir_a, dir_b, lo, hi, shifts=(0.0,), gap=LATCH_GAP) -> str | None:
+    """Why a one-way latch at ``x`` with ``frame``, its row of teeth at ``shifts`` (:func:`_tooth_shifts`) and its lug
+    ``gap`` from the tooth's face would meet itself on a free move or leave the box, or None.
 
     The lug and each tooth are boxes in the (e1, e2, e3) frame, each carried rigidly by its part's motion; a
     rotation of a part is allowed for by widening its box by the turn times its largest half size."""
     tooth_centre = np.array([TOOTH_LENGTH / 2, 0.0, (TOOTH_RISE - TOOTH_DEPTH) / 2])
     tooth_half = np.array([TOOTH_LENGTH / 2, TOOTH_HALF_WIDTH, (TOOTH_RISE + TOOTH_DEPTH) / 2])
-    lug_centre = np.array([-LATCH_GAP - LUG_LENGTH / 2, 0.0, LUG_HEIGHT / 2])
+    lug_centre = np.array([-gap - LUG_LENGTH / 2, 0.0, LUG_HEIGHT / 2])
     lug_half = np.array([LUG_LENGTH / 2, LUG_HALF_WIDTH, LUG_HEIGHT / 2])
     ts = np.linspace(0.0, 1.0, 51)
     n = len(ts)
-    tooth_paths = [
-        a.move(a.move(x + frame @ tooth_centre, -dir_a * a.travel * shift), dir_a * a.travel * ts) for shift in shifts
-    ]  # each tooth as A goes from a to 1-a
+    # B anywhere in its band: its lug, met by a locker coming back to a, presses the pawl down on the last tooth's
+    # ramp only if it stands no lower than the pawl can retract past the tooth's rise (a lug carried down by B's arc
+    # stops the locker instead); first, as it needs B's motion alone
+    in_band = ts[ts <= IN_STATE]
+    corners = x + (lug_centre + lug_half * np.array(np.meshgrid(*[[-1, 1]] * 3)).reshape(3, -1).T) @ frame.T
+    lowest = float(((b.move(corners[:, None], dir_b * b.travel * in_band) - x) @ frame[:, 2]).min())
+    if lowest < -LUG_DIP:
+        return LUG_DIPS
+    shifts = np.asarray(shifts, dtype=float)
+    # each tooth as A goes from a to 1-a, carried back by its shift first: (teeth, n, 3)
+    starts = a.move(x + frame @ tooth_centre, -dir_a * a.travel * shifts)
+    tooth_paths = a.move(starts[:, None], dir_a * a.travel * ts)
     lug_path = b.move(x + frame @ lug_centre, dir_b * b.travel * ts)  # B from b to 1-b
     hinge_a = 1.0 if a.joint == "hinge" else 0.0
     # each tooth's turn away from the design frame: it was carried back by its shift, so it stands as designed at X
-    turns_a = [hinge_a * np.abs(ts - shift) * a.travel for shift in shifts]
+    turns_a = hinge_a * np.abs(ts[None] - shifts[:, None]) * a.travel
     turn_b = ts * b.travel if b.joint == "hinge" else 0 * ts
-    every = np.vstack([*tooth_paths, lug_path])
+    reach_sum = tooth_half + lug_half + LATCH_CLEARANCE
     reach = max(np.linalg.norm(tooth_half), np.linalg.norm(lug_half))
-    if np.any(every < lo + reach) or np.any(every > hi - reach):
+    if (
+        np.any(tooth_paths < lo + reach) or np.any(tooth_paths > hi - reach)
+        or np.any(lug_path < lo + reach) or np.any(lug_path > hi - reach)
+    ):  # fmt: skip
         return "it leaves the box"
 
     def overlap(tooth_i: np.ndarray, lug_i: np.ndarray) -> bool:  # whether any pair (tooth_i[k], lug_i[k]) overlaps
-        for path, turn_a in zip(tooth_paths, turns_a, strict=True):  # each carried rigidly: its turn widens it
-            d = (lug_path[lug_i] - path[tooth_i]) @ frame
-            grow = turn_a[tooth_i] * tooth_half.max() + turn_b[lug_i] * lug_half.max()
-            if np.any(np.all(np.abs(d) < tooth_half + lug_half + grow[:, None] + LATCH_CLEARANCE, axis=1)):
-                return True
-        return False
+        d = (lug_path[lug_i][None] - tooth_paths[:, tooth_i]) @ frame  # every tooth, each carried rigidly
+        grow = turns_a[:, tooth_i] * tooth_half.max() + (turn_b[lug_i] * lug_half.max())[None]  # its turn widens it
+        return bool(np.any(np.all(np.abs(d) < reach_sum + grow[..., None], axis=-1)))
 
-    # B anywhere in its band: its lug, met by a locker coming back to a, presses the pawl down on the last tooth's
-    # ramp only if it stands no lower than the pawl can retract past the tooth's rise (a lug carried down by B's arc
-    # stops the locker instead)
-    in_band = ts[ts <= IN_STATE]
-    corners = x + (lug_centre + lug_half * np.array(np.meshgrid(*[[-1, 1]] * 3)).reshape(3, -1).T) @ frame.T
-    lowest = min(float(((b.move(corners, dir_b * b.travel * t) - x) @ frame[:, 2]).min()) for t in in_band)
-    if lowest < -LUG_DIP:
-        return "the lug dips under the teeth inside its band"
     leaving = np.arange(1, n)
     if overlap(leaving, np.zeros_like(leaving)):
         return "the tooth meets the lug as the locker leaves"

@@ -301,12 +301,14 @@ def _mechanism_pieces(
     """A mechanism group's geoms as MuJoCo collides with them, in the export frame (``T``: world -> export):
     capsules joined end to end (a chain, in index order; a lone capsule is a chain of one) are one tube
     (:func:`_tubes`; the k-th chain of the group moved by ``k (attempt + 1)`` :data:`_JITTER`), a mesh geom is
-    its convex hull, any other geom its :func:`geom_mesh`."""
+    its convex hull (the k-th moved by ``(k + 1) attempt`` :data:`_JITTER` after the first attempt), any other geom
+    its :func:`geom_mesh`."""
     pieces: list[tuple[trimesh.Trimesh, tuple]] = []
     chain: list[np.ndarray] = []
     radius, rgba = 0.0, _GREY
 
     made = 0  # chains made so far
+    meshes = 0  # mesh geoms so far
 
     def flush() -> None:
         nonlocal made
@@ -344,7 +346,13 @@ def _mechanism_pieces(
             flush()
         if kind == mujoco.mjtGeom.mjGEOM_MESH:
             vertices = geom_mesh(model, g).apply_transform(pose).vertices
-            pieces.append((trimesh.convex.convex_hull(vertices), tuple(model.geom_rgba[g])))
+            hull = trimesh.convex.convex_hull(vertices)
+            if attempt:  # a row of teeth turned a little from one to the next: faces near-coplanar, as rings are
+                hull.apply_translation(
+                    _JITTER * attempt * (meshes + 1) * _SKEWS[attempt] / np.linalg.norm(_SKEWS[attempt])
+                )
+            meshes += 1
+            pieces.append((hull, tuple(model.geom_rgba[g])))
         else:
             pieces.append(_posed(model, data, g, T))
     if chain:
