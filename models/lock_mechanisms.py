@@ -403,8 +403,8 @@ def _latch_clear(x, frame, a, b, dir_a, dir_b, lo, hi, shifts=(0.0,), gap=LATCH_
     lug_half = np.array([LUG_LENGTH / 2, LUG_HALF_WIDTH, LUG_HEIGHT / 2])
     ts = np.linspace(0.0, 1.0, 51)
     n = len(ts)
-    # B anywhere in its band: its lug, met by a locker coming back to a, presses the pawl down on the last tooth's
-    # ramp only if it stands no lower than the pawl can retract past the tooth's rise (a lug carried down by B's arc
+    # B anywhere in its band: its lug, met by a locker coming back to a, presses the pawl down on a tooth's ramp
+    # only if it stands no lower than the pawl can retract past the tooth's rise (a lug carried down by B's arc
     # stops the locker instead); first, as it needs B's motion alone
     in_band = ts[ts <= IN_STATE]
     corners = x + (lug_centre + lug_half * np.array(np.meshgrid(*[[-1, 1]] * 3)).reshape(3, -1).T) @ frame.T
