@@ -146,6 +146,11 @@ class Interlock:
     radius: float = TUBE_RADIUS
 
 
+TOOTH_UNDERCUT = 0.27
+"""Slope of the tooth's face [run over rise]: it leans over the lug by 15 degrees, top first, as a ratchet pawl's
+face is undercut, so that a lug pressing it draws the pawl onto its stop rather than down its slide (a square face
+met by a lug turned a few degrees with its part, or by a tooth's edge, was pressed down: wheel > drawer latches
+let the drawer through with the wheel 20 % inside its band)."""
 TOOTH_LENGTH = 0.004
 """Length of a one-way latch's tooth along B's motion (e1) [m]."""
 TOOTH_HALF_WIDTH = 0.002
@@ -227,22 +232,30 @@ class OneWayLatch:
             # underside at -w would lie on the hull's edges, which a convex hull's triangulation turns into slivers
             local = [(u, -back * w, v) for u, v in profile]
             local += [(u, back * w, v) for u, v in profile if v > -TOOTH_DEPTH]
-            local += [(u, back * (w + TOOTH_RISE + TOOTH_DEPTH), -TOOTH_DEPTH) for u in (0.0, TOOTH_LENGTH)]
+            local += [(u, back * (w + TOOTH_RISE + TOOTH_DEPTH), -TOOTH_DEPTH) for u in (profile[0, 0], TOOTH_LENGTH)]
             world = self.crossing + np.asarray(local) @ self.frame.T
             carried = a.move(world, -direction * a.travel * shift)
             teeth.append((carried - self.crossing) @ self.frame)
         return teeth
 
     def tooth_profile(self) -> np.ndarray:
-        """``(5, 2)`` the tooth's outline in the (e1, e3) plane [m], counter-clockwise: flat face at e1 = 0 toward
-        the lug, bevel at 45 degrees down to the far end, extruded ±:data:`TOOTH_HALF_WIDTH` along e2."""
+        """``(5, 2)`` the tooth's outline in the (e1, e3) plane [m], counter-clockwise: the face toward the lug, its
+        top at e1 = 0 and undercut (:data:`TOOTH_UNDERCUT`) below, bevel at 45 degrees down to the far end, extruded
+        ±:data:`TOOTH_HALF_WIDTH` along e2."""
         lt, rise, depth = TOOTH_LENGTH, TOOTH_RISE, TOOTH_DEPTH
-        return np.array([(0.0, -depth), (lt, -depth), (lt, 0.0), (lt - rise, rise), (0.0, rise)])
+        foot = TOOTH_UNDERCUT * (rise + depth)
+        return np.array([(foot, -depth), (lt, -depth), (lt, 0.0), (lt - rise, rise), (0.0, rise)])
 
-    def lug_box(self) -> tuple[np.ndarray, np.ndarray]:
-        """The lug with B at b: centre in the (e1, e2, e3) frame at X and half sizes [m]."""
-        centre = np.array([-self.gap - LUG_LENGTH / 2, 0.0, LUG_HEIGHT / 2])
-        return centre, np.array([LUG_LENGTH / 2, LUG_HALF_WIDTH, LUG_HEIGHT / 2])
+    def lug_vertices(self) -> np.ndarray:
+        """``(8, 3)`` the lug's corners with B at b in the (e1, e2, e3) frame at X [m]: a block :data:`LUG_LENGTH`
+        long, ±:data:`LUG_HALF_WIDTH` wide, :data:`LUG_HEIGHT` high from its underside at e3 = 0, its face toward the
+        tooth parallel to the tooth's undercut face and ``gap`` from it (faces meet flat, and the lug's push draws
+        the pawl onto its stop)."""
+        corners = []
+        for e3 in (0.0, LUG_HEIGHT):
+            front = -self.gap + TOOTH_UNDERCUT * (TOOTH_RISE - e3)
+            corners += [(e1, e2, e3) for e1 in (front, front - LUG_LENGTH) for e2 in (-LUG_HALF_WIDTH, LUG_HALF_WIDTH)]
+        return np.array(corners)
 
 
 @dataclass(frozen=True)
@@ -396,7 +409,9 @@ def _latch_clear(x, frame, a, b, dir_a, dir_b, lo, hi, shifts=(0.0,), gap=LATCH_
     ``gap`` from the tooth's face would meet itself on a free move or leave the box, or None.
 
     The lug and each tooth are boxes in the (e1, e2, e3) frame, each carried rigidly by its part's motion; a
-    rotation of a part is allowed for by widening its box by the turn times its largest half size."""
+    rotation of a part is allowed for by widening its box by the turn times its largest half size. The tooth's face
+    and the lug's are undercut alike (:data:`TOOTH_UNDERCUT`): sheared along e1 by the same amount at each height,
+    they stand as far apart along e1, layer by layer, as the two boxes do."""
     tooth_centre = np.array([TOOTH_LENGTH / 2, 0.0, (TOOTH_RISE - TOOTH_DEPTH) / 2])
     tooth_half = np.array([TOOTH_LENGTH / 2, TOOTH_HALF_WIDTH, (TOOTH_RISE + TOOTH_DEPTH) / 2])
     lug_centre = np.array([-gap - LUG_LENGTH / 2, 0.0, LUG_HEIGHT / 2])

@@ -1,8 +1,8 @@
 """The lock mechanisms of a spec (:mod:`models.lock_mechanisms`) as MJCF geoms on the components' moving bodies.
 
 Each one-way latch is a sprung pawl body ``<A>:latch:<B>:pawl`` (slide joint ``...:spring`` along its e3, a row of
-convex mesh teeth ``...:tooth:<k>`` along the locker's path) on the locker's moving body and a box lug
-``<A>:latch:<B>:lug`` on the locked part's.
+convex mesh teeth ``...:tooth:<k>`` along the locker's path) on the locker's moving body and a convex mesh
+lug ``<A>:latch:<B>:lug`` on the locked part's.
 Each interlock's wall is a chain of capsules in the locker's moving body, its rod a chain in the locked part's,
 named ``<A>:interlock:<B>:wall:<k>`` and ``<A>:interlock:<B>:rod:<k>`` (MJCF component names). They collide
 with each other only: both have the contact bit of their interlock alone (``contype = conaffinity = 2**k``,
@@ -158,13 +158,11 @@ def _add_latch(root, latch: OneWayLatch, bodies, prefixes, by_name, bit: int) ->
         mesh = root.asset.add("mesh", name=f"{base}:tooth:{k}", vertex=np.asarray(vertices).ravel().tolist())
         pawl.add("geom", name=f"{base}:tooth:{k}", type="mesh", mesh=mesh, density=STEEL_DENSITY, **contact)
     # the lug, on the locked part
-    centre, half = latch.lug_box()
-    rotation_b = np.column_stack([b.direction_to_body(latch.frame[:, i], q_b) for i in range(3)])
-    lug_world = latch.crossing + latch.frame @ centre
+    lug_world = latch.crossing + latch.lug_vertices() @ latch.frame.T
+    mesh = root.asset.add("mesh", name=f"{base}:lug", vertex=b.to_body(lug_world, q_b).ravel().tolist())
     _carried(bodies[latch.locked], f"{base}:lug").add(
-        "geom", name=f"{base}:lug", type="box", size=half.tolist(), pos=b.to_body(lug_world[None], q_b)[0].tolist(),
-        quat=_quat(rotation_b), density=PART_DENSITY, **contact,
-    )  # fmt: skip
+        "geom", name=f"{base}:lug", type="mesh", mesh=mesh, density=PART_DENSITY, **contact
+    )
 
 
 def _add_chain(body: mjcf.Element, name: str, chains: list[np.ndarray], interlock: Interlock, bit: int) -> None:
