@@ -26,9 +26,10 @@ latched attempt within 0.13-1.2 s; without a stop the grasp is torn off at 100-3
 along its own post (a lever), which the pads hold by friction alone, is held once the opposing force exceeds the
 lighter ``press_force``, at any progress short of ``moved_fraction``. The start of the
 travel, where latches and sticky parts are met, is driven at ``breakaway_pace`` of the rest's pace, and a
-door's path yields across itself to the load there (``comply_gain``): only the load along the motion tells a latch,
-and a path planned from a slightly wrong hinge otherwise drags the handle across its true arc (57 N on a free
-door at one placement, 39 N yielding).
+door's or a wheel's path yields across itself to the load there (``comply_gain``, ``Handling.yields_across``): only
+the load along the motion tells a latch, and a path planned from a slightly wrong hinge otherwise drags the handle
+across its true arc (57 N on a free door at one placement, 39 N yielding). A closed grasp yields across the
+fingers' closing axis too before it pulls (:meth:`Toggler._close_slowly`).
 
 Whatever the motion (approach, descent, actuation, retreat), a filtered force above ``force_limit``
 stops it at once: the gripper opens and the arm withdraws, and the try ends ``failed: force limit``
@@ -622,24 +623,31 @@ class Toggler(DoorPushing):
     def _close_slowly(self) -> np.ndarray:
         """Ramp the gripper command from its pre-grasp closure to fully closed at ``close_speed``, then
         hold for ``close_time`` while the grip builds, the wrist yielding along the closing axis to a load there
-        (``grasp_centre_force``). Returns how far it yielded [m, base frame]: where the handle was found to be
-        beside where it was aimed."""
+        (``grasp_centre_force``) and, once closed, across it (``comply_deadband``). Returns how far it yielded [m,
+        base frame]: where the handle was found to be beside where it was aimed."""
         c = self.config
         ramp = max(1, round((1.0 - c.pregrasp_closure) / c.close_speed * self.slowdown / c.tick))
         hold = self.ik.tcp_pose()
         axis = hold[:3, 1].copy()  # the fingers close along the TCP's y axis (skills.kinematics.top_down)
         shift = 0.0
+        # once closed, the hand also yields across the closing axis, as a door's path does (:meth:`_yield_across`):
+        # a handle gripped a few millimetres from where it was aimed (an uncalibrated camera) loads the stiff arm
+        # across the fingers — 15-18 N on a free wheel, 28 N as it turned about the aimed point, read as held
+        # part-way at 29 % — and the hand settles on the handle before it pulls
+        settled = np.zeros(3)
         for k in range(1, ramp + round(c.close_time / c.tick) + 1):
             if k <= ramp:
                 self.robot.command_gripper(c.pregrasp_closure + (1.0 - c.pregrasp_closure) * k / ramp)
+            else:
+                settled = self._yield_across(settled, axis)
             shift = self._centring(shift, axis)
-            if shift == 0.0:  # (the aimed pose itself, to the bit, while nothing pushes the hand aside)
+            if shift == 0.0 and not settled.any():  # (the aimed pose itself, to the bit, while nothing pushes)
                 self._tick(hold)
             else:
                 shifted = hold.copy()
-                shifted[:3, 3] += shift * axis
+                shifted[:3, 3] += shift * axis + settled
                 self._tick(shifted)
-        return shift * axis
+        return shift * axis + settled
 
     def _centring(self, shift: float, axis: np.ndarray) -> float:
         """The hand's offset ``shift`` [m] along the closing ``axis`` (unit, base frame) moved along the filtered
@@ -893,7 +901,7 @@ class Toggler(DoorPushing):
         progress_at_peak = 0.0
         in_end_stop = False  # felt the door reach its end stop: open, whatever the pads do next
         across = np.zeros(3)  # the path's offset across itself, yielding to the load there [m, base frame]
-        yields = jm.handling.swings_up  # (slides and wheels yielding too were read latched while free)
+        yields = jm.handling.yields_across
         returning = 1.0 - c.tick / c.comply_return_time  # the offset kept per tick past the travel
         window = max(2, round(c.stall_window * slowdown / c.tick))
         press_limit = (

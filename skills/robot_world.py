@@ -365,7 +365,8 @@ class RobotWorld:
         each, after ``first``, its outcome as the kind in use (``empty``: a grasp of it closed on nothing). Gives the
         try's outcome, the last toggle's result with the effort of them all (None if no other kind fits) and the
         kinds tried. A kind that moves the part is kept (:attr:`found_kinds`); one whose grasp held where the kind in
-        use closed on nothing, or that carried the part past ``blocked_progress``, is used from then on."""
+        use closed on nothing, or that carried the part past ``blocked_progress``, is used from then on (the first
+        that carried it, else the first that held)."""
         c = self.config
         in_use = self.joint_models[marker]
         if empty:
@@ -377,6 +378,7 @@ class RobotWorld:
         total: ToggleResult | None = None
         blocked = [first] if first.outcome == "blocked" else []
         adopt: JointModel | None = None
+        adopt_carried = False
         tried: list[str] = []
         # the part itself, as the door in use, may stand open over the other kinds' grasp points
         own_door = self._lowest_open(marker, 0 if opening else 1) if in_use.handling.swings_up else None
@@ -403,13 +405,16 @@ class RobotWorld:
             if outcome.moved:  # (try_toggle keeps it in found_kinds)
                 self.blocked_as.discard(marker)
                 return TryResult("moved", f"moved as a {kind}, not a {in_use.kind}"), total, tuple(tried)
+            carried = result.progress >= self.toggler.config.blocked_progress
             if result.closed_on_nothing:
                 self.empty_handles.setdefault(marker, []).append(jm.grasp_point)
-            elif adopt is None and (
-                (outcome.outcome == "blocked" and empty)
-                or (jm.handling.swings_up and result.progress >= self.toggler.config.blocked_progress)
+            elif (adopt is None or (not adopt_carried and carried)) and (
+                (outcome.outcome == "blocked" and empty) or (jm.handling.swings_up and carried)
             ):
-                adopt = jm  # its handle is there (held, or carried part of the way): this kind from now on
+                # its handle is there (held, or carried part of the way): this kind from now on; one that carried
+                # the handle part of the way before it was held outranks one held at once (a wheel told a slide,
+                # pushed without progress as a door, then held part-way as a wheel: a wheel)
+                adopt, adopt_carried = jm, carried
             if outcome.outcome == "blocked":
                 blocked.append(outcome)
         self.joint_models[marker] = adopt or in_use

@@ -65,6 +65,6 @@ KIND = Kind(
     glyph="#4C72B0",
     sweep_effort=0.3,
     neighbours=("slide",),
-    handling=Handling(grasp="along_axis", verdict="arc", swings_up=True),
+    handling=Handling(grasp="along_axis", verdict="arc", swings_up=True, yields_across=True),
 )
 """The door, as registered (:mod:`models.kinds.registry`)."""

@@ -46,6 +46,11 @@ class Handling:
     """Opens by swinging its plate up out of the lid plane (a door): pushed where a pinch cannot hold it,
     carried past its travel into its end stop, may stand open over its neighbours, and hides its marker when
     open (the skills' door rules: :mod:`skills.door_push`, :mod:`skills.door_clearance`)."""
+    yields_across: bool = False
+    """Whether the hand's path yields across itself to the load there as it moves the part (only the load along
+    the motion tells a latch): a hinge turned about an axis perceived a little off drags its handle across the
+    true arc, which the part resists without moving — a free door 57 N, 39 N yielding; free wheels under an
+    uncalibrated camera 30-46 N, 23 N yielding. Slides and drawers hold their handle on a straight line."""
 
 
 PartBuilder = Callable[["mjcf.Element", str], "mjcf.Element"]

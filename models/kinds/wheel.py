@@ -11,7 +11,7 @@ import math
 from typing import TYPE_CHECKING
 
 from puzzlebox.models.geometry import circle_polygon
-from puzzlebox.models.kinds.kind import JointDynamics, Kind
+from puzzlebox.models.kinds.kind import Handling, JointDynamics, Kind
 from puzzlebox.models.kinds.parts import PART_DENSITY, PLATE_THICKNESS, add_handle, add_joint
 from puzzlebox.models.kinds.template import HANDLE_OFFSET, MARKER_SIZE, KindTemplate
 
@@ -60,5 +60,6 @@ KIND = Kind(
     glyph="#55A868",
     sweep_effort=0.3,
     neighbours=("slide",),
+    handling=Handling(yields_across=True),
 )
 """The wheel, as registered (:mod:`models.kinds.registry`)."""
