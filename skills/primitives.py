@@ -620,25 +620,28 @@ class Toggler(DoorPushing):
         for _ in range(ticks):
             self._tick(self.ik.tcp_pose())
 
-    def _close_slowly(self) -> np.ndarray:
+    def _close_slowly(self, settle: bool = False) -> np.ndarray:
         """Ramp the gripper command from its pre-grasp closure to fully closed at ``close_speed``, then
         hold for ``close_time`` while the grip builds, the wrist yielding along the closing axis to a load there
-        (``grasp_centre_force``) and, once closed, across it (``comply_deadband``). Returns how far it yielded [m,
-        base frame]: where the handle was found to be beside where it was aimed."""
+        (``grasp_centre_force``) and, with ``settle``, once closed, across it too (``comply_deadband``). Returns how
+        far it yielded [m, base frame]: where the handle was found to be beside where it was aimed."""
         c = self.config
         ramp = max(1, round((1.0 - c.pregrasp_closure) / c.close_speed * self.slowdown / c.tick))
         hold = self.ik.tcp_pose()
         axis = hold[:3, 1].copy()  # the fingers close along the TCP's y axis (skills.kinematics.top_down)
         shift = 0.0
-        # once closed, the hand also yields across the closing axis, as a door's path does (:meth:`_yield_across`):
-        # a handle gripped a few millimetres from where it was aimed (an uncalibrated camera) loads the stiff arm
-        # across the fingers — 15-18 N on a free wheel, 28 N as it turned about the aimed point, read as held
-        # part-way at 29 % — and the hand settles on the handle before it pulls
+        # once closed on a handle the pads push along its motion (a slide's, a wheel's, a drawer's), the hand also
+        # yields across the closing axis, as a door's path does (:meth:`_yield_across`): a handle gripped a few
+        # millimetres from where it was aimed (an uncalibrated camera) loads the stiff arm across the fingers —
+        # 15-18 N on a free wheel, 28 N as it turned about the aimed point, read as held part-way at 29 % — and
+        # the hand settles on the handle before it pulls. A post that pivots between the pads (a door's, a lever's)
+        # keeps the grasp it had: settled, the doors' replayed loads fitted a friction 31 % below the nominal
+        # model's on ideal-world logs (tests/twin/test_system_id.py); a door's path yields as it moves
         settled = np.zeros(3)
         for k in range(1, ramp + round(c.close_time / c.tick) + 1):
             if k <= ramp:
                 self.robot.command_gripper(c.pregrasp_closure + (1.0 - c.pregrasp_closure) * k / ramp)
-            else:
+            elif settle:
                 settled = self._yield_across(settled, axis)
             shift = self._centring(shift, axis)
             if shift == 0.0 and not settled.any():  # (the aimed pose itself, to the bit, while nothing pushes)
@@ -852,7 +855,7 @@ class Toggler(DoorPushing):
         at_grasp = self._leaning(top_down(jm.grasp_point_at(begin), grasp_yaw))
         self._descend_to(at_grasp)
         self.phase = "grasping"
-        found = self._close_slowly()
+        found = self._close_slowly(settle=jm.handling.grasp == "across_motion")
         if found.any():  # the handle stands that far beside where it was aimed: the path starts from it
             jm = replace(jm, origin=jm.origin + found, grasp_point=jm.grasp_point + found)
             at_grasp = at_grasp.copy()
