@@ -601,7 +601,8 @@ def _design_interlock(spec, first: LockRule, second: LockRule, a: JointMotion, b
     if not np.any(keep):
         return "no point inside the box where the two parts' motions cross at 30 degrees or more"
     # first guess of the blocking fractions from the local geometry (clearance across the motion)
-    guess = (2 * TUBE_RADIUS + GAP) / sine * (1 / na + 1 / nb)
+    with np.errstate(divide="ignore", invalid="ignore"):  # (points where a part does not move are not kept)
+        guess = (2 * TUBE_RADIUS + GAP) / sine * (1 / na + 1 / nb)
     # near the two parts first (within 2 cm of their footprints), ordered by the guess; then the rest of the lid
     guess = guess + np.where(_near(grid, by_name, first), 0.0, 100.0)
     exposure = np.where(top + TUBE_RADIUS > 0, 0.5 + 200.0 * (top + TUBE_RADIUS), 0.0)
