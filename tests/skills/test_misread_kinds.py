@@ -4,7 +4,7 @@ twin: found, moved as its true kind and reported so, while a locked part of the 
 from world_fixtures import TrueForceWatch
 
 from puzzlebox.lab.twin_trial import evaluation_world
-from puzzlebox.models.generator import generate_chain
+from puzzlebox.models.generator import generate_chain, paper_family
 from puzzlebox.twin.session import TwinSession
 
 FORCE_MARGIN = 45.0
@@ -52,3 +52,18 @@ def test_a_slide_told_as_a_door_is_found_where_its_handle_is():
         assert result.moved and not result.give_up and world.log[-1].tried_kinds == ("slide",)
         assert world.log[-1].true_moved and world.observe().kinds[slide] == "slide"
         assert robot.peak <= FORCE_MARGIN, robot.peak_during
+
+
+def test_a_locked_wheel_told_as_a_slide_stays_a_wheel_not_the_door_it_was_pushed_as():
+    """paper-test-2 under ``realistic``, placed by seed 70001: wheel-4, held by slide-3, told a slide. Its slide
+    grasps close on nothing; tried as a door it is pushed without progress, as a wheel held part-way (the handle
+    carried past ``blocked_progress``). The wheel is kept: a door kept instead had its neighbour tried around a door
+    that was not there for the rest of the trial."""
+    spec = next(s for s in paper_family("test") if s.name == "paper-test-2")
+    with TwinSession(spec, seed=70001, reality="realistic") as session:
+        world = evaluation_world(session, seed=70001, told_kinds={"wheel-4": "slide"})
+        wheel = _index(world, session.spec, "wheel-4")
+        assert world.observe().kinds[wheel] == "slide"
+        assert world.try_toggle(wheel).outcome == "blocked" and world.log[-1].true_moved is False
+        assert world.log[-1].tried_kinds == ("door", "wheel")
+        assert world.kinds[session.spec.components[session.spec.index_of("wheel-4")].marker] == "wheel"
