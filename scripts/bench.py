@@ -47,7 +47,7 @@ from puzzlebox.lab.bench_figures import (  # noqa: E402
     scale_figures,
 )
 from puzzlebox.lab.bench_soak import SoakConfig, SoakPoint, soak_points, soak_verdict  # noqa: E402
-from puzzlebox.lab.cli import fail, one_line, write_json  # noqa: E402
+from puzzlebox.lab.cli import OneLineParser, fail, one_line, write_json  # noqa: E402
 from puzzlebox.lab.errors import RunStoreError  # noqa: E402
 from puzzlebox.lab.out_lock import OutputLock  # noqa: E402
 
@@ -74,7 +74,7 @@ def soak(out: Path, results: dict, config: SoakConfig) -> Path:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = OneLineParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", required=True, help="output JSON file")
     parser.add_argument("--quick", action="store_true", help="fewer episodes (CI smoke run)")
     parser.add_argument(

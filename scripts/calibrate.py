@@ -29,14 +29,14 @@ import dataclasses
 import time
 from pathlib import Path
 
-from puzzlebox.lab.cli import fail, one_line, versions, write_json
+from puzzlebox.lab.cli import OneLineParser, fail, one_line, versions, write_json
 from puzzlebox.lab.errors import RunStoreError
 from puzzlebox.lab.inputs import MAX_SEED, MAX_VIEWS
 from puzzlebox.lab.out_lock import OutputLock
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(description=(__doc__ or "").partition("\n")[0])  # (no docstring under -OO)
+    parser = OneLineParser(description=(__doc__ or "").partition("\n")[0])  # (no docstring under -OO)
     parser.add_argument("--out", required=True, type=Path, help="calibration file to write (JSON)")
     parser.add_argument("--reality", default="ideal", help="reality profile of the twin: a preset name or JSON file")
     parser.add_argument("--cell-seed", type=int, default=None, help="seed of the cell's fixed imperfections")

@@ -8,7 +8,8 @@ the reality gap in the twin.
     python scripts/experiment.py twin-learning --out DIR [--quick] [--runs R] [--seeds S] [--workers W | --ray ...]
                                  [--agents memory,dqn,model-based] [--test-set paper|hard]
     python scripts/experiment.py hard-sets --out DIR [--profile realistic|harsh|FILE] [--boxes B] [--runs R]
-                                 [--memory MEM.sqlite] [--quick] [--workers W | --ray ...]
+                                 [--seed S] [--calibration both|with|without] [--memory MEM.sqlite] [--quick]
+                                 [--workers W | --ray ...]
     python scripts/experiment.py sysid --out DIR [--workers W] [--cells 0,1,2] [--quick]
     python scripts/experiment.py disassembly --agents memory,dual,dqn,model-based --out DIR [--quick] [--runs R]
                                  [--seeds S] [--workers W | --ray ...] [--validation] [--no-holding-rule]
@@ -45,8 +46,10 @@ on boxes of the same families.
 ``hard-sets`` (``puzzlebox/lab/hard_grid.py``) runs the memory agent end to end in the twin on ``--boxes`` boxes
 (default 20) of each hard family at ``--runs`` random reachable placements each (default 2) under ``--profile``
 (default ``realistic``), its memory the twin-learning ``symbolic`` start (40 generated training boxes per family, or
-``--memory``): ``DIR/hard-sets.{json,md,png}``, per family solved, mean actions against the optimum, peak true wrist
-force and runs over 45 N, outcome agreement; every trial in ``DIR/trials/``: the same command resumes.
+``--memory``), every trial with the cell calibrated first and without a calibration file (``--calibration``);
+``--seed S`` draws fresh test boxes (from seed S) and placements (from S + 100): ``DIR/hard-sets.{json,md,png}``,
+per cell and family solved, mean actions against the optimum, peak true wrist force and runs over 45 N, outcome
+agreement; every trial in ``DIR/trials/``: the same command resumes.
 
 ``sysid`` (``puzzlebox/lab/sysid.py``) identifies the box's per-kind joint damping, joint friction and latch
 compliance from logged robot data of toggles (oracle trials in the twin under ``realistic``, three cells) and
@@ -83,7 +86,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from puzzlebox.lab.cli import fail
+from puzzlebox.lab.cli import OneLineParser, fail
 from puzzlebox.lab.errors import ExperimentStepFailed, LabError
 from puzzlebox.lab.experiment_flags import AGENTS, PROTOCOL_NAMES, ExperimentFlags
 from puzzlebox.lab.experiment_protocols import run_experiment
@@ -93,7 +96,7 @@ from puzzlebox.learning.agents.factory import POSE_ENCODINGS
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = OneLineParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("protocol", choices=PROTOCOL_NAMES)
     parser.add_argument("--agents", default=None, help=f"comma-separated, from {list(AGENTS)} (reality: memory)")
     parser.add_argument("--out", required=True, help="output directory (also the resume cache of deep jobs)")
@@ -126,6 +129,14 @@ def main(argv: list[str] | None = None) -> int:
         "--profile", default=None, help="hard-sets: the cell's reality profile, a preset or a JSON file (realistic)"
     )
     parser.add_argument("--boxes", type=int, default=None, help="hard-sets: test boxes of each family (default 20)")
+    parser.add_argument(
+        "--seed", type=int, default=None,
+        help="hard-sets: fresh test boxes from seed S and placements from S + 100 (default 36000, 36100)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--calibration", choices=("both", "with", "without"), default=None,
+        help="hard-sets: run every trial with the cell calibrated first, without a calibration file, or both (default)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
     try:  # SIGINT or SIGTERM, whatever this process inherited: stop now, in one line; every saved job is kept
         with AbortOnSignal():

@@ -54,7 +54,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from puzzlebox.lab.box_exports import export_box_meshes, export_mjcf
-from puzzlebox.lab.cli import fail, write_json
+from puzzlebox.lab.cli import OneLineParser, fail, write_json
 from puzzlebox.lab.errors import LabError, SpecFilesInvalid
 from puzzlebox.lab.inputs import check_seed
 from puzzlebox.lab.spec_files import load_box_specs, validation_lines, write_spec_file
@@ -140,7 +140,7 @@ def _generator_flags(parser: argparse.ArgumentParser, name_from: str) -> None:
 def main(argv: list[str] | None = None) -> int:
     locks = {"choices": LOCK_MODES, "default": "contact", "help": "lock rules as mechanisms that block by contact "
              "(default) or as latches alone (no mechanism)"}  # fmt: skip
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = OneLineParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     verbs = parser.add_subparsers(dest="verb", required=True)
 
     paper = verbs.add_parser("paper", help="the paper's 12 five-component chains (train 9 / test 3)")

@@ -16,13 +16,13 @@ import argparse
 import json
 import sys
 
-from puzzlebox.lab.cli import fail
+from puzzlebox.lab.cli import OneLineParser, fail
 from puzzlebox.learning.errors import MemoryFileError
 from puzzlebox.learning.memory import MemoryStore
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = OneLineParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("memory", help="SQLite memory file (from scripts/train.py)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument("--migrate", action="store_true", help="bring an older file to the current schema in place")

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import imageio.v3 as iio
 
-from puzzlebox.lab.cli import fail, one_line, versions, write_json
+from puzzlebox.lab.cli import OneLineParser, fail, one_line, versions, write_json
 from puzzlebox.lab.errors import RunStoreError
 from puzzlebox.lab.inputs import MAX_IMAGE_SIDE, MAX_VIEWS, check_count, check_seed
 from puzzlebox.lab.out_lock import OutputLock
@@ -32,7 +32,7 @@ from puzzlebox.twin.video import VideoWriter
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = OneLineParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("spec", help="puzzle spec file")
     parser.add_argument("--out", required=True, help="output directory")
     parser.add_argument("--camera", help="camera name (default: overview)")

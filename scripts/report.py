@@ -28,7 +28,7 @@ import sys
 import time
 from pathlib import Path
 
-from puzzlebox.lab.cli import fail, one_line
+from puzzlebox.lab.cli import OneLineParser, fail, one_line
 from puzzlebox.lab.report_gallery import write_top_views
 from puzzlebox.lab.report_html import ReportError, build_page, load_results_dir
 from puzzlebox.models.atomic import write_text_atomically
@@ -52,7 +52,7 @@ def measure_load(page: Path, timeout_s: float = 60.0) -> tuple[float, float] | N
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = OneLineParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("dir", help="a trial or sweep directory (--out of trial.py or sweep.py)")
     parser.add_argument("--out", default=None, metavar="FILE.html", help="the page (default: DIR/report.html)")
     parser.add_argument("--measure-load", action="store_true", help="time the page's load in headless Chromium")

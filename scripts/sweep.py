@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from puzzlebox.lab.cell_bars import cell_bars
-from puzzlebox.lab.cli import fail, one_line
+from puzzlebox.lab.cli import OneLineParser, fail, one_line
 from puzzlebox.lab.errors import RunStoreError
 from puzzlebox.lab.inputs import MAX_WORKERS
 from puzzlebox.lab.interrupt import StopRequests
@@ -79,7 +79,7 @@ def cells_plot(rows: list[dict[str, Any]], path: Path) -> Path:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = OneLineParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("sweep", help="sweep file (JSON)")
     parser.add_argument("--out", required=True, help="output directory")
     parser.add_argument("--workers", type=int, default=None, help="worker processes (default: one per core)")

@@ -36,7 +36,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from puzzlebox.lab.cli import fail, versions
+from puzzlebox.lab.cli import OneLineParser, fail, versions
 from puzzlebox.lab.deep_training import train_deep
 from puzzlebox.lab.errors import LabError
 from puzzlebox.lab.inputs import MAX_ACTIONS, MAX_EPISODES, check_count, check_seed
@@ -53,7 +53,7 @@ from puzzlebox.learning.scene_lockers import training_max_lockers
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = OneLineParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--specs", nargs="+", required=True, help="training puzzle spec files")
     parser.add_argument("--episodes", type=int, required=True, help="training episodes (cycling through the specs)")
     parser.add_argument("--memory", default=None, help="SQLite memory file (created or continued): memory agent")

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from puzzlebox.lab.agent_class import check_agent
-from puzzlebox.lab.cli import fail, one_line
+from puzzlebox.lab.cli import OneLineParser, fail, one_line
 from puzzlebox.lab.errors import AgentClassError, ArmTrialFailed, ArmTrialRefused, RunStoreError, TrialConfigError
 from puzzlebox.lab.run_store import RunStore
 from puzzlebox.lab.runner import RunnerError, make_executor
@@ -104,7 +104,7 @@ def _check_twin_flags(args) -> None:
 def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None = None) -> int:
     """The command line (see the module docstring); ``arm(ip, cell)`` connects ``--robot xarm`` (default
     ``real.XArmRobot``: tests pass one over a test double of the SDK)."""
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = OneLineParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--specs", nargs="+", required=True, help="puzzle spec files")
     parser.add_argument("--memory", default=None, help="memory file from train.py (memory agent; read only)")
     parser.add_argument("--sim", choices=SIMS, required=True)

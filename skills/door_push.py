@@ -14,6 +14,7 @@ when closed); opening turns ``e_x`` towards ``e_z`` by the door angle.
 
 from __future__ import annotations
 
+import collections
 import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
@@ -25,7 +26,7 @@ from puzzlebox.skills.errors import IKFailure
 from puzzlebox.skills.joint_model import GRASP_DEPTH, JointModel, cross
 from puzzlebox.skills.kinematics import ArmKinematics, top_down
 from puzzlebox.skills.pacing import Pacing
-from puzzlebox.skills.toggle_result import ToggleResult
+from puzzlebox.skills.toggle_result import HELD_PART_WAY, ToggleResult
 
 if TYPE_CHECKING:
     from puzzlebox.models.robot import Robot
@@ -59,6 +60,12 @@ class DoorPushConfig:
     slide_turn: float = math.radians(7.0)
     """Turn of the pad since it first pressed after which a face that turned less than half as much means
     the pad is sliding along a latched handle [rad] (a jammed door: the pad slid ~12 deg and over the post)."""
+    held_turn: float = math.radians(3.0)
+    """Turn of the pad, pressed all the while, over which a face that had turned with it and now turns less than
+    half as much means the door is held part-way [rad]: a lock's rod meets its wall past the closed band
+    (``models.lock_mechanisms``), and a door carried there stood at 25 % while the pad slid 7 deg up its face
+    with the load rising 5-22 N, then slipped over the post (read as a push short of the travel, and tried again
+    and again)."""
     pad_half_width: float = 0.015
     """Half the width of a finger pad along the gripper's x (perpendicular to closing) [m]: its edge pushes a
     door closed."""
@@ -489,6 +496,7 @@ class DoorPushing:
         progress = 0.0
         pressed_at: tuple[float, float] | None = None  # (progress, face angle) when the pad first pressed
         last_pressed, last_face = start, 0.0  # progress and face angle when the pad last pressed on the face
+        track: collections.deque[tuple[float, float]] = collections.deque()  # (progress, face) pressed, in a row
         self.ik.set_joints(self.robot.joint_positions())
         turn_at_start = door.turn_of(self._pad_edge(door, p.pad_offset))
         for k in range(1, last_tick + 1 + round(2 * c.settle_time / c.tick)):
@@ -509,6 +517,18 @@ class DoorPushing:
                 last_pressed, last_face = progress, face
                 if pressed_at is None:
                     pressed_at = (progress, face)
+                track.append((progress, face))
+            else:
+                track.clear()  # (the turn over which the pad slid is measured pressed all the while)
+            held = (
+                len(track) > 0
+                and pressed_at is not None
+                and self._held_part_way(track, pressed_at[1], p.held_turn / door.travel)
+            )
+            if held:
+                self._back_off(door, angle)
+                return ToggleResult("blocked", f"{HELD_PART_WAY} ({face:.0%} of the travel)", progress, max(forces),
+                                    forces=forces)  # fmt: skip
             slid = pressed_at is not None and progress - pressed_at[0] >= p.slide_turn / door.travel
             if slid and pressed_at is not None and face - pressed_at[1] < 0.5 * (progress - pressed_at[0]):
                 self._back_off(door, angle)
@@ -528,6 +548,24 @@ class DoorPushing:
             at = start + (max(last_face - pressed_at[1], 0.0) if pressed_at is not None else 0.0)
             return self._verdict(at, forces, PUSHED_IN_VAIN if start < c.blocked_progress else None)
         return self._verdict(progress, forces)  # a latch was decided on the way: short of it, no evidence
+
+    def _held_part_way(self, track: collections.deque[tuple[float, float]], first_face: float, turn: float) -> bool:
+        """Whether the pad, pressed on the face over ``track`` ((progress, face) per tick, the latest last; ticks
+        older than ``turn`` of the pad's travel are dropped), slid along it over that turn while the face turned
+        less than half as much, after the face had turned with it past ``blocked_progress`` of the travel since
+        it first pressed (at ``first_face``), short of ``moved_fraction``: the door stopped part-way against the
+        push (a lock's rod at its wall). A face that never turned is a latch or a jam, judged by the slide test
+        since the first press."""
+        progress, face = track[-1]
+        while len(track) > 1 and track[1][0] <= progress - turn:
+            track.popleft()
+        begun, face_then = track[0]
+        return (
+            progress - begun >= turn
+            and face - face_then < 0.5 * (progress - begun)
+            and face_then - first_face >= self.config.blocked_progress
+            and face < self.config.moved_fraction  # (further, the door is in its end stop: open)
+        )
 
     def _back_off(self, door: DoorPush, angle: float) -> None:
         """Take the pad off the handle's face (along its normal, :meth:`DoorPush.face_normal` at ``angle``; a

@@ -60,11 +60,9 @@ from puzzlebox.skills.errors import ForceLimitExceeded, GraspFailure, IKFailure,
 from puzzlebox.skills.joint_model import JointModel
 from puzzlebox.skills.kinematics import ArmKinematics, top_down
 from puzzlebox.skills.pacing import Pacing
-from puzzlebox.skills.toggle_result import ToggleResult
+from puzzlebox.skills.toggle_result import HELD_PART_WAY, ToggleResult
 
 SLIPPED_OFF = "latched: held until the grasp slipped"
-HELD_PART_WAY = "latched: held part-way"
-"""Reason prefix of a part that stalled against the pull past ``blocked_progress`` (``PrimitiveConfig.stall_force``)."""
 MAX_HEAD_START = 0.5
 """Largest :attr:`Toggler.head_start` believed [-]: a part seen further along is not where its state says."""
 INCOMPLETE_TRAVEL = "IncompleteTravel"

@@ -6,6 +6,11 @@ from dataclasses import dataclass, field
 
 from puzzlebox.models.try_outcome import Outcome
 
+HELD_PART_WAY = "latched: held part-way"
+"""Reason prefix of a part that a toggle carried past ``blocked_progress`` of its travel, where it stopped against
+the motion (a lock's rod met its wall: ``models.lock_mechanisms``): pulled, it stalled under ``stall_force``; pushed
+(a door), its face stood still while the pad slid along it."""
+
 
 @dataclass
 class ToggleResult:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import importlib.util
 import json
 import platform
@@ -12,6 +13,15 @@ from typing import Any, NoReturn
 
 from puzzlebox.models.atomic import write_text_atomically
 from puzzlebox.models.spec import dumps_compact
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """An :class:`argparse.ArgumentParser` whose mistakes are one line on stderr, as :func:`fail`'s (``error: ...``,
+    exit 2), the usage left to ``--help``: a command-line mistake is one clear line, never a screenful (its verbs'
+    parsers, ``add_subparsers``, are of this class too)."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"error: {message} (see {self.prog} --help)\n")
 
 
 def versions() -> dict[str, str]:

@@ -62,6 +62,8 @@ class ExperimentFlags:
     test_set: str | None = None
     profile: str | None = None
     boxes: int | None = None
+    seed: int | None = None
+    calibration: str | None = None
 
     def check(self) -> None:
         """The flags that belong to one protocol only are not given to another; sizes are bounded."""
@@ -77,8 +79,12 @@ class ExperimentFlags:
             raise ExperimentSettingsError("--steps and --algo go with the manipulation protocol")
         if self.test_set is not None and self.protocol != TWIN_LEARNING:
             raise ExperimentSettingsError("--test-set goes with the twin-learning protocol")
-        if (self.profile is not None or self.boxes is not None) and self.protocol != HARD_SETS:
-            raise ExperimentSettingsError("--profile and --boxes go with the hard-sets protocol")
+        hard_only = {"--profile": self.profile, "--boxes": self.boxes, "--seed": self.seed,
+                     "--calibration": self.calibration}  # fmt: skip
+        given = [flag for flag, value in hard_only.items() if value is not None]
+        if given and self.protocol != HARD_SETS:
+            verb = "goes" if len(given) == 1 else "go"
+            raise ExperimentSettingsError(f"{' and '.join(given)} {verb} with the hard-sets protocol")
         if self.boxes is not None and not 1 <= self.boxes <= MAX_BOXES:
             raise ExperimentSettingsError(f"--boxes must be >= 1 and <= {MAX_BOXES}, got {self.boxes}")
 

@@ -101,13 +101,22 @@ def run_twin_learning(flags: ExperimentFlags, echo: Echo = print) -> None:
 
 def run_hard_sets(flags: ExperimentFlags, echo: Echo = print) -> None:
     """The hard test sets in the twin: eight-part boxes of every kind, the symbolic memory agent, one profile."""
-    from puzzlebox.lab.hard_grid import HardGridConfig, run_hard_grid
+    from puzzlebox.lab.hard_grid import CALIBRATIONS, HardGridConfig, run_hard_grid
     from puzzlebox.twin.errors import ProfileError
     from puzzlebox.twin.reality import load_profile
 
-    flags.only("--out, --profile, --boxes, --runs, --memory, --workers, --ray and --quick", "agents", "seeds")
+    flags.only("--out, --profile, --boxes, --seed, --calibration, --runs, --memory, --workers, --ray and --quick",
+               "agents", "seeds")  # fmt: skip
     flags.check_workers(show=True)
     config = HardGridConfig().quick() if flags.quick else HardGridConfig()
+    if flags.seed is not None:
+        try:
+            config = config.with_seed(flags.seed)
+        except ValueError as err:
+            raise ExperimentSettingsError(f"--seed {flags.seed}: {err}") from err
+    if flags.calibration is not None:
+        cells = {"both": CALIBRATIONS, "with": ("calibrated",), "without": ("uncalibrated",)}
+        config = replace(config, calibrations=cells[flags.calibration])
     if flags.profile is not None:
         try:
             load_profile(flags.profile)  # a preset's name or a profile file, checked before any work

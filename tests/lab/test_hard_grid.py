@@ -43,17 +43,45 @@ def test_an_unsolved_trial_counts_the_budget_and_a_run_past_the_margin_is_counte
     assert rows["all"]["unsolved_reasons"] == [f"{a.name} seed 1: GraspFailure: closed on nothing"]
 
 
+def test_both_cells_are_summarised_apart_each_family_and_all():
+    a, b = paper_family("test", seed=0)[:2]
+    tests = [LearningBox(a, "random8", 1, 5), LearningBox(b, "chain8", 1, 6)]
+    runs = {
+        "calibrated": [_run(a.name, True, 5, 30.0, [True] * 5), _run(b.name, True, 6, 20.0, [True] * 6)],
+        "uncalibrated": [_run(a.name, False, 3, 50.0, [True, False, False]), _run(b.name, True, 6, 25.0, [True] * 6)],
+    }
+    rows = summarise_grid(HardGridConfig(max_actions=40), "realistic", runs, tests)["rows"]
+    assert [(r["calibration"], r["set"]) for r in rows] == [
+        ("calibrated", "random8"), ("calibrated", "chain8"), ("calibrated", "all"),
+        ("uncalibrated", "random8"), ("uncalibrated", "chain8"), ("uncalibrated", "all"),
+    ]  # fmt: skip
+    assert rows[2]["solved"] == 2 and rows[5]["solved"] == 1 and rows[5]["runs_over_margin"] == 1
+    assert rows[3]["mean_actions"] == 40 and rows[2]["peak_true_wrist_force_n"] == 30.0
+
+
+def test_fresh_seeds_draw_other_boxes_and_placements_and_never_the_training_ones():
+    fresh = HardGridConfig().with_seed(91_000)
+    assert (fresh.test_seed, fresh.eval_seed) == (91_000, 91_100)
+    with pytest.raises(ValueError, match="overlap"):
+        HardGridConfig().with_seed(500)  # the training boxes' seeds 0..999
+    with pytest.raises(ValueError, match="calibrations"):
+        HardGridConfig(calibrations=("calibrated", "calibrated"))
+
+
 def test_the_grid_runs_each_family_in_the_twin_keeps_every_trial_and_resumes(tmp_path):
-    config = HardGridConfig(boxes=1, placements=1, train_boxes=1, max_actions=3)
+    # without a calibration file (the calibrated cell's trials are those of every other twin experiment)
+    config = HardGridConfig(boxes=1, placements=1, train_boxes=1, max_actions=3, calibrations=("uncalibrated",))
     summary = run_hard_grid(tmp_path, config, workers=1)
     rows = {r["set"]: r for r in summary["rows"]}
     assert list(rows) == ["random8", "multi8", "chain8", "all"] and rows["all"]["trials"] == 3
+    assert {r["calibration"] for r in summary["rows"]} == {"uncalibrated"} and not (tmp_path / "calibrations").exists()
     assert rows["chain8"]["solved"] == 0 and rows["chain8"]["mean_actions"] == 3  # a chain of 8 takes 8
     assert all(0.0 < r["peak_true_wrist_force_n"] < 60.0 for r in rows.values())  # the arm touched every box
     trials = sorted((tmp_path / "trials").glob("*.json"))
     assert len(trials) == 3
     records = [json.loads(t.read_text()) for t in trials]
     assert {r["record"]["seed"] for r in records} == {config.eval_seed}
+    assert all(r["key"].endswith("-p0-uncalibrated") for r in records)
     assert (tmp_path / "memory" / "memory-s0.sqlite").is_file() and not list((tmp_path / "memory").glob(".*"))
     assert (tmp_path / "hard-sets.png").read_bytes().startswith(b"\x89PNG")
     assert "| all | 3 |" in (tmp_path / "hard-sets.md").read_text()
@@ -71,6 +99,8 @@ def test_the_grid_runs_each_family_in_the_twin_keeps_every_trial_and_resumes(tmp
         (("--runs", "0"), "--runs must be >= 1"),
         (("--seeds", "2"), "takes only --out, --profile"),
         (("--memory", "missing.sqlite"), "--memory missing.sqlite: no such file"),
+        (("--seed", "10"), "--seed 10: test seeds from 10 and training seeds from 0 overlap"),
+        (("--calibration", "sometimes"), "invalid choice: 'sometimes'"),
     ],
 )
 def test_hard_sets_command_line_mistakes_are_one_line_and_exit_2(tmp_path, args, message):
@@ -84,4 +114,8 @@ def test_hard_sets_command_line_mistakes_are_one_line_and_exit_2(tmp_path, args,
 def test_profile_and_boxes_go_with_the_hard_sets_protocol_only(tmp_path):
     result = subprocess.run([sys.executable, str(ROOT / "scripts/experiment.py"), "twin-learning", "--out",
                              str(tmp_path / "out"), "--profile", "harsh"], capture_output=True, text=True)  # fmt: skip
-    assert result.returncode == 2 and "--profile and --boxes go with the hard-sets protocol" in result.stderr
+    assert result.returncode == 2 and "--profile goes with the hard-sets protocol" in result.stderr
+    result = subprocess.run([sys.executable, str(ROOT / "scripts/experiment.py"), "reality", "--out",
+                             str(tmp_path / "out"), "--seed", "91000", "--calibration", "without"],
+                            capture_output=True, text=True)  # fmt: skip
+    assert result.returncode == 2 and "--seed and --calibration go with the hard-sets protocol" in result.stderr

@@ -350,3 +350,19 @@ def test_a_real_full_disk_is_one_line_and_the_runs_written_are_whole(tmp_path, s
         assert kept and all(json.loads(p.read_text())["record"]["seed"] >= 0 for p in kept), "every kept run whole"
     finally:
         subprocess.run(["umount", str(disk)], check=False)
+
+
+@pytest.mark.parametrize(
+    ("script", "argv", "says"),
+    [
+        ("trial", ["--specs", "x.json", "--sim", "moon"], "argument --sim: invalid choice: 'moon'"),
+        ("generate", ["teleport"], "invalid choice: 'teleport'"),
+        ("generate", ["mjcf"], "the following arguments are required: spec, --out (see "),
+        ("experiment", ["hard-sets", "--out", "x", "--calibration", "sometimes"], "invalid choice: 'sometimes'"),
+        ("train", ["--specs", "x.json", "--episodes", "many"], "argument --episodes: invalid int value: 'many'"),
+        ("sweep", [], "the following arguments are required"),
+    ],
+)
+def test_an_argument_the_parser_refuses_is_one_line_without_the_usage(capsys, script, argv, says):
+    line = one_line_exit_2(capsys, script, *argv)
+    assert says in line and "usage:" not in line, line

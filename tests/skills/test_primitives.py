@@ -8,6 +8,7 @@ from dm_control import mjcf
 from world_fixtures import TrueForceWatch
 
 from puzzlebox.models.generator import generate_chain
+from puzzlebox.models.kinds import get_kind
 from puzzlebox.models.lock_check import HELD_FRACTION
 from puzzlebox.models.lock_mechanisms import IN_STATE
 from puzzlebox.models.xarm7 import HOME_QPOS, build_xarm7
@@ -55,6 +56,24 @@ def test_a_latched_part_of_each_kind_is_reported_blocked_and_stays_put(chain, na
     assert session.component_states()[j] == 0
     assert abs(session.component_positions()[j] - before) < 0.02  # the lock held against the pull, the part back
     assert session.robot.gripper_opening() <= PrimitiveConfig().pregrasp_closure + 0.05  # and the robot let go
+
+
+def test_a_locked_door_pushed_from_closed_is_held_part_way_where_its_lock_stops_it(chain):
+    """A pad pushing a locked door's handle carries it until the lock's rod meets its wall, past the closed band;
+    there the door stops while the pad slides up its face: held part-way (a lock), not a push that fell short
+    (before, the pad slid over the post and the try read ``IncompleteTravel``, and was tried again and again)."""
+    session, models = chain
+    session.reset()
+    j = session.spec.index_of("door-1")
+    travel = get_kind("door").travel
+    watch = TrueForceWatch(session.robot, session)
+    result = Toggler(watch).toggle(models["door-1"], push=True)
+    assert result.outcome == "blocked" and result.reason.startswith(HELD_PART_WAY), result.reason
+    assert session.component_states()[j] == 0  # the truth: not open
+    assert watch.peak < 45.0
+    met = float(result.reason.split("(")[1].split("%")[0]) / 100  # where the face stood still, of the travel
+    assert IN_STATE - 0.05 < met < HELD_FRACTION
+    assert abs(session.component_positions()[j] / travel - met) < 0.03  # the door stands where it was read held
 
 
 def test_a_blocked_try_is_felt_against_a_mechanism_not_a_latch(chain):
