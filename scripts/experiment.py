@@ -10,6 +10,7 @@ the reality gap in the twin.
     python scripts/experiment.py hard-sets --out DIR [--profile realistic|harsh|FILE] [--boxes B] [--runs R]
                                  [--seed S] [--calibration both|with|without] [--memory MEM.sqlite] [--quick]
                                  [--workers W | --ray ...]
+    python scripts/experiment.py regression --out DIR [--reference REGRESSION.json] [--quick] [--workers W | --ray ...]
     python scripts/experiment.py sysid --out DIR [--workers W] [--cells 0,1,2] [--quick]
     python scripts/experiment.py disassembly --agents memory,dual,dqn,model-based --out DIR [--quick] [--runs R]
                                  [--seeds S] [--workers W | --ray ...] [--validation] [--no-holding-rule]
@@ -50,6 +51,12 @@ on boxes of the same families.
 ``--seed S`` draws fresh test boxes (from seed S) and placements (from S + 100): ``DIR/hard-sets.{json,md,png}``,
 per cell and family solved, mean actions against the optimum, peak true wrist force and runs over 45 N, outcome
 agreement; every trial in ``DIR/trials/``: the same command resumes.
+
+``regression`` (``puzzlebox/lab/regression_grid.py``) runs a fixed grid of twin trials (the paper test boxes x 5 seeds
+under ``realistic`` and ``harsh``, 6 hard boxes x 2 placements, 10 runs with a misreported kind) and writes each
+trial's fingerprint — its actions, their outcomes, ``sensed_sha256`` — to ``DIR/regression.json``; with
+``--reference`` (an earlier run's ``regression.json``) it lists every difference and exits 1 if there is any: a
+change meant to keep the behaviour keeps it bit for bit.
 
 ``sysid`` (``puzzlebox/lab/sysid.py``) identifies the box's per-kind joint damping, joint friction and latch
 compliance from logged robot data of toggles (oracle trials in the twin under ``realistic``, three cells) and
@@ -132,6 +139,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--seed", type=int, default=None,
         help="hard-sets: fresh test boxes from seed S and placements from S + 100 (default 36000, 36100)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--reference", default=None, metavar="REGRESSION.json",
+        help="regression: an earlier run's DIR/regression.json; exit 1 if any action, outcome or sensed hash differs",
     )  # fmt: skip
     parser.add_argument(
         "--calibration", choices=("both", "with", "without"), default=None,

@@ -22,11 +22,24 @@ REALITY = "reality"
 FAULTS = "faults"
 TWIN_LEARNING = "twin-learning"
 HARD_SETS = "hard-sets"
+REGRESSION = "regression"
 SYSID = "sysid"
 KINDS = "kinds"
 MANIPULATION = "manipulation"
 ALL = "all"
-PROTOCOL_NAMES = (*PROTOCOLS, ALL, REALITY, FAULTS, TWIN_LEARNING, HARD_SETS, SYSID, DISASSEMBLY, KINDS, MANIPULATION)
+PROTOCOL_NAMES = (
+    *PROTOCOLS,
+    ALL,
+    REALITY,
+    FAULTS,
+    TWIN_LEARNING,
+    HARD_SETS,
+    REGRESSION,
+    SYSID,
+    DISASSEMBLY,
+    KINDS,
+    MANIPULATION,
+)
 """Every protocol ``experiment.py`` runs: the paper's symbolic ones, all three of them, and the twin's."""
 AGENTS = (*SYMBOLIC_AGENTS, *DEEP_AGENTS)
 """The agents of the paper's symbolic protocols."""
@@ -64,6 +77,7 @@ class ExperimentFlags:
     boxes: int | None = None
     seed: int | None = None
     calibration: str | None = None
+    reference: str | None = None
 
     def check(self) -> None:
         """The flags that belong to one protocol only are not given to another; sizes are bounded."""
@@ -85,6 +99,8 @@ class ExperimentFlags:
         if given and self.protocol != HARD_SETS:
             verb = "goes" if len(given) == 1 else "go"
             raise ExperimentSettingsError(f"{' and '.join(given)} {verb} with the hard-sets protocol")
+        if self.reference is not None and self.protocol != REGRESSION:
+            raise ExperimentSettingsError("--reference goes with the regression protocol")
         if self.boxes is not None and not 1 <= self.boxes <= MAX_BOXES:
             raise ExperimentSettingsError(f"--boxes must be >= 1 and <= {MAX_BOXES}, got {self.boxes}")
 

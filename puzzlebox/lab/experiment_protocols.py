@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from puzzlebox.lab.cli import write_json
-from puzzlebox.lab.errors import ExperimentFailed, ExperimentSettingsError
+from puzzlebox.lab.errors import ExperimentFailed, ExperimentSettingsError, ExperimentStepFailed
 from puzzlebox.lab.experiment_flags import (
     DISASSEMBLY,
     FAULTS,
@@ -23,6 +23,7 @@ from puzzlebox.lab.experiment_flags import (
     KINDS,
     MANIPULATION,
     REALITY,
+    REGRESSION,
     SYSID,
     TWIN_LEARNING,
     ExperimentFlags,
@@ -39,7 +40,7 @@ def run_experiment(flags: ExperimentFlags, echo: Echo = print) -> None:
     """Check ``flags`` and run its protocol."""
     flags.check()
     runs = {REALITY: run_reality, FAULTS: run_faults, TWIN_LEARNING: run_twin_learning, HARD_SETS: run_hard_sets,
-            SYSID: run_sysid,
+            REGRESSION: run_regression, SYSID: run_sysid,
             DISASSEMBLY: run_disassembly, KINDS: run_kinds, MANIPULATION: run_manipulation}  # fmt: skip
     try:
         runs.get(flags.protocol, run_paper_protocols)(flags, echo)
@@ -134,6 +135,39 @@ def run_hard_sets(flags: ExperimentFlags, echo: Echo = print) -> None:
     except LearningError as err:
         raise ExperimentFailed(str(err)) from err
     report(out, HARD_SETS, summary, echo)
+
+
+def run_regression(flags: ExperimentFlags, echo: Echo = print) -> None:
+    """The regression grid: a fixed set of twin trials, fingerprinted; with ``--reference``, compared with an
+    earlier run's (every difference one line on stdout, then exit 1)."""
+    from puzzlebox.lab.regression_grid import RegressionGridConfig, compare, load_reference, run_regression_grid
+
+    flags.only("--out, --reference, --workers, --ray and --quick", "agents", "seeds", "runs", "memory")
+    flags.check_workers(show=True)
+    reference = None
+    if flags.reference is not None:
+        try:
+            reference = load_reference(Path(flags.reference))  # checked before any work
+        except ValueError as err:
+            raise ExperimentSettingsError(f"--reference: {err}") from err
+    config = RegressionGridConfig().quick() if flags.quick else RegressionGridConfig()
+    out = flags.out_dir()
+    flags.write_config(out, REGRESSION, regression=asdict(config))
+    try:
+        summary = run_regression_grid(out, config, flags.workers, flags.ray)
+    except LearningError as err:
+        raise ExperimentFailed(str(err)) from err
+    trials = summary["trials"]
+    lines = [f"# The regression grid: {len(trials)} twin trials, {sum(t['solved'] for t in trials.values())} solved",
+             "", f"Fingerprints: `{out / 'regression.json'}`."]  # fmt: skip
+    differences = compare(summary, reference) if reference is not None else []
+    if reference is not None:
+        verdict = f"{len(differences)} difference(s)" if differences else "identical (actions, outcomes, sensed_sha256)"
+        lines += ["", f"Against `{flags.reference}`: {verdict}", *(f"- {d}" for d in differences)]
+    (out / "regression.md").write_text("\n".join(lines) + "\n")
+    report(out, REGRESSION, summary, echo)
+    if differences:
+        raise ExperimentStepFailed("the regression grid against its reference", 1)
 
 
 def _memory_file(memory: str | None) -> Path | None:
