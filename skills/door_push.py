@@ -256,6 +256,12 @@ class PushingConfig(Protocol):
     def blocked_magnitude(self) -> float: ...
     @property
     def overtravel_force(self) -> float: ...
+    @property
+    def stall_force(self) -> float: ...
+    @property
+    def stall_progress(self) -> float: ...
+    @property
+    def stall_window(self) -> float: ...
 
 
 class DoorPushing:
@@ -523,7 +529,7 @@ class DoorPushing:
             held = (
                 len(track) > 0
                 and pressed_at is not None
-                and self._held_part_way(track, pressed_at[1], p.held_turn / door.travel)
+                and self._held_part_way(track, pressed_at[1], p.held_turn / door.travel, normal)
             )
             if held:
                 self._back_off(door, angle)
@@ -549,23 +555,28 @@ class DoorPushing:
             return self._verdict(at, forces, PUSHED_IN_VAIN if start < c.blocked_progress else None)
         return self._verdict(progress, forces)  # a latch was decided on the way: short of it, no evidence
 
-    def _held_part_way(self, track: collections.deque[tuple[float, float]], first_face: float, turn: float) -> bool:
-        """Whether the pad, pressed on the face over ``track`` ((progress, face) per tick, the latest last; ticks
-        older than ``turn`` of the pad's travel are dropped), slid along it over that turn while the face turned
-        less than half as much, after the face had turned with it past ``blocked_progress`` of the travel since
-        it first pressed (at ``first_face``), short of ``moved_fraction``: the door stopped part-way against the
-        push (a lock's rod at its wall). A face that never turned is a latch or a jam, judged by the slide test
-        since the first press."""
+    def _held_part_way(
+        self, track: collections.deque[tuple[float, float]], first_face: float, turn: float, normal: float
+    ) -> bool:
+        """Whether the door stopped part-way against the push (a lock's rod at its wall), the pad pressed on its face
+        over ``track`` ((progress, face) per tick, the latest last; ticks older than ``turn`` of the pad's travel
+        are dropped): after the face had turned with the pad past ``blocked_progress`` of the travel since it
+        first pressed (at ``first_face``), short of ``moved_fraction``, either the pad slid along the face over
+        ``turn`` while the face turned less than half as much, or the face stood still (``stall_progress`` over
+        ``stall_window``) with ``normal`` [N] on it above ``stall_force`` (the pad, held back by its lead, turns
+        slowly along a face that does not give: a door held at 27 % was pressed with 51 N before it had slid 3
+        deg). A face that never turned is a latch or a jam, judged by the slide test since the first press."""
+        c = self.config
         progress, face = track[-1]
         while len(track) > 1 and track[1][0] <= progress - turn:
             track.popleft()
         begun, face_then = track[0]
-        return (
-            progress - begun >= turn
-            and face - face_then < 0.5 * (progress - begun)
-            and face_then - first_face >= self.config.blocked_progress
-            and face < self.config.moved_fraction  # (further, the door is in its end stop: open)
-        )
+        if face_then - first_face < c.blocked_progress or face >= c.moved_fraction:
+            return False  # (further, the door is in its end stop: open)
+        if progress - begun >= turn and face - face_then < 0.5 * (progress - begun):
+            return True
+        window = max(2, round(c.stall_window * self.slowdown / c.tick))
+        return normal > c.stall_force and len(track) >= window and abs(face - track[-window][1]) < c.stall_progress
 
     def _back_off(self, door: DoorPush, angle: float) -> None:
         """Take the pad off the handle's face (along its normal, :meth:`DoorPush.face_normal` at ``angle``; a

@@ -903,6 +903,7 @@ class Toggler(DoorPushing):
         in_end_stop = False  # felt the door reach its end stop: open, whatever the pads do next
         across = np.zeros(3)  # the path's offset across itself, yielding to the load there [m, base frame]
         yields = jm.handling.yields_across
+        held_along = None if jm.handling.yields_along_axis else jm.axis  # (a load along it: no yield)
         returning = 1.0 - c.tick / c.comply_return_time  # the offset kept per tick past the travel
         window = max(2, round(c.stall_window * slowdown / c.tick))
         press_limit = (
@@ -922,7 +923,7 @@ class Toggler(DoorPushing):
             opposing = float(-np.dot(self.force_in_base, direction))
             if yields:  # once the end stop is felt, back to the planned arc: its load tells the door is open
                 if s <= 1.0 or (c.overtravel_comply and not in_end_stop):
-                    across = self._yield_across(across, direction)
+                    across = self._yield_across(across, direction, held_along)
                 else:
                     across = across * returning
             forces.append(opposing)
@@ -982,17 +983,24 @@ class Toggler(DoorPushing):
 
     def _take_back(self, motion: collections.abc.Callable[[], None]) -> None:
         """Run ``motion``, a held handle's way back to where it was grasped, under ``back_off_force``: stopped there,
-        the arm backs off along the load instead (the try's verdict stands)."""
+        the arm backs off along the load (:meth:`_relieve`) and sets out once more; stopped again, it stays backed
+        off (the try's verdict stands). The load of the hold still rises for a few ticks after it is read (the
+        filter's lag): a wheel held at 35-40 N had its way back stopped on the second tick and was left at 27 % of
+        its travel, where its next try began with the hand believing it closed (it met its stop at 73 % of the way
+        and read held part-way)."""
         limit = self.limit
         self.limit = min(limit, self.config.back_off_force)
         try:
-            motion()
-        except ForceLimitExceeded:
-            self.guard = False
-            try:
-                self._relieve()
-            finally:
-                self.guard = True
+            for _ in range(2):  # (once more after backing off)
+                try:
+                    motion()
+                    return
+                except ForceLimitExceeded:
+                    self.guard = False
+                    try:
+                        self._relieve()
+                    finally:
+                        self.guard = True
         finally:
             self.limit = limit
 
@@ -1010,15 +1018,20 @@ class Toggler(DoorPushing):
             target[:3, 3] += across * left
             self._tick(target)
 
-    def _yield_across(self, across: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    def _yield_across(
+        self, across: np.ndarray, direction: np.ndarray, held_along: np.ndarray | None = None
+    ) -> np.ndarray:
         """The path's offset ``across`` [m] moved along the filtered force's component across the direction of
         motion ``direction`` (unit, base frame), at ``comply_gain`` per newton above a deadband
         (``comply_deadband``, ``comply_noise_margin``), within ``comply_limit``: a path planned from a slightly
         wrong hinge pulls the handle across its true arc, which the part resists with no motion, and only the
-        load along the motion tells a latch."""
+        load along the motion tells a latch. ``held_along``: a unit axis along which the load is not yielded to
+        (``Handling.yields_along_axis``)."""
         c = self.config
         force = self.force_in_base
         load = force - float(force @ direction) * direction
+        if held_along is not None:  # nor along this (unit) axis, where the part holds the handle in the pads
+            load = load - float(load @ held_along) * held_along
         size = math.sqrt(load @ load)
         deadband = max(c.comply_deadband, c.comply_noise_margin * self.rest_noise)
         if size <= deadband:

@@ -51,6 +51,10 @@ class Handling:
     the motion tells a latch): a hinge turned about an axis perceived a little off drags its handle across the
     true arc, which the part resists without moving — a free door 57 N, 39 N yielding; free wheels under an
     uncalibrated camera 30-46 N, 23 N yielding. Slides and drawers hold their handle on a straight line."""
+    yields_along_axis: bool = True
+    """Whether that yield includes the hinge axis's direction. A wheel's knob stands on a vertical axis and is held
+    in the pads by their friction along it: yielding to that load too set the hand bouncing up and down on the knob
+    (+-20 N at ~7 Hz against the F/T filter's lag), up to 46 N on a wheel held part-way by its lock."""
 
 
 PartBuilder = Callable[["mjcf.Element", str], "mjcf.Element"]

@@ -60,6 +60,6 @@ KIND = Kind(
     glyph="#55A868",
     sweep_effort=0.3,
     neighbours=("slide",),
-    handling=Handling(yields_across=True),
+    handling=Handling(yields_across=True, yields_along_axis=False),
 )
 """The wheel, as registered (:mod:`models.kinds.registry`)."""
