@@ -9,7 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from puzzlebox.lab.regression_grid import RegressionGridConfig, compare, fingerprint, grid_trials
+from puzzlebox.lab.regression_grid import RegressionGridConfig, compare, fingerprint, grid_trials, load_reference
 from puzzlebox.learning.memory import MemoryStore
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -48,6 +48,20 @@ def test_the_grid_is_the_issue_s_52_trials_each_key_once(tmp_path):
     assert len(keys) == len(set(keys)) == 30 + 12 + 10
     assert sum(k.startswith("harsh-") for k in keys) == 15 and sum(k.startswith("hard-") for k in keys) == 12
     assert all(t.settings.get("misreport_kind") for t in tasks if t.key.startswith("misreported-"))
+
+
+def test_the_committed_reference_covers_the_grid_trial_for_trial(tmp_path):
+    """``tests/regression/reference.json``: the grid as it ran before the hand's redesign (the command in it)."""
+    reference = load_reference(ROOT / "tests/regression/reference.json")
+    memories = {"paper": tmp_path / "m.sqlite", "hard": tmp_path / "m.sqlite"}
+    MemoryStore(memories["paper"]).close()
+    keys = [t.key for t in grid_trials(RegressionGridConfig(), tmp_path, memories, {"realistic": {}, "harsh": {}},
+                                       {"realistic": {}, "harsh": {}})]  # fmt: skip
+    assert sorted(reference["trials"]) == sorted(keys)
+    assert all(
+        len(t["sensed_sha256"]) == 64 and len(t["actions"]) == t["num_actions"] for t in reference["trials"].values()
+    )
+    assert compare(reference, reference) == []
 
 
 def test_the_quick_grid_runs_and_a_reference_with_a_planted_change_fails_it_in_one_line_each(tmp_path):
