@@ -903,7 +903,8 @@ class Toggler(DoorPushing):
         in_end_stop = False  # felt the door reach its end stop: open, whatever the pads do next
         across = np.zeros(3)  # the path's offset across itself, yielding to the load there [m, base frame]
         yields = jm.handling.yields_across
-        held_along = None if jm.handling.yields_along_axis else jm.axis  # (a load along it: no yield)
+        held_along = None if jm.handling.axis_yield == 1.0 else jm.axis  # (a load along it: yielded to in part)
+        axis_yield = jm.handling.axis_yield
         returning = 1.0 - c.tick / c.comply_return_time  # the offset kept per tick past the travel
         window = max(2, round(c.stall_window * slowdown / c.tick))
         press_limit = (
@@ -923,7 +924,7 @@ class Toggler(DoorPushing):
             opposing = float(-np.dot(self.force_in_base, direction))
             if yields:  # once the end stop is felt, back to the planned arc: its load tells the door is open
                 if s <= 1.0 or (c.overtravel_comply and not in_end_stop):
-                    across = self._yield_across(across, direction, held_along)
+                    across = self._yield_across(across, direction, held_along, axis_yield)
                 else:
                     across = across * returning
             forces.append(opposing)
@@ -1019,19 +1020,19 @@ class Toggler(DoorPushing):
             self._tick(target)
 
     def _yield_across(
-        self, across: np.ndarray, direction: np.ndarray, held_along: np.ndarray | None = None
+        self, across: np.ndarray, direction: np.ndarray, held_along: np.ndarray | None = None, share: float = 1.0
     ) -> np.ndarray:
         """The path's offset ``across`` [m] moved along the filtered force's component across the direction of
         motion ``direction`` (unit, base frame), at ``comply_gain`` per newton above a deadband
         (``comply_deadband``, ``comply_noise_margin``), within ``comply_limit``: a path planned from a slightly
         wrong hinge pulls the handle across its true arc, which the part resists with no motion, and only the
-        load along the motion tells a latch. ``held_along``: a unit axis along which the load is not yielded to
-        (``Handling.yields_along_axis``)."""
+        load along the motion tells a latch. ``held_along``: a unit axis along which only ``share`` of the load is
+        yielded to (``Handling.axis_yield``)."""
         c = self.config
         force = self.force_in_base
         load = force - float(force @ direction) * direction
-        if held_along is not None:  # nor along this (unit) axis, where the part holds the handle in the pads
-            load = load - float(load @ held_along) * held_along
+        if held_along is not None:  # only in part along this (unit) axis, where the part holds the handle in the pads
+            load = load - (1.0 - share) * float(load @ held_along) * held_along
         size = math.sqrt(load @ load)
         deadband = max(c.comply_deadband, c.comply_noise_margin * self.rest_noise)
         if size <= deadband:

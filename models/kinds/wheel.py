@@ -60,6 +60,6 @@ KIND = Kind(
     glyph="#55A868",
     sweep_effort=0.3,
     neighbours=("slide",),
-    handling=Handling(yields_across=True, yields_along_axis=False),
+    handling=Handling(yields_across=True, axis_yield=0.3),
 )
 """The wheel, as registered (:mod:`models.kinds.registry`)."""
