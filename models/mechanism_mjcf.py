@@ -116,7 +116,7 @@ def _carried(part: mjcf.Element, name: str, **attributes: Any) -> mjcf.Element:
     balanced on its pin (``models.kinds.lever``), and the walls, rods, lugs and pawls it carries unbalanced turned it
     (0.06-0.5 g each, 0.2-0.9 mN·m in all, 2-8 % of its weight's moment, past MuJoCo's soft dry friction: a free lever
     of a hard box crept open at 0.14-0.32 % of its travel per second, up to its stop in a training episode, where a
-    grasp aimed at its closed handle closed on nothing above it; runs/s8/lever-grasp)."""
+    grasp aimed at its closed handle closed on nothing above it)."""
     if part.gravcomp is not None:
         attributes["gravcomp"] = part.gravcomp
     return part.add("body", name=name, **attributes)

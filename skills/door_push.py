@@ -154,7 +154,7 @@ class DoorPushConfig:
     """Force magnitude that ends a top-up push wherever the pads are [N]: the plate is held there, or in its
     end stop. A free door at 64 deg turned at ``top_up_speed`` under the harsh profile's draws (damping,
     friction, mass) pressed back with up to 12 N (12 draws). Stopped here, a door held at 56-72 deg or in its
-    stop took 18-24 N true under the harsh reading, against 40-50 N at ``blocked_magnitude`` (runs/s6/topup)..."""
+    stop took 18-24 N true under the harsh reading, against 40-50 N at ``blocked_magnitude``..."""
     top_up_noise_margin: float = 5.0
     """... plus this many times the noise of the filtered force (:meth:`Toggler.filtered_noise_now`, per axis:
     its magnitude over three axes reaches ~5 times it), up to ``blocked_magnitude``."""

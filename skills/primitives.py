@@ -103,7 +103,7 @@ class PrimitiveConfig:
     touch_speed: float = 0.006
     """TCP speed over ``touch_height`` [m/s] (slower by :attr:`Toggler.slowdown`): the impact of the touch, one
     tick's spike, grows with it (fingers on a handle's top: 112 N at 4.5 cm/s, 22-45 N at 0.5-1.1 cm/s), and so
-    does the servos' tracking lag they press on with while the filtered reading catches up (runs/s5/force-descent)."""
+    does the servos' tracking lag they press on with while the filtered reading catches up."""
     cautious_descend_time: float = 6.5
     """Time of the descent beside a door that may stand open over it (``toggle(cautious=True)``) [s]: met at
     the 6 cm/s peak of a normal descent, a flap's edge put 80 N on the wrist at the first touch; at a third of
@@ -111,7 +111,7 @@ class PrimitiveConfig:
     and stop, its 2.4 cm/s peak met an open door's plate 4 cm above a slide's grasp point, and the pad bounced on it
     for 11 ticks (47 N true) while the filtered reading, a median that needs most of its window in contact, read
     3 N (paper-test-2 seed 100, harsh); at a constant 1.6 cm/s a knuckle met a plate with 42 N true (hard chain8,
-    harsh; runs/s5/force-base)."""
+    harsh)."""
     cautious_contact_force: float = 15.0
     """Filtered force that stops a cautious descent, and the last ``touch_height`` of every descent [N]: nothing
     should touch the fingers on the way down, and
@@ -245,11 +245,11 @@ class PrimitiveConfig:
     the progress short of ``moved_fraction`` [N]: the pads hold a post along its length by friction alone, and
     under the harsh grip they slid down a locked lever's post at 13 N (the lever still) until the fingers met its
     arm, where the load rose 4.5 N a tick to 56 N true before the stall was read; a free lever is pressed with
-    ~5 N (harsh), and past ``moved_fraction`` more force is its end stop (runs/s5/force-descent/locked_lever.py).
+    ~5 N (harsh), and past ``moved_fraction`` more force is its end stop.
     The same for a handle pulled up its post (a lever lifted; a door swings up under a pinch of its own): a lever held
     open by its lock stopped after the lock's play while the realistic pads slid up its post at 15-19 N along the
     motion, never stalling (the hand kept rising), until they slid off its top, seen at 73-89 % and given up; a free
-    lever is lifted with 3-4 N (runs/s8/lever-close)."""
+    lever is lifted with 3-4 N."""
     press_noise_margin: float = 3.0
     """... or this many times the filtered F/T noise of the toggle, if larger: noise must not read as a hold."""
     press_pace: float = 0.5
@@ -258,7 +258,7 @@ class PrimitiveConfig:
     along the motion (a free lever is pressed with ~4 N: no force tells the slide under ``press_force``), 8 mm
     (40 % of the travel) until the fingers met the lever's arm, where the true load rose from 16 N by 12 N in the
     first tick and to 45 N in the five before the 30 ms late, filtered reading showed it; stopped, 46.5 N
-    (hard-random8-s36014 seed 36100, runs/s7/lever-force). That rise scales with the pace the arm meets the arm at:
+    (hard-random8-s36014 seed 36100). That rise scales with the pace the arm meets the arm at:
     at half the pace, 6 N in the first tick and 34 N true at the most."""
     press_angle: float = math.radians(30.0)
     """Largest angle between the motion of a grasped handle and the gripper's approach axis (down, into the part)
@@ -280,7 +280,7 @@ class PrimitiveConfig:
     (``end_stop_force``), then return to the planned arc: the planned arc's mismatch with the door's true arc grows
     past the travel (a door still rising, near upright), and held on the arc it loaded the grasp with ~32 N
     *across* the motion (2-5 N along it), on which the handle's stick-slip in the pads put one-tick spikes of
-    45-48 N true (realistic: paper-test-2 seed 105, hard-chain8-s36004 seed 36100; runs/s6/pinch). Yielding,
+    45-48 N true (realistic: paper-test-2 seed 105, hard-chain8-s36004 seed 36100). Yielding,
     the same pinches peaked at 27 and 22 N with the doors in their stops; a door that reaches its stop without
     20 N felt is then topped up (``push.top_up``)."""
     end_stop_force: float = 20.0
@@ -499,7 +499,7 @@ class Toggler(DoorPushing):
         counts from the perceived closed (or open) pose, and the handle of a lever left part-way is that much ahead
         of them (a lever rests up to ~20 % pressed once lifted, a try taken back leaves it at 30-45 %). Its stop
         was met with the fingers at 57-73 % and read ``held part-way``; taken back, the lever was tried again and
-        again until the grasp closed on nothing (runs/s5/force-descent/lever.py)."""
+        again until the grasp closed on nothing."""
         self.lean: np.ndarray | None = None
         """Horizontal vector (base frame) along which the gripper leans over the part of the toggle in progress,
         by ``lean_angle`` times its length (``toggle(lean=...)``), or None: upright."""
@@ -829,8 +829,7 @@ class Toggler(DoorPushing):
         arm's base, ``base_rise``, reached at that height from ``base_radius`` out and moving in horizontally (the
         way :meth:`_out_from_base` leaves): the arm reaches there folded over its own shoulder, and every route to 8
         cm above a drawer's handle 0.176 m from the axis put the gripper's knuckle on link 2 (101-137 N, 17 mm deep in
-        the robot model); arriving 3.5 cm above it from outside kept 3-6 mm of clearance, more on the way down
-        (runs/s5/force-retreat, force-base)."""
+        the robot model); arriving 3.5 cm above it from outside kept 3-6 mm of clearance, more on the way down."""
         c = self.config
         above = target.copy()
         above[:3, 3] -= c.approach_height * target[:3, 2]

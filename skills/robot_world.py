@@ -109,7 +109,7 @@ class WorldConfig:
     57 deg) 47 mm above the slide's grasp point (the light touch watches the last 18 mm only), pushed it up to 77 deg,
     where a downward push has little lever about the hinge, and the load rose ~1.1 N a tick to 66.8 N true before the
     late, filtered reading passed the 60 N guard (hard-chain8-s36016 seed 36100, harsh). Cautious, the same descent
-    stopped at 17.8 N true (runs/s7/door-descent)."""
+    stopped at 17.8 N true."""
     lift_tolerance: float = 0.012
     """A kind fits a marker perceived this close to the kind's ``lift`` above the lid [m] (a lever's marker stands
     30 mm up; close up, markers are measured within ~1 mm)."""

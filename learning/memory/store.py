@@ -83,7 +83,7 @@ SEVERAL_LOCKERS_LEARNED = 1.9
 """Expected number of lockers of one component in one state (its memberships summed) from which an episode has
 learned a component held by several: with sets of up to two, ``P(two) >= sum - 1``, so at least 0.9. A belief
 over sets of two left uncertain on a one-locker chain box sums to at most 1.62 (paper training boxes, 18
-episodes); multi-locker boxes and lab-computer-a reach 1.96-2.0 (``runs/s4/defaults/membership_probe.py``)."""
+episodes); multi-locker boxes and lab-computer-a reach 1.96-2.0."""
 
 _LOG_SCHEMA = """
 CREATE TABLE training_runs (id INTEGER PRIMARY KEY, started REAL NOT NULL, config TEXT NOT NULL);

@@ -13,7 +13,7 @@
 - ``experiment stopped``: ``experiment.py`` sent SIGTERM (and SIGINT, inherited as ignored) after its first saved
   job: one line, exit 130, the job kept and reused by the same command.
 
-:func:`writer_races` is also what ``runs/s3/races.py`` measures with.
+:func:`writer_races` is also what a development race script measured with.
 """
 
 from __future__ import annotations

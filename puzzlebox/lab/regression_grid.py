@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from puzzlebox.lab.cli import write_json
-from puzzlebox.lab.hard_grid import memory_task
+from puzzlebox.lab.hard_grid import HardGridConfig, memory_task
 from puzzlebox.lab.learning_boxes import test_boxes, training_boxes
 from puzzlebox.lab.reality_sweep import calibrated_cell
 from puzzlebox.lab.runner import RecordStore, Task, make_executor, run_tasks
@@ -50,7 +50,7 @@ class RegressionGridConfig:
     hard_boxes: int = 2
     """Test boxes of each hard family (their first seeds), under ``realistic``."""
     hard_placements: int = 2
-    """Placements of each hard box (world seeds 36100 + p, as ``experiment.py hard-sets``)."""
+    """Placements of each hard box (world seeds as ``experiment.py hard-sets``: ``HardGridConfig.eval_seed + p``)."""
     hard_train_boxes: int = 10
     """Training boxes of each hard family in the hard boxes' symbolic memory."""
     misreported: int = 10
@@ -118,7 +118,7 @@ def grid_trials(
             trial(
                 f"hard-{box.spec.name}-p{p}",
                 box.spec,
-                36100 + p,
+                HardGridConfig.eval_seed + p,
                 "realistic",
                 "hard",
                 max_actions=40,

@@ -70,7 +70,7 @@ HARD_TEST_BOXES = 2
 HARD_TRAIN_BOXES = 40
 """Training boxes of each hard family, chosen on validation boxes (seeds 5000-5009, never the test boxes), symbolic,
 3 seeds each: 20 of each took 1.20 / 1.29 / 1.14 x the optimum on random / multi-locker / chain boxes, 40 of each
-1.09 / 1.19 / 1.08 (``runs/s4/hard-sets/symbolic_val.py``)."""
+1.09 / 1.19 / 1.08."""
 STARTS = ("empty", "symbolic", "symbolic+twin")
 """Where a learning curve starts (see the module docstring)."""
 PAPER_ROBOT = {0.0: 26.0, 0.5: 10.0, 1.0: 8.8}

@@ -61,7 +61,11 @@ def test_the_committed_reference_covers_the_grid_trial_for_trial(tmp_path):
     assert all(
         len(t["sensed_sha256"]) == 64 and len(t["actions"]) == t["num_actions"] for t in reference["trials"].values()
     )
-    assert compare(reference, reference) == []
+    planted = copy.deepcopy(reference)
+    key = sorted(planted["trials"])[0]
+    planted["trials"][key]["sensed_sha256"] = "0" * 64
+    assert compare(planted, reference) == [f"{key}: sensed_sha256 {'0' * 64!r}, the reference's "
+                                           f"{reference['trials'][key]['sensed_sha256']!r}"]  # fmt: skip
 
 
 def test_the_quick_grid_runs_and_a_reference_with_a_planted_change_fails_it_in_one_line_each(tmp_path):
