@@ -30,7 +30,7 @@ from puzzlebox.models.cell_config import CellConfig
 from puzzlebox.models.reach import MIN_REACH
 from puzzlebox.models.robot import Robot
 from puzzlebox.skills.errors import ForceLimitExceeded, IKFailure, MarkersNotFound
-from puzzlebox.skills.kinematics import top_down
+from puzzlebox.skills.kinematics import ArmKinematics, top_down
 from puzzlebox.skills.perception import MarkerDetection, MarkerDetector, lid_height, select_markers
 from puzzlebox.skills.primitives import Toggler
 
@@ -106,6 +106,8 @@ class SceneSurvey:
         self.detector = detector or MarkerDetector()
         self.config = config or SurveyConfig()
         self.last_close_up_reached = False
+        self._planner = ArmKinematics()
+        """IK of its own to check a viewpoint before going there (the toggler's holds the arm's warm start)."""
         """Whether the last close-up look got the wrist camera above its marker."""
         self.overview_trusted: set[int] = set()
         """Markers the overview camera posed within bounds and on the lid's plane in :meth:`locate`
@@ -139,6 +141,8 @@ class SceneSurvey:
             target[:3, 3] = np.asarray(point, float) + (0.0, 0.0, height) - target[:3, :3] @ T_tcp_camera[:3, 3]
             if np.hypot(*target[:2, 3]) < MIN_REACH:
                 continue  # the camera's offset puts the gripper over the base: it meets the arm's link 2
+            if not self._reachable(target):
+                continue
             try:
                 self.toggler.travel_to(target, self.config.move_time)
                 return True
@@ -148,6 +152,19 @@ class SceneSurvey:
                 self.toggler.withdraw()
                 return False
         return False
+
+    def _reachable(self, target: np.ndarray) -> bool:
+        """Whether the IK reaches ``target`` (4x4, base frame) from the rest posture, without moving the arm.
+
+        A viewpoint out of reach is left alone rather than tried: the arm stopped stretched where the IK gave up,
+        and the next yaw set out from there, the wrist's last joint winding ~1.6 rad further each time; at its
+        limit the IK folded the forearm onto the gripper (hard-chain8-s91002 at world seed 91101: a finger pad on
+        link 4 at 388 N true, before the first action)."""
+        try:
+            self._planner.solve(target, np.asarray(self.toggler.rest_posture, float))
+        except IKFailure:
+            return False
+        return True
 
     def close_up(self, marker: int, planar_pose: np.ndarray, height: float | None = None) -> MarkerDetection | None:
         """``marker`` measured from straight above its believed ``[x, y, yaw]`` at marker ``height`` [m],
