@@ -11,6 +11,7 @@ import numpy as np
 
 from puzzlebox.learning.agents.base import Agent
 from puzzlebox.models import World
+from puzzlebox.models.try_outcome import Cause
 
 MAX_FAILURES_IN_A_ROW = 3
 """A run ends when one component fails this many tries in a row (each already retried by the world), or when every
@@ -27,6 +28,8 @@ class ActionRecord:
     outcome: str = "moved"
     """``moved``, ``blocked`` or ``failed`` (see :class:`models.TryResult`)."""
     reason: str = ""
+    cause: Cause | None = None
+    """Why it was ``blocked`` or ``failed``, as a type (None for ``moved`` and for worlds that do not say)."""
 
 
 @dataclass(frozen=True)
@@ -77,7 +80,7 @@ def run_episode(
             failed_here = set()
         agent.record(index, result, observation)
         name = name_of(index) if name_of else str(index)
-        actions.append(ActionRecord(name, result.moved, result.outcome, result.reason))
+        actions.append(ActionRecord(name, result.moved, result.outcome, result.reason, result.cause))
         if on_action is not None:
             on_action(actions[-1])
         repeated = len(actions) > 1 and actions[-2].component == name and actions[-2].outcome == "failed"

@@ -22,16 +22,17 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from puzzlebox.models.kinds import HANDLE_HEIGHT, HANDLE_MARGIN, HANDLE_SIZE
+from puzzlebox.models.try_outcome import Cause
 from puzzlebox.skills.errors import IKFailure
 from puzzlebox.skills.joint_model import GRASP_DEPTH, JointModel, cross
 from puzzlebox.skills.kinematics import ArmKinematics, top_down
 from puzzlebox.skills.pacing import Pacing
-from puzzlebox.skills.toggle_result import HELD_PART_WAY, ToggleResult
+from puzzlebox.skills.toggle_result import HELD_PART_WAY, LATCHED, ToggleResult
 
 if TYPE_CHECKING:
     from puzzlebox.models.robot import Robot
 
-PUSHED_IN_VAIN = "latched: pushed without progress"
+PUSHED_IN_VAIN = LATCHED[Cause.LOCKED_PUSHED]
 
 
 @dataclass(frozen=True)
@@ -286,7 +287,7 @@ class DoorPushing:
         def _tick(self, target: np.ndarray) -> tuple[float, float]: ...
         def _descend_to(self, target: np.ndarray) -> None: ...
         def _let_go_and_retreat(self, guarded: bool = True) -> None: ...
-        def _verdict(self, progress: float, forces: list[float], latched: str | None = None) -> ToggleResult: ...
+        def _verdict(self, progress: float, forces: list[float], latched: Cause | None = None) -> ToggleResult: ...
 
     def _push_door_open(self, jm: JointModel, start: float = 0.0) -> ToggleResult:
         """Open a door by pushing the back face of its handle with the inner face of a finger pad (see
@@ -394,10 +395,10 @@ class DoorPushing:
             short = progress < c.moved_fraction and pushed < c.blocked_progress
             if short and (forces[-1] > c.blocked_force or magnitude > c.blocked_magnitude):
                 result = ToggleResult("blocked", PUSHED_IN_VAIN, progress, max(forces),
-                                      forces=forces)  # fmt: skip
+                                      forces=forces, cause=Cause.LOCKED_PUSHED)  # fmt: skip
                 break
         if result is None:
-            result = self._verdict(progress, forces, PUSHED_IN_VAIN)
+            result = self._verdict(progress, forces, Cause.LOCKED_PUSHED)
         # off the plate along its normal before letting go: held pressed on a latched plate (the command runs
         # ``lead`` into it) while the gripper opened, a harsh latch's play built 65 N on the wrist
         self._back_off(door, (1.0 - max(progress, 0.0)) * door.travel + math.pi / 2)
@@ -534,25 +535,26 @@ class DoorPushing:
             if held:
                 self._back_off(door, angle)
                 return ToggleResult("blocked", f"{HELD_PART_WAY} ({face:.0%} of the travel)", progress, max(forces),
-                                    forces=forces)  # fmt: skip
+                                    forces=forces, cause=Cause.HELD_PART_WAY, held_at=face)  # fmt: skip
             slid = pressed_at is not None and progress - pressed_at[0] >= p.slide_turn / door.travel
             if slid and pressed_at is not None and face - pressed_at[1] < 0.5 * (progress - pressed_at[0]):
                 self._back_off(door, angle)
                 if start >= c.blocked_progress:  # a door held part-way open is stuck, not latched: no evidence
                     return ToggleResult("failed", f"Jammed: the door held at {start:.0%} of its travel",
-                                        progress, max(forces), forces=forces)  # fmt: skip
-                return ToggleResult("blocked", "latched: the pad slid along its handle", progress, max(forces),
-                                    forces=forces)  # fmt: skip
+                                        progress, max(forces), forces=forces, cause=Cause.JAMMED)  # fmt: skip
+                return ToggleResult("blocked", LATCHED[Cause.LOCKED_PAD_SLID], progress, max(forces),
+                                    forces=forces, cause=Cause.LOCKED_PAD_SLID)  # fmt: skip
             if progress < c.blocked_progress and (normal > p.blocked_force or magnitude > c.blocked_magnitude):
                 self._back_off(door, angle)
-                return ToggleResult("blocked", PUSHED_IN_VAIN, progress, max(forces), forces=forces)
+                return ToggleResult("blocked", PUSHED_IN_VAIN, progress, max(forces), forces=forces,
+                                    cause=Cause.LOCKED_PUSHED)  # fmt: skip
         self._back_off(door, max(progress, 0.0) * door.travel)
         if last_pressed < c.moved_fraction:
             # the pad lost the face before the door was open: it went over the post (a latched door, inside the
             # slide test's 7 deg: it read "moved" with the door shut) or the door is elsewhere. How far the door
             # went is how far its face turned while pressed.
             at = start + (max(last_face - pressed_at[1], 0.0) if pressed_at is not None else 0.0)
-            return self._verdict(at, forces, PUSHED_IN_VAIN if start < c.blocked_progress else None)
+            return self._verdict(at, forces, Cause.LOCKED_PUSHED if start < c.blocked_progress else None)
         return self._verdict(progress, forces)  # a latch was decided on the way: short of it, no evidence
 
     def _held_part_way(

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
+from puzzlebox.models.try_outcome import Cause
+
 
 class SkillError(Exception):
     """Base class of every error raised on purpose by the `skills` package."""
@@ -34,9 +36,13 @@ class UnknownMarker(SkillError, KeyError):
 class IKFailure(SkillError):
     """Inverse kinematics could not reach a target (out of reach, or stalled at a joint limit)."""
 
+    cause = Cause.UNREACHABLE
+
 
 class GraspFailure(SkillError):
     """The gripper closed on nothing."""
+
+    cause = Cause.GRASP_EMPTY
 
 
 class CalibrationFailed(SkillError):
@@ -57,8 +63,25 @@ class InconsistentViews(CalibrationFailed, ValueError):
 
 
 class ForceLimitExceeded(SkillError):
-    """The wrist force passed the safety limit during a motion: the motion was stopped."""
+    """The wrist force passed the safety limit during a motion: the motion was stopped.
+
+    Attributes:
+        force: the filtered force magnitude that passed the limit [N].
+        limit: the limit it passed [N].
+        phase: what the primitive was doing (``models.toggle_log.PHASES``).
+    """
+
+    cause = Cause.FORCE_LIMIT
+
+    def __init__(self, force: float, limit: float, phase: str) -> None:
+        self.force, self.limit, self.phase = force, limit, phase
+        super().__init__(f"force limit: {force:.0f} N > {limit:.0f} N while {phase}, motion stopped")
+
+    def __reduce__(self):  # type: ignore[override]  # (pickled across worker processes)
+        return type(self), (self.force, self.limit, self.phase)
 
 
 class SlipDetected(SkillError):
     """The handle left the grasp during the motion (the gripper closed past the handle's width)."""
+
+    cause = Cause.SLIPPED

@@ -55,14 +55,15 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from puzzlebox.models.cell_config import CellConfig
 from puzzlebox.models.robot import Robot
+from puzzlebox.models.try_outcome import Cause
 from puzzlebox.skills.door_push import DoorPushConfig, DoorPushing
 from puzzlebox.skills.errors import ForceLimitExceeded, GraspFailure, IKFailure, SlipDetected
 from puzzlebox.skills.joint_model import JointModel
 from puzzlebox.skills.kinematics import ArmKinematics, top_down
 from puzzlebox.skills.pacing import Pacing
-from puzzlebox.skills.toggle_result import HELD_PART_WAY, ToggleResult
+from puzzlebox.skills.toggle_result import HELD_PART_WAY, LATCHED, ToggleResult
 
-SLIPPED_OFF = "latched: held until the grasp slipped"
+SLIPPED_OFF = LATCHED[Cause.LOCKED_SLIPPED_OFF]
 MAX_HEAD_START = 0.5
 """Largest :attr:`Toggler.head_start` believed [-]: a part seen further along is not where its state says."""
 INCOMPLETE_TRAVEL = "IncompleteTravel"
@@ -71,8 +72,8 @@ STOPPED = "motion stopped"
 """End of the reason of a motion the force guard stopped: ``... while <phase>, motion stopped``."""
 STOPPED_DESCENDING = f"while descending, {STOPPED}"
 """End of the reason of a try the force guard stopped on the way down onto the handle."""
-PADS_LOST_HOLD = ("SlipDetected", "GraspFailure", SLIPPED_OFF)
-"""Reasons of a pinch that ended for want of a hold on the handle (it slipped out, the grasp closed on nothing,
+PADS_LOST_HOLD = frozenset({Cause.SLIPPED, Cause.GRASP_EMPTY, Cause.LOCKED_SLIPPED_OFF})
+"""Causes of a pinch that ended for want of a hold on the handle (it slipped out, the grasp closed on nothing,
 or the part held until the pads slid off: a latch, or a door heavier than the grip holds). A door is then
 pushed, and the push's verdict stands."""
 
@@ -523,9 +524,7 @@ class Toggler(DoorPushing):
         magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
         self.peak_force = max(self.peak_force, magnitude)
         if self.guard and magnitude > self.limit:
-            raise ForceLimitExceeded(
-                f"force limit: {magnitude:.0f} N > {self.limit:.0f} N while {self.phase}, {STOPPED}"
-            )
+            raise ForceLimitExceeded(magnitude, self.limit, self.phase)
 
     def force_noise(self) -> float:
         """The F/T force noise now: the rms over the axes of the raw force's spread over the last
@@ -715,16 +714,17 @@ class Toggler(DoorPushing):
             result = self._push_on(jm, opening, 0.0 if covered is None else covered, where_is)
         else:
             result = self._attempt(lambda: self._toggle(jm, 1.0 if opening else -1.0))
-            empty = result.reason.startswith(GraspFailure.__name__)
+            empty = result.cause is Cause.GRASP_EMPTY
             if pushable and opening and result.outcome == "moved" and not result.end_stop_felt and c.push.top_up:
                 self._attempt(lambda: self._top_up_door(jm))  # best effort: the pinch's verdict stands
-            if pushable and result.reason.startswith(PADS_LOST_HOLD):
+            if pushable and result.cause in PADS_LOST_HOLD:
                 # the pads could not hold the handle: push the door instead, in the same try, from where it stands
                 covered = self._push_start(result, opening, where_is)
                 if covered is not None:
                     result = self._push_on(jm, opening, covered, where_is)
                 elif result.progress < c.moved_fraction:  # (past it, the world looks whether it moved)
                     result.reason += "; the door stands part-way where it cannot be seen: not pushed"
+                    result.not_pushed = True
             result.closed_on_nothing = empty
         result.peak_force = self.peak_force  # over the whole try, withdrawal included
         result.sim_time = self.robot.time - start_time
@@ -745,13 +745,14 @@ class Toggler(DoorPushing):
         marker). A door seen lower is left to a retry's push from where it stands: under a plate that low
         the top-up's pads pass over it and read "moved"."""
         result = self._push(jm, opening, covered)
-        if opening and self.config.push.top_up and result.reason.startswith(INCOMPLETE_TRAVEL):
+        if opening and self.config.push.top_up and result.cause is Cause.INCOMPLETE_TRAVEL:
             if where_is is not None and where_is() is not None:
                 return result
             topped = self._attempt(lambda: self._top_up_door(jm))
             if topped.outcome == "moved":
                 return topped
             result.reason += f"; pushed on under its plate: {topped.reason}"
+            result.pushed_on = topped
         return result
 
     def _push(self, jm: JointModel, opening: bool, covered: float) -> ToggleResult:
@@ -786,7 +787,10 @@ class Toggler(DoorPushing):
         try:
             return motion()
         except (IKFailure, GraspFailure, SlipDetected, ForceLimitExceeded) as err:
-            result = ToggleResult("failed", reason=f"{type(err).__name__}: {err}", progress=self.progress)
+            result = ToggleResult(
+                "failed", reason=f"{type(err).__name__}: {err}", progress=self.progress, cause=err.cause,
+                stopped_while=err.phase if isinstance(err, ForceLimitExceeded) else "",
+            )  # fmt: skip
             self.withdraw()
             return result
 
@@ -936,7 +940,7 @@ class Toggler(DoorPushing):
                 if progress_at_peak < c.blocked_progress and max(forces) >= c.push_force:
                     # the part held while pulled until the pads slid off its handle: a latch, not a slip
                     return ToggleResult("blocked", SLIPPED_OFF, progress, max(forces),
-                                        forces=forces)  # fmt: skip
+                                        forces=forces, cause=Cause.LOCKED_SLIPPED_OFF)  # fmt: skip
                 if in_end_stop:  # the pads slid off a post pressed into its end stop: the door is open
                     return ToggleResult("moved", "", progress, max(forces), forces=forces, end_stop_felt=True)
                 raise
@@ -950,8 +954,9 @@ class Toggler(DoorPushing):
             ) and progress < c.blocked_progress:
                 self._take_back(functools.partial(self.move_to, at_grasp, 0.5))  # back to where the handle was grasped
                 return ToggleResult(
-                    "blocked", "latched: force rose without progress", progress, max(forces), forces=forces
-                )
+                    "blocked", LATCHED[Cause.LOCKED_NO_PROGRESS], progress, max(forces), forces=forces,
+                    cause=Cause.LOCKED_NO_PROGRESS,
+                )  # fmt: skip
             recent.append(progress)
             stalled = len(recent) == recent.maxlen and progress - recent[0] < c.stall_progress
             held = held or (stalled and opposing > c.stall_force and s <= 1.0)
@@ -961,8 +966,9 @@ class Toggler(DoorPushing):
             if held:  # (progress >= blocked_progress: tested above)
                 self._take_back(functools.partial(self._return_along, jm, sign, begin, progress, at_grasp, across))
                 return ToggleResult(
-                    "blocked", f"{HELD_PART_WAY} ({progress:.0%} of the travel)", progress, max(forces), forces=forces
-                )
+                    "blocked", f"{HELD_PART_WAY} ({progress:.0%} of the travel)", progress, max(forces), forces=forces,
+                    cause=Cause.HELD_PART_WAY, held_at=progress,
+                )  # fmt: skip
         for _ in range(round(2 * c.settle_time / c.tick)):  # let the part catch up with the end target
             progress = self.progress = self._progress(jm, sign, begin)
             target = self._pose_along(jm, begin + sign * min(end, max(progress, 0.0) + lead), at_grasp, begin)
@@ -975,7 +981,7 @@ class Toggler(DoorPushing):
                     raise
                 break
         reached = self._progress(jm, sign, begin) + self.head_start
-        result = self._verdict(reached, forces, "latched: pulled without progress")
+        result = self._verdict(reached, forces, Cause.LOCKED_PULLED)
         result.end_stop_felt = in_end_stop
         if result.outcome == "blocked":
             self._take_back(functools.partial(self.move_to, at_grasp, 0.5))
@@ -1040,19 +1046,20 @@ class Toggler(DoorPushing):
         length = math.sqrt(across @ across)
         return across if length <= c.comply_limit else across * (c.comply_limit / length)
 
-    def _verdict(self, progress: float, forces: list[float], latched: str | None = None) -> ToggleResult:
+    def _verdict(self, progress: float, forces: list[float], latched: Cause | None = None) -> ToggleResult:
         """How a motion that ran its course ended: ``moved`` past ``moved_fraction`` of the travel; ``blocked``
-        (reason ``latched``, when given) short of ``blocked_progress`` after at least ``push_force`` against
+        (cause ``latched``, when given) short of ``blocked_progress`` after at least ``push_force`` against
         the motion (``forces`` [N], one per tick); else ``failed``."""
         c = self.config
         peak = max(forces)
         if progress >= c.moved_fraction:
             return ToggleResult("moved", "", progress, peak, forces=forces)
         if latched is not None and progress < c.blocked_progress and peak >= c.push_force:
-            return ToggleResult("blocked", latched, progress, peak, forces=forces)
+            return ToggleResult("blocked", LATCHED[latched], progress, peak, forces=forces, cause=latched)
         return ToggleResult(
-            "failed", f"{INCOMPLETE_TRAVEL}: only {progress:.0%} of the travel covered", progress, peak, forces=forces
-        )
+            "failed", f"{INCOMPLETE_TRAVEL}: only {progress:.0%} of the travel covered", progress, peak, forces=forces,
+            cause=Cause.INCOMPLETE_TRAVEL,
+        )  # fmt: skip
 
     def _check_grip(self, progress: float) -> None:
         closure = self.robot.gripper_opening()

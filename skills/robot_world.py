@@ -56,11 +56,13 @@ from puzzlebox.models.disassembly_kinds import family_kind_names
 from puzzlebox.models.geometry import wrap_angle
 from puzzlebox.models.kinds import get_kind, registered_kinds
 from puzzlebox.models.robot import Robot
+from puzzlebox.models.try_outcome import Cause
 from puzzlebox.skills.door_clearance import lean_away, near_open_door
 from puzzlebox.skills.joint_model import JointModel, joint_model
 from puzzlebox.skills.perception import MarkerDetection, MarkerDetector, kind_of, lid_height, upright_pose
-from puzzlebox.skills.primitives import STOPPED_DESCENDING, PrimitiveConfig, Toggler, ToggleResult
+from puzzlebox.skills.primitives import PrimitiveConfig, Toggler, ToggleResult
 from puzzlebox.skills.scene_survey import SceneSurvey, SurveyConfig
+from puzzlebox.skills.toggle_result import LATCHED
 
 MOVED_DISTANCE = 0.01
 """A re-observed marker this far from its closed pose has moved [m]..."""
@@ -68,10 +70,17 @@ MOVED_ANGLE = math.radians(20)
 """... or turned this much [rad]."""
 DOOR_STAYED = "SlipDetected: the door stayed shut"
 """Reason of a try whose fingers went the whole way while the door's marker stayed at its closed pose."""
-HELD_UNDER_PINCH_AND_PUSH = "latched: the door stayed shut under the pinch and the push"
+HELD_UNDER_PINCH_AND_PUSH = LATCHED[Cause.LOCKED_PINCH_AND_PUSH]
 """Reason of a door seen shut after a pinch and then a push both went the whole way: held (a latch or a jam). The
 push's own reading can miss it: on a latched door whose post the pad rode over before the load reached
 ``push.blocked_force`` (28 N of 30), and which it then pressed on something else near the end of the arc."""
+
+
+def _stopped_descending(result: ToggleResult) -> bool:
+    """Whether a toggle ended with the force guard stopping the fingers on their way down: the pinch's or the
+    push's descent, or that of the push on under a door's plate that followed a push run short."""
+    last = result.last_stop()
+    return not result.not_pushed and last.cause is Cause.FORCE_LIMIT and last.stopped_while == "descending"
 
 
 @dataclass(frozen=True)
@@ -141,6 +150,8 @@ class ActionLog:
     true_moved: bool | None = None
     tried_kinds: tuple[str, ...] = ()
     """The other kinds the part was tried as in this try, in order (``kind`` is the one in use after it)."""
+    cause: Cause | None = None
+    """Why it was ``blocked`` or ``failed`` (None for ``moved``): :attr:`reason` is its text."""
 
 
 @dataclass
@@ -257,15 +268,16 @@ class RobotWorld:
                 # (a door's marker must be seen where an open door's is: one the pads let go part-way hides
                 # it behind its own raised handle, as an open one shows it edge-on)
                 if self._overview_verdict(marker, opening, unseen_moved=not is_door).moved:
-                    result.outcome, result.reason = "moved", ""
+                    result.outcome, result.reason, result.cause = "moved", "", None
+                    result.stopped_while, result.pushed_on, result.not_pushed = "", None, False
             if result.outcome != "failed":
                 break
             reasons.append(result.reason)
-            if lean is not None and result.reason.startswith("IKFailure"):
+            if lean is not None and result.cause is Cause.UNREACHABLE:
                 # leaning out of reach (tilted 20 deg outwards, the flange stands ~6 cm further out): half as much
                 # next time (10 deg still cleared a post), then upright
                 lean = 0.5 * lean if np.linalg.norm(lean) > 0.75 else None
-            if attempt < self.config.max_retries and overhanging and result.reason.endswith(STOPPED_DESCENDING):
+            if attempt < self.config.max_retries and overhanging and _stopped_descending(result):
                 # the fingers met something on the way down beside a door that may stand short of its stop,
                 # leaning over this part: push that door up into its stop, then descend again
                 for door in overhanging:
@@ -300,7 +312,7 @@ class RobotWorld:
             wall_time += result.wall_time
             outcome = self._sensed_outcome(result, marker, opening)
             if self._door_stayed_shut(outcome, marker):
-                outcome = TryResult("blocked", HELD_UNDER_PINCH_AND_PUSH)
+                outcome = TryResult("blocked", HELD_UNDER_PINCH_AND_PUSH, cause=Cause.LOCKED_PINCH_AND_PUSH)
         tried: tuple[str, ...] = ()
         if self._other_kinds_due(marker, outcome, reasons):
             outcome, other, tried = self._try_other_kinds(marker, opening, outcome, empty)
@@ -316,13 +328,13 @@ class RobotWorld:
         elif outcome.outcome == "blocked":
             self.blocked_as.add(marker)
         if outcome.outcome == "failed" and len(reasons) > self.config.max_retries:
-            outcome = TryResult("failed", f"{outcome.reason} ({attempts} attempts)", give_up=True)
+            outcome = TryResult("failed", f"{outcome.reason} ({attempts} attempts)", give_up=True, cause=outcome.cause)
         after = self.ground_truth(marker) if self.ground_truth else None
         self.log.append(
             ActionLog(
                 index, marker, kind_of(self.kinds, marker), outcome.outcome, outcome.reason, outcome.moved,
                 result.progress, peak, attempts, sim_time, wall_time, None if before is None else bool(before != after),
-                tried,
+                tried, outcome.cause,
             )
         )  # fmt: skip
         return outcome
@@ -396,7 +408,8 @@ class RobotWorld:
             )
             if result.outcome == "failed" and result.progress >= self.toggler.config.moved_fraction:
                 if self._overview_verdict(marker, opening, unseen_moved=not jm.handling.swings_up).moved:
-                    result.outcome, result.reason = "moved", ""
+                    result.outcome, result.reason, result.cause = "moved", "", None
+                    result.stopped_while, result.pushed_on, result.not_pushed = "", None, False
             outcome = self._sensed_outcome(result, marker, opening)
             if total is not None:
                 result.peak_force = max(result.peak_force, total.peak_force)
@@ -425,7 +438,8 @@ class RobotWorld:
                 self.unsettled.add(marker)  # the next try of it looks first
         if blocked:
             held = ", ".join(tried)
-            return TryResult("blocked", f"{blocked[0].reason} (also tried as {held})"), total, tuple(tried)
+            also = TryResult("blocked", f"{blocked[0].reason} (also tried as {held})", cause=blocked[0].cause)
+            return also, total, tuple(tried)
         return first, total, tuple(tried)
 
     def _doors_overhanging(self, marker: int, opening: bool) -> list[int]:
@@ -453,7 +467,7 @@ class RobotWorld:
     def _door_stayed_shut(self, outcome: TryResult, marker: int) -> bool:
         """Whether a pinch that carried its fingers the whole way left a door seen shut (its marker where
         it was): the signature of pads sliding along the post of a door they could not turn."""
-        stayed = outcome.reason.startswith(DOOR_STAYED)  # (opening only)
+        stayed = outcome.cause is Cause.DOOR_STAYED_SHUT  # (opening only)
         return self.toggler.config.door_push and self._swings_up(marker) and stayed
 
     def _fraction_open(self, marker: int) -> float | None:
@@ -497,7 +511,7 @@ class RobotWorld:
 
     def _sensed_outcome(self, result: ToggleResult, marker: int, opening: bool) -> TryResult:
         if result.outcome != "moved":
-            return TryResult(result.outcome, result.reason)
+            return TryResult(result.outcome, result.reason, cause=result.cause)
         return self._overview_verdict(marker, opening)
 
     def _overview_verdict(self, marker: int, opening: bool, unseen_moved: bool = True) -> TryResult:
@@ -511,7 +525,9 @@ class RobotWorld:
         if not seen:
             # a door standing open shows its marker edge-on: it left its closed pose; anything else
             # hidden (the arm?) leaves the primitive's verdict standing
-            return TryResult("moved") if unseen_moved else TryResult("failed", "SlipDetected: the part was not seen")
+            if unseen_moved:
+                return TryResult("moved")
+            return TryResult("failed", "SlipDetected: the part was not seen", cause=Cause.MARKER_LOST)
         return self._verdict(seen[0], marker, opening)
 
     def _close_up_verdict(self, marker: int, opening: bool, unseen_moved: bool = True) -> TryResult:
@@ -532,7 +548,10 @@ class RobotWorld:
         if seen is None:
             if (opening and unseen_moved) or not self.survey.last_close_up_reached:
                 return TryResult("moved")
-            return TryResult("failed", "SlipDetected: the handle moved but the part is not back at its closed pose")
+            return TryResult(
+                "failed", "SlipDetected: the handle moved but the part is not back at its closed pose",
+                cause=Cause.NOT_BACK_CLOSED,
+            )  # fmt: skip
         return self._verdict(seen, marker, opening)
 
     def _verdict(self, seen: MarkerDetection, marker: int, opening: bool) -> TryResult:
@@ -549,7 +568,7 @@ class RobotWorld:
         away = bool(np.linalg.norm(delta[:2]) > MOVED_DISTANCE or turn > MOVED_ANGLE)
         if away == opening:
             return TryResult("moved")
-        return TryResult("failed", "SlipDetected: the handle moved but the marker did not")
+        return TryResult("failed", "SlipDetected: the handle moved but the marker did not", cause=Cause.MARKER_STILL)
 
     def _door_verdict(self, at: float, opening: bool) -> TryResult:
         """Whether a part (a door, a lever) seen at fraction ``at`` of its travel reached its other state."""
@@ -557,8 +576,10 @@ class RobotWorld:
         if (at >= c.moved_fraction) if opening else (at <= 1.0 - c.moved_fraction):
             return TryResult("moved")
         if opening and at < c.blocked_progress:
-            return TryResult("failed", f"{DOOR_STAYED} ({at:.0%} of its travel)")
-        return TryResult("failed", f"SlipDetected: the part stands at {at:.0%} of its travel")
+            return TryResult("failed", f"{DOOR_STAYED} ({at:.0%} of its travel)", cause=Cause.DOOR_STAYED_SHUT)
+        return TryResult(
+            "failed", f"SlipDetected: the part stands at {at:.0%} of its travel", cause=Cause.STANDS_PART_WAY
+        )
 
     def _swings_up(self, marker: int) -> bool:
         """Whether ``marker``'s part swings up out of the lid plane (a door: ``Handling.swings_up``)."""

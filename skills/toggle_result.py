@@ -4,8 +4,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from puzzlebox.models.try_outcome import Outcome
+from puzzlebox.models.try_outcome import Cause, Outcome
 
+LATCHED: dict[Cause, str] = {
+    Cause.LOCKED_NO_PROGRESS: "latched: force rose without progress",
+    Cause.LOCKED_PULLED: "latched: pulled without progress",
+    Cause.LOCKED_SLIPPED_OFF: "latched: held until the grasp slipped",
+    Cause.LOCKED_PUSHED: "latched: pushed without progress",
+    Cause.LOCKED_PAD_SLID: "latched: the pad slid along its handle",
+    Cause.LOCKED_PINCH_AND_PUSH: "latched: the door stayed shut under the pinch and the push",
+}
+"""The reason text of each ``blocked`` cause that carries no figure."""
 HELD_PART_WAY = "latched: held part-way"
 """Reason prefix of a part that a toggle carried past ``blocked_progress`` of its travel, where it stopped against
 the motion (a lock's rod met its wall: ``models.lock_mechanisms``): pulled, it stalled under ``stall_force``; pushed
@@ -31,3 +40,20 @@ class ToggleResult:
     """A door's pinch felt the door reach its end stop (past the travel, ``end_stop_force``)."""
     closed_on_nothing: bool = False
     """The gripper closed on nothing where the handle was looked for (whatever the try did next: a door is pushed)."""
+    cause: Cause | None = None
+    """Why it ended ``blocked`` or ``failed``, as a type (None for ``moved``); :attr:`reason` is its text."""
+    stopped_while: str = ""
+    """What the primitive was doing when the force guard stopped it (``models.toggle_log.PHASES``; "" if it did
+    not)."""
+    pushed_on: ToggleResult | None = None
+    """A door's opening push that ran short was followed by a push on under its plate, which failed or was
+    blocked: that push's result (its verdict is in :attr:`reason` after this one's)."""
+    held_at: float | None = None
+    """Where a part read ``held part-way`` stopped, as a fraction of its travel (a door's: where its face stood
+    still while the pad slid along it)."""
+    not_pushed: bool = False
+    """A door the pads lost stands part-way where no look sees it: it was not pushed."""
+
+    def last_stop(self) -> ToggleResult:
+        """The motion the try ended with: the push on under the plate if there was one, else this one."""
+        return self.pushed_on if self.pushed_on is not None else self

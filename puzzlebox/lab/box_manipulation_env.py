@@ -218,13 +218,14 @@ class BoxManipulationEnv(gym.Env[dict[str, Any], np.ndarray]):
                 f"action must be {self._action_shape[0]} finite numbers in [-1, 1], got {action!r}"
             )
         reason = ""
+        diverged = False
         try:
             a = [min(max(v, -1.0), 1.0) for v in a]
             self.controller.apply(a, session.robot, observer.tcp[:3, 3].tolist())
             session.robot.wait(CONTROL_PERIOD)
             self._obs = observer.observe()
         except SimulationDiverged as err:
-            reason = f"diverged: {err}"
+            reason, diverged = f"diverged: {err}", True
         self._steps += 1
         force = math.sqrt(float(observer.wrench[:3] @ observer.wrench[:3]))  # [N]
         success = not reason and potential.solved()
@@ -237,7 +238,7 @@ class BoxManipulationEnv(gym.Env[dict[str, Any], np.ndarray]):
         if truncated:
             reason = "time limit"
         reward = float(success)
-        if self.reward_mode == "dense" and not reason.startswith("diverged"):
+        if self.reward_mode == "dense" and not diverged:
             phi = potential(observer.grasp_points())
             reward += phi - self._phi
             self._phi = phi

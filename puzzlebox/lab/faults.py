@@ -41,6 +41,7 @@ import numpy as np
 from puzzlebox.lab.cli import scripts_folder, write_json
 from puzzlebox.lab.trial_task import without_timing
 from puzzlebox.learning.memory import MemoryStore
+from puzzlebox.models.try_outcome import Cause
 
 SCRIPTS = scripts_folder()
 """The command-line scripts, run in real processes as a user runs them."""
@@ -442,7 +443,9 @@ def twin_faults(out: Path, config: FaultsConfig) -> list[FaultRow]:
         results = json.loads(results_path.read_text()) if results_path.exists() else {}
         runs = results.get("runs", [])
         run = runs[0] if runs else {}
-        failed = {a["reason"].split(":")[0] for a in run.get("timeline", []) if a["outcome"] == "failed"}
+        failed = {
+            Cause(a["cause"]).prefix for a in run.get("timeline", []) if a["outcome"] == "failed" and a.get("cause")
+        }
         said = "solved anyway" if run.get("solved") else f"ended: {run.get('ended') or 'out of actions'}"
         rows.append(FaultRow(
             f"twin: {name}", 1,

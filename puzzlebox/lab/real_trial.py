@@ -161,7 +161,7 @@ def _unfinished(spec: PuzzleSpec, seed: int, world: RobotWorld | None, wall: flo
     log = world.log if world else []
     names = world.names if world else {}
     assert names is not None  # run_real_trial's world is made with the spec's names
-    actions = [ActionRecord(names[a.marker], a.moved, a.outcome, a.reason) for a in log]
+    actions = [ActionRecord(names[a.marker], a.moved, a.outcome, a.reason, a.cause) for a in log]
     solved = bool(world is not None and world.observe().solved)
     return RunResult(spec.name, seed, solved, len(log), time.perf_counter() - wall, actions, ended=why)
 

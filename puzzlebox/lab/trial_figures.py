@@ -3,6 +3,8 @@ perception error, speed and peak wrist force."""
 
 from __future__ import annotations
 
+from puzzlebox.models.try_outcome import Cause
+
 __all__ = ["twin_figures"]
 
 
@@ -12,7 +14,8 @@ def twin_figures(runs: list) -> dict:
     reasons: dict[str, int] = {}
     for a in actions:
         if a["outcome"] == "failed":
-            key = a["reason"].split(":")[0] or "unknown"
+            cause = a.get("cause") or Cause.from_legacy(a["reason"])  # (a record from before causes were kept)
+            key = Cause(cause).prefix if cause else "unknown"
             reasons[key] = reasons.get(key, 0) + 1
     errors = [e for r in runs for e in r["perceived_position_error_m"].values()]
     sim, wall = sum(r["sim_time_s"] for r in runs), sum(r["wall_time_s"] for r in runs)

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field, fields
 from typing import Any
 
 from puzzlebox.learning import ActionRecord, RunResult
+from puzzlebox.models.try_outcome import Cause
 
 __all__ = ["TrialRecord"]
 
@@ -15,6 +16,16 @@ _OPTIONAL = (
     "peak_true_wrist_force_during", "sensed_sha256", "told_kinds", "found_kinds", "timeline", "robot_time_s", "stopped",
     "perceived_closed_poses",
 )  # fmt: skip
+
+
+def _action(entry: dict[str, Any], known: set[str]) -> ActionRecord:
+    """One ``actions[]`` entry; one written before causes were kept gets the cause its reason text names."""
+    values = {k: v for k, v in entry.items() if k in known}
+    if "cause" not in entry:
+        values["cause"] = Cause.from_legacy(entry.get("reason", ""))
+    elif entry["cause"] is not None:
+        values["cause"] = Cause(entry["cause"])
+    return ActionRecord(**values)
 
 
 @dataclass(frozen=True)
@@ -79,7 +90,7 @@ class TrialRecord:
         """The record of a run entry (:meth:`to_dict`'s layout: a ``results.json`` ``runs[]`` entry or a
         ``DIR/runs/<key>.json`` record) of a symbolic, twin or real trial; ``from_dict(r.to_dict()) == r``."""
         known = {f.name for f in fields(ActionRecord)}
-        actions = tuple(ActionRecord(**{k: v for k, v in a.items() if k in known}) for a in entry.get("actions", ()))
+        actions = tuple(_action(a, known) for a in entry.get("actions", ()))
         extra = {k: entry[k] for k in _OPTIONAL if k in entry}
         if "box_pose" in extra:
             extra["box_pose"] = tuple(extra["box_pose"])
@@ -100,8 +111,8 @@ class TrialRecord:
         out: dict[str, Any] = {
             "spec": self.spec, "seed": self.seed, "solved": self.solved, "num_actions": self.num_actions,
             "wall_time_s": self.wall_time_s,
-            "actions": [{"component": a.component, "moved": a.moved, "outcome": a.outcome, "reason": a.reason}
-                        for a in self.actions],
+            "actions": [{"component": a.component, "moved": a.moved, "outcome": a.outcome, "reason": a.reason,
+                         "cause": a.cause} for a in self.actions],
             "ended": self.ended,
         }  # fmt: skip
         if self.robot_time_s is not None:  # a real cell: what was sensed, no simulator

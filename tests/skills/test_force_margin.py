@@ -17,8 +17,8 @@ from puzzlebox.lab.observers import ObservedRobot, TrialObserver
 from puzzlebox.lab.twin_trial import evaluation_world
 from puzzlebox.models.generator import generate_chain, paper_family
 from puzzlebox.models.placement import placed
-from puzzlebox.skills.door_push import PUSHED_IN_VAIN
-from puzzlebox.skills.primitives import HELD_PART_WAY, STOPPED_DESCENDING, PrimitiveConfig
+from puzzlebox.models.try_outcome import Cause
+from puzzlebox.skills.primitives import PrimitiveConfig
 from puzzlebox.twin.reality import ArmReality, ForceTorqueReality, PhysicsReality, RealityProfile, load_profile
 from puzzlebox.twin.session import TwinSession
 
@@ -51,7 +51,7 @@ def _closed_against_its_locker(kinds: list[str], reality: RealityProfile | None 
 
 def test_a_part_held_open_by_a_lock_with_play_reads_blocked_within_the_margin_and_is_taken_back():
     with _closed_against_its_locker(["slide", "wheel"]) as (session, robot, world, slide, held):
-        assert held.outcome == "blocked" and held.reason.startswith(HELD_PART_WAY), held
+        assert held.outcome == "blocked" and held.cause is Cause.HELD_PART_WAY, held
         assert robot.peak <= FORCE_MARGIN, robot.peak_during
         assert session.component_states()[0] == 1 and world.log[-1].progress > 0.1  # taken back where it was
         # and tried again, the handle is where the fingers descend
@@ -70,7 +70,9 @@ def test_a_descent_onto_a_handle_beside_where_it_was_aimed_stops_at_a_light_touc
         aimed = dataclasses.replace(jm, origin=jm.origin + beside, grasp_point=jm.grasp_point + beside)
         robot.peak = 0.0
         missed = world.toggler.toggle(aimed)
-        assert missed.outcome == "failed" and missed.reason.endswith(STOPPED_DESCENDING), missed
+        assert missed.last_stop().cause is Cause.FORCE_LIMIT and missed.last_stop().stopped_while == "descending", (
+            missed
+        )
         assert robot.peak <= FORCE_MARGIN, robot.peak  # 85 N true with the whole descent at its normal pace
         assert session.component_states()[0] == 0
 
@@ -123,7 +125,7 @@ def test_a_lever_held_open_by_its_lock_is_lifted_at_a_light_force_and_read_held(
         assert world.try_toggle(lever).moved and world.try_toggle(wheel).moved
         robot.peak = 0.0
         held = world.try_toggle(lever)
-        assert held.outcome == "blocked" and held.reason.startswith(HELD_PART_WAY), held
+        assert held.outcome == "blocked" and held.cause is Cause.HELD_PART_WAY, held
         assert robot.peak <= FORCE_MARGIN, robot.peak_during
         travel = session.data.qpos[session.component_qpos[0]] / session.travel[0]
         assert session.component_states()[0] == 1 and travel > 0.9  # taken back into its open stop
@@ -254,6 +256,6 @@ def test_a_door_held_open_by_its_locker_pushed_closed_under_a_late_reading_reads
     # the wrist (the guard stopped it at 61-65 N sensed; under harsh, hard-chain8-s36004 seed 36101: 56 N). Sent back
     # to where the pads are and pressed on at press_speed, the latch is read at ~30 N true.
     with _closed_against_its_locker(["door", locker], LATE_READING) as (session, robot, _, _, held):
-        assert held.outcome == "blocked" and held.reason == PUSHED_IN_VAIN, held
+        assert held.outcome == "blocked" and held.cause is Cause.LOCKED_PUSHED, held
         assert robot.peak <= 35.0, robot.peak  # a margin under 45 N: another pose may meet a stiffer arm
         assert list(session.component_states()) == [1, 1]

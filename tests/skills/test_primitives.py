@@ -11,11 +11,12 @@ from puzzlebox.models.generator import generate_chain
 from puzzlebox.models.kinds import get_kind
 from puzzlebox.models.lock_check import HELD_FRACTION
 from puzzlebox.models.lock_mechanisms import IN_STATE
+from puzzlebox.models.try_outcome import Cause
 from puzzlebox.models.xarm7 import HOME_QPOS, build_xarm7
 from puzzlebox.skills import MarkerDetector, joint_model, lid_height, select_markers, upright_pose
 from puzzlebox.skills.errors import IKFailure
 from puzzlebox.skills.kinematics import ArmKinematics, top_down
-from puzzlebox.skills.primitives import HELD_PART_WAY, PrimitiveConfig, Toggler
+from puzzlebox.skills.primitives import PrimitiveConfig, Toggler
 from puzzlebox.twin.nominal_calibration import nominal_calibration
 from puzzlebox.twin.session import TwinSession
 
@@ -52,7 +53,7 @@ def test_a_latched_part_of_each_kind_is_reported_blocked_and_stays_put(chain, na
     # an interlock holds a closed part once it has left its closed band (anywhere in it the part must leave its
     # locker free), short of half its travel: held part-way, and taken back to where it was grasped
     assert result.peak_opposing_force > 5.0 and IN_STATE - 0.05 < result.progress < HELD_FRACTION
-    assert result.reason.startswith(HELD_PART_WAY)
+    assert result.cause is Cause.HELD_PART_WAY
     assert session.component_states()[j] == 0
     assert abs(session.component_positions()[j] - before) < 0.02  # the lock held against the pull, the part back
     assert session.robot.gripper_opening() <= PrimitiveConfig().pregrasp_closure + 0.05  # and the robot let go
@@ -68,10 +69,11 @@ def test_a_locked_door_pushed_from_closed_is_held_part_way_where_its_lock_stops_
     travel = get_kind("door").travel
     watch = TrueForceWatch(session.robot, session)
     result = Toggler(watch).toggle(models["door-1"], push=True)
-    assert result.outcome == "blocked" and result.reason.startswith(HELD_PART_WAY), result.reason
+    assert result.outcome == "blocked" and result.cause is Cause.HELD_PART_WAY, result.reason
     assert session.component_states()[j] == 0  # the truth: not open
     assert watch.peak < 45.0
-    met = float(result.reason.split("(")[1].split("%")[0]) / 100  # where the face stood still, of the travel
+    met = result.held_at  # where the face stood still, of the travel
+    assert met is not None and result.reason == f"latched: held part-way ({met:.0%} of the travel)"
     assert PrimitiveConfig().blocked_progress < met < HELD_FRACTION  # carried, then held short of half its travel
     assert abs(session.component_positions()[j] / travel - met) < 0.03  # the door stands where it was read held
 

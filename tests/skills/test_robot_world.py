@@ -11,6 +11,7 @@ from world_fixtures import twin_world
 from puzzlebox.learning import DualAgent, OracleAgent, run_episode
 from puzzlebox.models import TryResult, World
 from puzzlebox.models.generator import generate_chain
+from puzzlebox.models.try_outcome import Cause
 from puzzlebox.skills.primitives import ToggleResult
 from puzzlebox.skills.robot_world import DOOR_STAYED, HELD_UNDER_PINCH_AND_PUSH, RobotWorld
 from puzzlebox.twin.nominal_calibration import nominal_calibration
@@ -114,8 +115,9 @@ def test_a_door_seen_shut_after_a_pinch_and_a_push_that_both_went_the_whole_way_
             return ToggleResult("moved", "", 0.95, 20.0)
 
         for seen_after_push, expected in ((DOOR_STAYED, "blocked"), ("", "moved")):
-            looks = iter([TryResult("failed", f"{DOOR_STAYED} (2% of its travel)"),
-                          TryResult("failed", f"{seen_after_push} (1% of its travel)") if seen_after_push
+            stayed = Cause.DOOR_STAYED_SHUT
+            looks = iter([TryResult("failed", f"{DOOR_STAYED} (2% of its travel)", cause=stayed),
+                          TryResult("failed", f"{seen_after_push} (1% of its travel)", cause=stayed) if seen_after_push
                           else TryResult("moved")])  # fmt: skip
             world.toggler.toggle, world._sensed_outcome = toggle, lambda *_, looks=looks: next(looks)
             calls.clear()
@@ -123,6 +125,7 @@ def test_a_door_seen_shut_after_a_pinch_and_a_push_that_both_went_the_whole_way_
             assert calls == [False, True]
             assert outcome.outcome == expected
             assert outcome.reason == (HELD_UNDER_PINCH_AND_PUSH if expected == "blocked" else "")
+            assert outcome.cause is (Cause.LOCKED_PINCH_AND_PUSH if expected == "blocked" else None)
             world.states[door] = 0
 
 
