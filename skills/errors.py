@@ -11,6 +11,10 @@ class SkillError(Exception):
     """Base class of every error raised on purpose by the `skills` package."""
 
 
+class ConfigError(SkillError, ValueError):
+    """A setting of the skills out of its range, or one that does not exist (the message says which)."""
+
+
 class MarkersNotFound(SkillError):
     """Markers the cell expects were not seen (or seen twice) from any camera: no pose is invented."""
 

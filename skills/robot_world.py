@@ -263,7 +263,7 @@ class RobotWorld:
                 wall_time + result.wall_time,
             )
             empty = empty or result.closed_on_nothing
-            if result.outcome == "failed" and result.progress >= self.toggler.config.moved_fraction:
+            if result.outcome == "failed" and result.progress >= self.toggler.config.judgement.moved_fraction:
                 # stopped (force limit, slip) after carrying the handle most of the way: look before retrying
                 # (a door's marker must be seen where an open door's is: one the pads let go part-way hides
                 # it behind its own raised handle, as an open one shows it edge-on)
@@ -287,7 +287,7 @@ class RobotWorld:
             if attempt < self.config.max_retries and is_door:
                 door_at = self._fraction_open(marker)  # a failed try may leave a door part-way: see where
                 # part-way and unseen: a pinch would descend onto it (195 N); it is pushed up under its plate
-                raised = door_at is None and result.progress >= self.toggler.config.blocked_progress
+                raised = door_at is None and result.progress >= self.toggler.config.judgement.blocked_progress
             if (
                 attempt < self.config.max_retries
                 and opening
@@ -299,7 +299,7 @@ class RobotWorld:
             is_door
             and opening
             and result.outcome == "failed"
-            and result.progress >= self.toggler.config.blocked_progress
+            and result.progress >= self.toggler.config.judgement.blocked_progress
         ):
             self.unsettled.add(marker)  # the next try of it looks first
         outcome = self._sensed_outcome(result, marker, opening)
@@ -406,7 +406,7 @@ class RobotWorld:
             result = self.toggler.toggle(
                 jm, opening, where_is=lambda: self._fraction_open(marker), careful=True, cautious=cautious
             )
-            if result.outcome == "failed" and result.progress >= self.toggler.config.moved_fraction:
+            if result.outcome == "failed" and result.progress >= self.toggler.config.judgement.moved_fraction:
                 if self._overview_verdict(marker, opening, unseen_moved=not jm.handling.swings_up).moved:
                     result.outcome, result.reason, result.cause = "moved", "", None
                     result.stopped_while, result.pushed_on, result.not_pushed = "", None, False
@@ -418,7 +418,7 @@ class RobotWorld:
             if outcome.moved:  # (try_toggle keeps it in found_kinds)
                 self.blocked_as.discard(marker)
                 return TryResult("moved", f"moved as a {kind}, not a {in_use.kind}"), total, tuple(tried)
-            carried = result.progress >= self.toggler.config.blocked_progress
+            carried = result.progress >= self.toggler.config.judgement.blocked_progress
             if result.closed_on_nothing:
                 self.empty_handles.setdefault(marker, []).append(jm.grasp_point)
             elif (adopt is None or (not adopt_carried and carried)) and (
@@ -461,7 +461,7 @@ class RobotWorld:
         """The lowest fraction of its travel the door on ``marker``, believed in ``state``, may stand open at: left
         part-way by a failed try (``blocked_progress``), believed open (``open_door_from``), or None: shut."""
         if marker in self.unsettled:
-            return self.toggler.config.blocked_progress
+            return self.toggler.config.judgement.blocked_progress
         return self.config.open_door_from if state == 1 else None
 
     def _door_stayed_shut(self, outcome: TryResult, marker: int) -> bool:
@@ -573,9 +573,9 @@ class RobotWorld:
     def _door_verdict(self, at: float, opening: bool) -> TryResult:
         """Whether a part (a door, a lever) seen at fraction ``at`` of its travel reached its other state."""
         c = self.toggler.config
-        if (at >= c.moved_fraction) if opening else (at <= 1.0 - c.moved_fraction):
+        if (at >= c.judgement.moved_fraction) if opening else (at <= 1.0 - c.judgement.moved_fraction):
             return TryResult("moved")
-        if opening and at < c.blocked_progress:
+        if opening and at < c.judgement.blocked_progress:
             return TryResult("failed", f"{DOOR_STAYED} ({at:.0%} of its travel)", cause=Cause.DOOR_STAYED_SHUT)
         return TryResult(
             "failed", f"SlipDetected: the part stands at {at:.0%} of its travel", cause=Cause.STANDS_PART_WAY

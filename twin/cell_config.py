@@ -1,7 +1,8 @@
 """The twin's own cell config (:class:`models.cell_config.CellConfig`), read off a session's actual constants.
 
-The force thresholds are the skills' (``skills.primitives.PrimitiveConfig.force_limit`` and ``blocked_force``);
-``twin`` may not import ``skills`` (DESIGN.md, "Layers"), so whoever wires the two passes them in.
+The force thresholds are the skills' (``skills.settings.PrimitiveConfig``: ``sensing.force_limit`` and
+``judgement.blocked_force``); ``twin`` may not import ``skills`` (DESIGN.md, "Layers"), so whoever wires the two
+passes them in.
 """
 
 from __future__ import annotations

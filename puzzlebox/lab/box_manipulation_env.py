@@ -153,7 +153,7 @@ class BoxManipulationEnv(gym.Env[dict[str, Any], np.ndarray]):
         self._observer: Observer | None = None
         self._potential: ProgressPotential | None = None
         self._primitives = PrimitiveConfig()  # the skills' force thresholds: the cell config's
-        self._force_limit = self._primitives.force_limit
+        self._force_limit = self._primitives.sensing.force_limit
         self._reusable = dataclasses.replace(profile, name=IDEAL.name) == IDEAL  # draws nothing from its seed
         self._renderer: Renderer | None = None
         self._phi = 0.0
@@ -200,7 +200,9 @@ class BoxManipulationEnv(gym.Env[dict[str, Any], np.ndarray]):
         robot.wait(SETTLE_TIME)
         robot.tare()
         primitives = self._primitives
-        cell = twin_cell_config(session, force_limit=primitives.force_limit, blocked_force=primitives.blocked_force)
+        cell = twin_cell_config(
+            session, force_limit=primitives.sensing.force_limit, blocked_force=primitives.judgement.blocked_force
+        )
         self.controller.reset(robot, (cell.workspace_min, cell.workspace_max))
         self._force_limit = cell.force_limit
         self._obs = observer.observe()

@@ -66,7 +66,9 @@ def test_twin_config_matches_the_constants_twin_and_skills_use(tmp_path):
 
     skills = PrimitiveConfig()
     with TwinSession(paper_family("test")[0], seed=0, reality="realistic") as session:
-        config = twin_cell_config(session, force_limit=skills.force_limit, blocked_force=skills.blocked_force)
+        config = twin_cell_config(
+            session, force_limit=skills.sensing.force_limit, blocked_force=skills.judgement.blocked_force
+        )
         robot = session.robot
         assert config.camera_names == robot.camera_names
         assert {config.overview_camera, config.wrist_camera} == set(robot.camera_names)

@@ -256,7 +256,11 @@ def test_the_worlds_primitives_run_the_cells_thresholds():
             spec.components[spec.index_of(spec.goal.component)].marker, config=world_config,
             detector=MarkerDetector(perception),
         )  # fmt: skip
-    assert (world.toggler.config.force_limit, world.toggler.config.blocked_force, world.toggler.limit) == (45, 15, 45)
+    assert (
+        world.toggler.config.sensing.force_limit,
+        world.toggler.config.judgement.blocked_force,
+        world.toggler.limit,
+    ) == (45, 15, 45)
     assert world.survey.toggler is world.toggler  # the survey moved the arm with them too
 
 

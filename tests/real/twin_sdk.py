@@ -41,14 +41,16 @@ def twin_xarm_cell(session: TwinSession, **overrides: Any) -> CellConfig:
     Gripper's units (850 open .. 0 closed), the F/T sensor read at the primitives' 100 Hz control tick, the
     skills' force thresholds; ``overrides`` replace any field (``force_limit``, ``aruco_dictionary``...)."""
     defaults = PrimitiveConfig()
-    cell = twin_cell_config(session, force_limit=defaults.force_limit, blocked_force=defaults.blocked_force)
+    cell = twin_cell_config(
+        session, force_limit=defaults.sensing.force_limit, blocked_force=defaults.judgement.blocked_force
+    )
     return replace(
         cell,
         name="twin-as-xarm",
         camera_devices={name: i for i, name in enumerate(cell.camera_names)},
         gripper_open=850.0,
         gripper_closed=0.0,
-        ft_rate_hz=1.0 / defaults.tick,
+        ft_rate_hz=1.0 / defaults.motion.tick,
         **overrides,
     )
 

@@ -20,7 +20,9 @@ from puzzlebox.twin.session import TwinSession
 def twin_cell():
     defaults = PrimitiveConfig()
     with TwinSession(paper_family("test")[0], seed=0) as session:
-        return twin_cell_config(session, force_limit=defaults.force_limit, blocked_force=defaults.blocked_force)
+        return twin_cell_config(
+            session, force_limit=defaults.sensing.force_limit, blocked_force=defaults.judgement.blocked_force
+        )
 
 
 def test_skills_configured_from_the_twins_cell_config_see_and_feel_the_twin_exactly_as_todays():
@@ -32,7 +34,9 @@ def test_skills_configured_from_the_twins_cell_config_see_and_feel_the_twin_exac
     runs = {}
     for configured in (True, False):
         with TwinSession(spec, seed=0) as session:
-            cell = twin_cell_config(session, force_limit=defaults.force_limit, blocked_force=defaults.blocked_force)
+            cell = twin_cell_config(
+                session, force_limit=defaults.sensing.force_limit, blocked_force=defaults.judgement.blocked_force
+            )
             config = WorldConfig(survey=SurveyConfig.for_cell(cell), primitives=PrimitiveConfig.for_cell(cell))
             world = RobotWorld(
                 session.robot, nominal_calibration(session), {c.marker: c.kind for c in spec.components},
@@ -54,7 +58,11 @@ def test_another_cells_thresholds_and_cameras_are_the_ones_used(twin_cell):
             "force_limit": 45.0, "blocked_force": 15.0}  # fmt: skip
     cell = CellConfig.from_dict(data)
     primitives = PrimitiveConfig.for_cell(cell, rest_time=2.0)
-    assert (primitives.force_limit, primitives.blocked_force, primitives.rest_time) == (45.0, 15.0, 2.0)
+    assert (primitives.sensing.force_limit, primitives.judgement.blocked_force, primitives.retreat.rest_time) == (
+        45.0,
+        15.0,
+        2.0,
+    )
 
     asked: list[str] = []
 

@@ -163,7 +163,9 @@ def test_a_locked_lever_pressed_by_a_weak_grip_reads_blocked_at_a_light_force():
         robot.peak = 0.0
         pressed = world.try_toggle(world.markers.index(spec.components[lever].marker))
         assert pressed.outcome == "blocked", pressed
-        assert robot.peak < PrimitiveConfig().blocked_force, robot.peak_during  # lighter than a latch elsewhere
+        assert robot.peak < PrimitiveConfig().judgement.blocked_force, (
+            robot.peak_during
+        )  # lighter than a latch elsewhere
         assert session.component_states()[lever] == 0
 
 
@@ -192,7 +194,9 @@ def test_a_free_lever_pressed_along_its_post_is_actuated_at_press_pace_and_opens
         world = watch.world = evaluation_world(session, ObservedRobot(session.robot, [watch]))
         opened = world.try_toggle(world.markers.index(spec.components[lever].marker))
         assert opened.moved and session.component_states()[lever] == 1, opened
-    assert watch.seconds >= config.actuate_time / config.press_pace, watch.seconds  # 6.95 s (4.08 at the usual pace)
+    assert watch.seconds >= config.actuation.actuate_time / config.actuation.press_pace, (
+        watch.seconds
+    )  # 6.95 s (4.08 at the usual pace)
 
 
 @pytest.mark.parametrize("held_at", [64.0, None], ids=["held at 64 deg", "in its end stop"])

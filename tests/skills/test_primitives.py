@@ -1,6 +1,10 @@
 """The toggle primitive opens free parts of each kind and feels latched ones through the wrist F/T
 sensor; unreachable and non-finite IK targets are typed failures."""
 
+import dataclasses
+import json
+from pathlib import Path
+
 import mujoco
 import numpy as np
 import pytest
@@ -14,9 +18,10 @@ from puzzlebox.models.lock_mechanisms import IN_STATE
 from puzzlebox.models.try_outcome import Cause
 from puzzlebox.models.xarm7 import HOME_QPOS, build_xarm7
 from puzzlebox.skills import MarkerDetector, joint_model, lid_height, select_markers, upright_pose
-from puzzlebox.skills.errors import IKFailure
+from puzzlebox.skills.errors import ConfigError, IKFailure
 from puzzlebox.skills.kinematics import ArmKinematics, top_down
 from puzzlebox.skills.primitives import PrimitiveConfig, Toggler
+from puzzlebox.skills.settings import DOOR_PARTS, PHASES
 from puzzlebox.twin.nominal_calibration import nominal_calibration
 from puzzlebox.twin.session import TwinSession
 
@@ -56,7 +61,7 @@ def test_a_latched_part_of_each_kind_is_reported_blocked_and_stays_put(chain, na
     assert result.cause is Cause.HELD_PART_WAY
     assert session.component_states()[j] == 0
     assert abs(session.component_positions()[j] - before) < 0.02  # the lock held against the pull, the part back
-    assert session.robot.gripper_opening() <= PrimitiveConfig().pregrasp_closure + 0.05  # and the robot let go
+    assert session.robot.gripper_opening() <= PrimitiveConfig().approach.pregrasp_closure + 0.05  # and the robot let go
 
 
 def test_a_locked_door_pushed_from_closed_is_held_part_way_where_its_lock_stops_it(chain):
@@ -74,7 +79,9 @@ def test_a_locked_door_pushed_from_closed_is_held_part_way_where_its_lock_stops_
     assert watch.peak < 45.0
     met = result.held_at  # where the face stood still, of the travel
     assert met is not None and result.reason == f"latched: held part-way ({met:.0%} of the travel)"
-    assert PrimitiveConfig().blocked_progress < met < HELD_FRACTION  # carried, then held short of half its travel
+    assert (
+        PrimitiveConfig().judgement.blocked_progress < met < HELD_FRACTION
+    )  # carried, then held short of half its travel
     assert abs(session.component_positions()[j] / travel - met) < 0.03  # the door stands where it was read held
 
 
@@ -191,7 +198,7 @@ def test_a_withdrawal_backs_off_a_held_grip_only_until_the_load_is_relieved():
     robot = _HeldTCP(stiffness=20_000.0, stretch=0.003)
     toggler = Toggler(robot)
     toggler.guard = False  # as in a withdrawal
-    for _ in range(toggler.config.force_filter_samples):
+    for _ in range(toggler.config.sensing.force_filter_samples):
         toggler._sense()
     assert np.linalg.norm(toggler.force_in_base) == pytest.approx(60.0, rel=0.02)
     toggler._relieve()
@@ -220,8 +227,24 @@ def test_a_withdrawal_backs_off_a_held_grip_only_until_the_load_is_relieved():
     ],
 )
 def test_a_config_with_an_impossible_pace_or_yield_is_a_clear_error(field, value, message):
-    with pytest.raises(ValueError, match=message):
-        PrimitiveConfig(**{field: value})
+    with pytest.raises(ConfigError, match=message):
+        PrimitiveConfig.of(**{field: value})
+
+
+def test_the_settings_by_phase_keep_every_default_and_name_what_exists():
+    """Grouped by phase, every setting keeps its name, type and default (taken from the flat config they replaced,
+    tests/skills/data/settings_defaults.json); each is changed by its own name; a wrong name lists the real ones."""
+    before = json.loads((Path(__file__).parent / "data" / "settings_defaults.json").read_text())
+    assert {k: repr(v) for k, v in PrimitiveConfig().flat().items()} == before
+    changed = PrimitiveConfig.of(force_limit=45.0, rest_time=2.0, lean_angle=0.0)
+    assert (changed.sensing.force_limit, changed.retreat.rest_time, changed.approach.lean_angle) == (45.0, 2.0, 0.0)
+    assert changed.changed(force_limit=60.0).flat() == {**changed.flat(), "force_limit": 60.0}
+    door = PrimitiveConfig().push.changed(held_turn=0.1, top_up=False)
+    assert (door.judgement.held_turn, door.top_up, door.plan.lead) == (0.1, False, 0.010)
+    with pytest.raises(ConfigError, match=r"no setting named \['forse_limit'\].*'force_limit'"):
+        PrimitiveConfig.of(forse_limit=45.0)
+    for phase in PHASES + DOOR_PARTS:
+        assert len(dataclasses.fields(phase)) <= 15, phase
 
 
 class _FreeTCP(_HeldTCP):
@@ -246,16 +269,16 @@ def test_a_lift_near_the_base_rises_over_the_post_then_moves_out_before_rising_o
     azimuth = np.radians(69.7)
     start = np.array([radius * np.cos(azimuth), radius * np.sin(azimuth), 0.108])
     robot = _FreeTCP(top_down(start, 0.5))
-    Toggler(robot)._lift_clear(c.approach_height)
+    Toggler(robot)._lift_clear(c.approach.approach_height)
     path = np.array(robot.path)
     out = np.hypot(path[:, 0], path[:, 1])
     end = path[-1]
-    assert end[2] == pytest.approx(start[2] + c.approach_height, abs=0.003)
-    if radius < c.base_radius:
-        low = path[:, 2] < start[2] + c.base_rise - 0.003
+    assert end[2] == pytest.approx(start[2] + c.approach.approach_height, abs=0.003)
+    if radius < c.approach.base_radius:
+        low = path[:, 2] < start[2] + c.approach.base_rise - 0.003
         assert np.all(out[low] < radius + 0.002)  # not across the post
-        high = path[:, 2] > start[2] + c.base_rise + 0.003
-        assert np.all(out[high] > c.base_radius - 0.003)  # out before rising on
+        high = path[:, 2] > start[2] + c.approach.base_rise + 0.003
+        assert np.all(out[high] > c.approach.base_radius - 0.003)  # out before rising on
     else:
         assert np.all(np.abs(out - radius) < 0.002)  # straight up
 
@@ -295,7 +318,7 @@ def _gripper_clearance_from_the_shoulder(joints: list[np.ndarray]) -> float:
     fingers = [
         m.jnt_qposadr[j] for j in range(m.njnt) if any(n in m.joint(j).name for n in ("driver", "inner_knuckle"))
     ]
-    pregrasp = PrimitiveConfig().pregrasp_closure * 0.85  # closure 0..1 over the driver's 0..0.85 rad
+    pregrasp = PrimitiveConfig().approach.pregrasp_closure * 0.85  # closure 0..1 over the driver's 0..0.85 rad
     fromto = np.zeros(6)
     least = 1.0
     for q in joints[::5]:
@@ -322,13 +345,15 @@ def test_an_approach_to_a_handle_near_the_base_comes_in_low_from_outside_and_kee
     path = np.array(robot.path)
     out = np.hypot(path[:, 0], path[:, 1])
     assert path[-1] == pytest.approx(target[:3, 3], abs=0.003)
-    if radius < c.base_radius:
-        low = path[:, 2] < target[2, 3] + c.approach_height - 0.003
+    if radius < c.approach.base_radius:
+        low = path[:, 2] < target[2, 3] + c.approach.approach_height - 0.003
         # in from base_radius (the straight line from the transit waypoint cuts ~3 mm inside it), then down
-        assert np.all((out[low] > c.base_radius - 0.01) | (path[low, 2] < target[2, 3] + c.base_rise + 0.003))
+        assert np.all(
+            (out[low] > c.approach.base_radius - 0.01) | (path[low, 2] < target[2, 3] + c.approach.base_rise + 0.003)
+        )
         assert _gripper_clearance_from_the_shoulder(robot.joints) > 0.002  # 3.1 mm; -17.4 mm at 8 cm (before)
     else:
-        assert path[:, 2].max() > target[2, 3] + c.approach_height - 0.003
+        assert path[:, 2].max() > target[2, 3] + c.approach.approach_height - 0.003
 
 
 def test_a_cautious_descent_runs_at_a_constant_speed_no_faster_than_its_mean():
@@ -343,10 +368,12 @@ def test_a_cautious_descent_runs_at_a_constant_speed_no_faster_than_its_mean():
     toggler._descend_to(target)
     path = np.array(robot.path)
     over = np.hypot(*(path[:, :2] - target[:2, 3]).T) < 1e-3  # the descent: straight down over the grasp point
-    assert path[over, 2].max() == pytest.approx(target[2, 3] + c.approach_height, abs=0.002)
-    below = path[over & (path[:, 2] < target[2, 3] + c.approach_height - 0.001), 2]  # after the travel's arrival
-    speed = -np.diff(below) / c.tick
-    assert speed.max() < 1.1 * c.approach_height / c.cautious_descend_time
+    assert path[over, 2].max() == pytest.approx(target[2, 3] + c.approach.approach_height, abs=0.002)
+    below = path[
+        over & (path[:, 2] < target[2, 3] + c.approach.approach_height - 0.001), 2
+    ]  # after the travel's arrival
+    speed = -np.diff(below) / c.motion.tick
+    assert speed.max() < 1.1 * c.approach.approach_height / c.approach.cautious_descend_time
 
 
 class _PlateBesideKnuckle(_HeldTCP):
@@ -389,9 +416,9 @@ def test_an_opening_finger_that_meets_a_plate_stops_at_a_light_touch_and_lets_go
     snapped = _PlateBesideKnuckle()
     snapping = Toggler(snapped)
     snapping.guard = False  # (it stops at the 60 N guard: the true force has passed it by then)
-    snapping._gripper(c.pregrasp_closure, c.release_time)
+    snapping._gripper(c.approach.pregrasp_closure, c.motion.release_time)
     assert snapped.peak >= 90.0
     robot = _PlateBesideKnuckle()
-    Toggler(robot)._open_gently(c.pregrasp_closure)
-    assert robot.peak < c.lift_contact_force + 10.0, robot.peak
+    Toggler(robot)._open_gently(c.approach.pregrasp_closure)
+    assert robot.peak < c.retreat.lift_contact_force + 10.0, robot.peak
     assert robot.closure < 0.93 - 0.1  # the handle let go

@@ -130,7 +130,7 @@ def test_a_toggle_with_the_wrong_kind_is_stopped_below_the_force_limit():
     """A slide perceived as a wheel is pulled along an arc it cannot follow: the try must end (blocked or
     failed), the part must not be forced, and the filtered wrist force must stay under the limit."""
     spec = generate_chain(["slide", "door"], seed=2)
-    limit = PrimitiveConfig().force_limit
+    limit = PrimitiveConfig().sensing.force_limit
     with TwinSession(spec, seed=0) as session:
         slide = spec.components[0]
         jm = _joint_models(session, {slide.marker: "wheel"})[slide.name]
@@ -158,8 +158,8 @@ def test_a_cautious_descent_meets_a_part_in_its_way_at_a_light_touch():
             true_peak[cautious], reasons[cautious] = watch.peak, result.reason
     config = PrimitiveConfig()
     for cautious in (False, True):
-        assert f"> {config.cautious_contact_force:.0f} N" in reasons[cautious]
-        assert true_peak[cautious] < config.cautious_contact_force + 15.0 < config.force_limit
+        assert f"> {config.approach.cautious_contact_force:.0f} N" in reasons[cautious]
+        assert true_peak[cautious] < config.approach.cautious_contact_force + 15.0 < config.sensing.force_limit
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -169,7 +169,7 @@ def test_a_cautious_descent_is_not_stopped_by_sensor_noise(seed):
     rest above the part, and the free part is moved."""
     noisy = RealityProfile(name="noisy-ft", force_torque=ForceTorqueReality(force_noise=7.0))
     spec = generate_chain(["slide", "door"], seed=2)
-    fixed = replace(PrimitiveConfig(), cautious_noise_margin=0.0, tare_noise=1e9)  # and a ten-reading tare
+    fixed = PrimitiveConfig.of(cautious_noise_margin=0.0, tare_noise=1e9)  # and a ten-reading tare
     for config, outcome in ((PrimitiveConfig(), "moved"), (fixed, "failed")):
         with TwinSession(spec, seed=seed, reality=noisy) as session:
             jm = _joint_models(session)[spec.components[0].name]
@@ -186,7 +186,7 @@ def test_at_15_n_of_sensor_noise_a_latched_part_reads_blocked_and_a_free_one_mov
     sized to the noise measured above the part read both parts right (all 8)."""
     noisy = RealityProfile(name="noisy-ft", force_torque=ForceTorqueReality(force_noise=15.0))
     spec = generate_chain(["slide", "door"], seed=2)  # the door is latched until the slide is open
-    fixed = replace(PrimitiveConfig(), filtered_noise=1e9, tare_noise=1e9)
+    fixed = PrimitiveConfig.of(filtered_noise=1e9, tare_noise=1e9)
     for config, slide_outcome in ((PrimitiveConfig(), "moved"), (fixed, "blocked")):
         with TwinSession(spec, seed=seed, reality=noisy) as session:
             slide, door = (_joint_models(session)[c.name] for c in spec.components)
@@ -363,7 +363,7 @@ def test_a_door_left_part_way_open_is_pushed_on_from_where_it_stands():
         marker = spec.components[door].marker
         result = world.toggler.toggle(world.joint_models[marker], opening=True, door_at=seen)  # as a retry does
         assert result.outcome == "moved" and np.degrees(session.data.qpos[angle]) > 83.0
-        assert result.peak_force < PrimitiveConfig().force_limit
+        assert result.peak_force < PrimitiveConfig().sensing.force_limit
 
 
 @pytest.mark.parametrize("degrees", [72.0, 50.0])
@@ -385,7 +385,7 @@ def test_a_door_left_short_of_its_end_stop_is_pushed_into_it_under_its_plate(deg
         marker = spec.components[door].marker
         result = world.toggler.toggle(world.joint_models[marker], opening=True, raised=True)
         assert result.outcome == "moved" and np.degrees(session.data.qpos[angle]) > 83.0
-        assert result.peak_force < PrimitiveConfig().force_limit
+        assert result.peak_force < PrimitiveConfig().sensing.force_limit
 
 
 def test_a_door_held_open_is_pushed_shut_in_vain_under_the_force_limit():
@@ -409,7 +409,7 @@ def test_a_door_held_open_is_pushed_shut_in_vain_under_the_force_limit():
         world.toggler.robot = watch
         result = world.toggler.toggle(world.joint_models[spec.components[door].marker], opening=False)
         assert result.outcome in ("blocked", "failed") and np.degrees(session.data.qpos[angle]) > 75.0, result
-        assert watch.peak < PrimitiveConfig().force_limit, watch.peak_during
+        assert watch.peak < PrimitiveConfig().sensing.force_limit, watch.peak_during
 
 
 class _ArcForceWatch(TrueForceWatch):
@@ -436,7 +436,7 @@ def test_a_door_arc_planned_from_a_wrong_hinge_yields_to_the_load_across_it():
         name="late", force_torque=ForceTorqueReality(rate_hz=100.0, delay=0.030), arm=ArmReality(command_latency=0.010)
     )
     results = {}
-    for gain in (PrimitiveConfig().comply_gain, 0.0):
+    for gain in (PrimitiveConfig().motion.comply_gain, 0.0):
         with TwinSession(spec, seed=0, reality=late) as session:
             world = twin_world(session)
             door = spec.index_of("door-0")
@@ -445,7 +445,7 @@ def test_a_door_arc_planned_from_a_wrong_hinge_yields_to_the_load_across_it():
             jm = replace(jm, origin=jm.origin + 0.015 * radius / np.linalg.norm(radius))
             watch = _ArcForceWatch(session.robot, session, door, below=60.0)
             world.toggler.robot = watch
-            world.toggler.config = replace(world.toggler.config, comply_gain=gain)
+            world.toggler.config = world.toggler.config.changed(comply_gain=gain)
             result = world.toggler.toggle(jm, opening=True)
             results[gain] = (result.outcome, np.degrees(session.data.qpos[session.component_qpos[door]]), watch.peak)
     (yielding, rigid) = results.values()
@@ -465,9 +465,9 @@ def test_the_lift_off_a_handle_steps_around_an_open_door_standing_over_it():
     filtered reading stopped it; lifted slowly at first, stopped at a light touch and stepped sideways along the
     pads, the toggle ends well under the force limit."""
     spec = placed(paper_family("train")[0], (0.432, 0.2434, 2.0084))
-    limit = PrimitiveConfig().force_limit
+    limit = PrimitiveConfig().sensing.force_limit
     peaks = {}
-    full_pace = replace(PrimitiveConfig(), lift_slow_height=0.0, lift_contact_force=59.0)
+    full_pace = PrimitiveConfig.of(lift_slow_height=0.0, lift_contact_force=59.0)
     for name, config in (("guarded", PrimitiveConfig()), ("full pace", full_pace)):
         with TwinSession(spec, seed=0, config=LATCHED_OPEN) as session:
             world = twin_world(session)
@@ -489,7 +489,7 @@ def test_a_slide_opening_under_an_open_doors_post_is_grasped_leaning_away_from_i
     its closing axis, the gripper passes it and the slide opens with the pads' own load alone."""
     spec = placed(paper_family("train")[0], (0.3785, -0.0679, 1.7884))
     peaks = {}
-    for name, config in (("leaning", PrimitiveConfig()), ("upright", replace(PrimitiveConfig(), lean_angle=0.0))):
+    for name, config in (("leaning", PrimitiveConfig()), ("upright", PrimitiveConfig.of(lean_angle=0.0))):
         with TwinSession(spec, seed=0, config=LATCHED_OPEN) as session:
             world = twin_world(session)
             watch = TrueForceWatch(session.robot, session)
