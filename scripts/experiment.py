@@ -138,7 +138,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--boxes", type=int, default=None, help="hard-sets: test boxes of each family (default 20)")
     parser.add_argument(
         "--seed", type=int, default=None,
-        help="hard-sets: fresh test boxes from seed S and placements from S + 100 (default 36000, 36100)",
+        help="hard-sets: fresh test boxes from seed S and placements from S + 100 (default 36000, 36100); "
+        "twin-learning: test placements from S, training episodes from S + 10000 (default 60000, 70000)",
     )  # fmt: skip
     parser.add_argument(
         "--reference", default=None, metavar="REGRESSION.json",
@@ -146,7 +147,8 @@ def main(argv: list[str] | None = None) -> int:
     )  # fmt: skip
     parser.add_argument(
         "--calibration", choices=("both", "with", "without"), default=None,
-        help="hard-sets: run every trial with the cell calibrated first, without a calibration file, or both (default)",
+        help="hard-sets: run every trial with the cell calibrated first, without a calibration file, or both "
+        "(default); twin-learning: train and test with (default) or without a calibration file",
     )  # fmt: skip
     args = parser.parse_args(argv)
     try:  # SIGINT or SIGTERM, whatever this process inherited: stop now, in one line; every saved job is kept

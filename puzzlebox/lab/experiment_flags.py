@@ -93,12 +93,19 @@ class ExperimentFlags:
             raise ExperimentSettingsError("--steps and --algo go with the manipulation protocol")
         if self.test_set is not None and self.protocol != TWIN_LEARNING:
             raise ExperimentSettingsError("--test-set goes with the twin-learning protocol")
-        hard_only = {"--profile": self.profile, "--boxes": self.boxes, "--seed": self.seed,
-                     "--calibration": self.calibration}  # fmt: skip
+        hard_only = {"--profile": self.profile, "--boxes": self.boxes}
         given = [flag for flag, value in hard_only.items() if value is not None]
         if given and self.protocol != HARD_SETS:
             verb = "goes" if len(given) == 1 else "go"
             raise ExperimentSettingsError(f"{' and '.join(given)} {verb} with the hard-sets protocol")
+        held_out = [
+            flag for flag, value in (("--seed", self.seed), ("--calibration", self.calibration)) if value is not None
+        ]
+        if held_out and self.protocol not in (HARD_SETS, TWIN_LEARNING):
+            verb = "goes" if len(held_out) == 1 else "go"
+            raise ExperimentSettingsError(
+                f"{' and '.join(held_out)} {verb} with the hard-sets and twin-learning protocols"
+            )
         if self.reference is not None and self.protocol != REGRESSION:
             raise ExperimentSettingsError("--reference goes with the regression protocol")
         if self.boxes is not None and not 1 <= self.boxes <= MAX_BOXES:

@@ -91,6 +91,17 @@ def run_twin_learning(flags: ExperimentFlags, echo: Echo = print) -> None:
             raise ExperimentSettingsError("twin-learning --test-set hard runs the memory agent only (the deep agents "
                                           "are trained on the paper's boxes): --agents memory")  # fmt: skip
     config = flags.with_seeds(flags.with_runs(config, "placements", 1), "seeds", as_range=True)
+    if flags.seed is not None:
+        try:
+            config = config.with_seed(flags.seed)
+        except ValueError as err:
+            raise ExperimentSettingsError(f"--seed {flags.seed}: {err}") from err
+    if flags.calibration == "both":
+        raise ExperimentSettingsError(
+            "twin-learning --calibration: with or without (a memory learns through one cell: run each into its own DIR)"
+        )
+    if flags.calibration is not None:
+        config = replace(config, calibrated=flags.calibration == "with")
     out = flags.out_dir()
     flags.write_config(out, TWIN_LEARNING, twin_learning=asdict(config))
     try:

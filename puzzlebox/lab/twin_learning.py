@@ -108,6 +108,9 @@ class TwinLearningConfig:
     eval_seed: int = 60000
     """Placement seeds of the test trials: ``eval_seed + placement`` (the same at every checkpoint)."""
     cell_seed: int = 0
+    calibrated: bool = True
+    """Perceive through a calibration made in the cell from ChArUco images first (the paper's robot was calibrated);
+    False: without a calibration file (the nominal cell), in training and in the test trials."""
     deep_agents: tuple[str, ...] = ("dqn", "model-based")
     """Deep agents measured beside the memory (trained in the symbolic simulator only; empty: none)."""
     deep_episodes: int = 650
@@ -135,6 +138,13 @@ class TwinLearningConfig:
 
     def starts(self) -> tuple[str, ...]:
         return STARTS
+
+    def with_seed(self, seed: int) -> TwinLearningConfig:
+        """Fresh placements and training episodes: test placements' world seeds from ``seed``, training episodes'
+        from ``seed + 10000`` (``seed + 10000 + 1000 s + e``)."""
+        if seed < 0:
+            raise ValueError(f"a seed is >= 0, got {seed}")
+        return dataclasses.replace(self, eval_seed=seed, train_seed=seed + 10000)
 
 
 def _snapshot(store_path: Path, target: Path) -> None:
@@ -194,8 +204,9 @@ def training_chain(settings: dict[str, Any], context: dict[str, Any]) -> dict[st
     try:
         if start != "empty" and store.num_episodes == 0:
             symbolic_training(store, seed, settings["symbolic_episodes"], settings["max_actions"], train, lockers)
+        calibration = settings["calibration"]
         twin = TwinTraining(RealityProfile.from_dict(settings["reality"]),
-                            CellCalibration.from_dict(settings["calibration"]))  # fmt: skip
+                            CellCalibration.from_dict(calibration) if calibration is not None else None)  # fmt: skip
         hours = [0.0] if start == "symbolic" else sorted(settings["hours"])
         checkpoints, skipped, runs = [], [], []
         for h in hours:
@@ -242,7 +253,7 @@ def run_twin_learning(
     phases: dict[str, float] = {}
     deep_records: dict[str, Any] = {}
     with make_executor(workers, ray) as executor:
-        calibration = calibrated_cell(reality, out / "calibrations", executor)
+        calibration = calibrated_cell(reality, out / "calibrations", executor) if config.calibrated else None
         memories = out / "memories"
         chains = [
             Task(f"{start}-s{seed}", training_chain, {
@@ -393,8 +404,10 @@ def markdown(summary: dict[str, Any]) -> str:
     lines = [
         "# Learning in the twin: the paper's robot learning curve, closed in simulation",
         "",
-        f"The memory agent trained end to end in the twin (`{summary['profile']}` profile) {boxes} "
-        f"({config['placements']} random placements each, {config['max_actions']} actions per trial), mean and "
+        f"The memory agent trained end to end in the twin (`{summary['profile']}` profile, "
+        f"{'calibrated first' if config.get('calibrated', True) else 'without a calibration file'}) {boxes} "
+        f"({config['placements']} random placements each, from world seed {config['eval_seed']}; "
+        f"{config['max_actions']} actions per trial), mean and "
         f"spread over {len(config['seeds'])} training seed(s).",
         "",
         "| start | robot hours | solved | mean actions | optimum | ratio | peak force [N] | paper (real robot) |",

@@ -13,6 +13,7 @@ import pytest
 
 from puzzlebox.lab.hard_grid import FORCE_MARGIN_N, HardGridConfig, run_hard_grid, summarise_grid
 from puzzlebox.lab.learning_boxes import LearningBox
+from puzzlebox.lab.twin_learning import TwinLearningConfig
 from puzzlebox.models.generator import paper_family
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -118,4 +119,17 @@ def test_profile_and_boxes_go_with_the_hard_sets_protocol_only(tmp_path):
     result = subprocess.run([sys.executable, str(ROOT / "scripts/experiment.py"), "reality", "--out",
                              str(tmp_path / "out"), "--seed", "91000", "--calibration", "without"],
                             capture_output=True, text=True)  # fmt: skip
-    assert result.returncode == 2 and "--seed and --calibration go with the hard-sets protocol" in result.stderr
+    assert (
+        result.returncode == 2 and "--seed and --calibration go with the hard-sets and twin-learning" in result.stderr
+    )
+
+
+def test_twin_learning_takes_fresh_seeds_and_a_cell_without_calibration(tmp_path):
+    """``twin-learning --seed S``: test placements from S, training episodes from S + 10000; ``--calibration``: with
+    or without a calibration file (not both: a memory learns through one cell)."""
+    fresh = TwinLearningConfig().with_seed(83_000)
+    assert (fresh.eval_seed, fresh.train_seed) == (83_000, 93_000)
+    command = [sys.executable, str(ROOT / "scripts/experiment.py"), "twin-learning", "--out", str(tmp_path / "out")]
+    result = subprocess.run([*command, "--calibration", "both"], capture_output=True, text=True)
+    assert result.returncode == 2 and "twin-learning --calibration: with or without" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1 and not (tmp_path / "out").exists()
