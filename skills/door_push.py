@@ -17,7 +17,6 @@ from __future__ import annotations
 import collections
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -25,13 +24,11 @@ from puzzlebox.models.kinds import HANDLE_HEIGHT, HANDLE_MARGIN, HANDLE_SIZE
 from puzzlebox.models.try_outcome import Cause
 from puzzlebox.skills.errors import IKFailure
 from puzzlebox.skills.joint_model import GRASP_DEPTH, JointModel, cross
-from puzzlebox.skills.kinematics import ArmKinematics, top_down
+from puzzlebox.skills.kinematics import top_down
 from puzzlebox.skills.pacing import Pacing
-from puzzlebox.skills.settings import DoorPushConfig, PrimitiveConfig
+from puzzlebox.skills.pinch import Pinch
+from puzzlebox.skills.settings import DoorPushConfig
 from puzzlebox.skills.toggle_result import HELD_PART_WAY, LATCHED, ToggleResult
-
-if TYPE_CHECKING:
-    from puzzlebox.models.robot import Robot
 
 PUSHED_IN_VAIN = LATCHED[Cause.LOCKED_PUSHED]
 
@@ -101,31 +98,15 @@ class DoorPush:
         return math.atan2(b, a) - math.acos(max(-1.0, min(1.0, self.contact[0] / radius)))
 
 
-class DoorPushing:
-    """The door pushes of :class:`skills.primitives.Toggler` (a mixin: it moves through the toggler's own
-    ticks, force guard and retreat, and reads ``config.push``)."""
+class DoorPusher:
+    """Pushes doors (see the module docstring): the pad's plan and its reading, moved by the pinch's descent, the
+    guarded motion and the retreat."""
 
-    # What the pushes use of the toggler, declared for type checkers (Toggler sets and defines them).
-    config: PrimitiveConfig
-    robot: Robot
-    ik: ArmKinematics
-    force_in_base: np.ndarray
-    slowdown: float
-    phase: str
-    progress: float
-    cautious: bool
+    def __init__(self, pinch: Pinch) -> None:
+        self.pinch, self.retreat, self.motion, self.watch = pinch, pinch.retreat, pinch.motion, pinch.watch
+        self.robot, self.config, self.ik = pinch.robot, pinch.config, pinch.ik
 
-    if TYPE_CHECKING:
-
-        def grasp_yaw(self, jm: JointModel) -> float: ...
-        def filtered_noise_now(self) -> float: ...
-        def move_to(self, target: np.ndarray, duration: float) -> None: ...
-        def _tick(self, target: np.ndarray) -> tuple[float, float]: ...
-        def _descend_to(self, target: np.ndarray) -> None: ...
-        def _let_go_and_retreat(self, guarded: bool = True) -> None: ...
-        def _verdict(self, progress: float, forces: list[float], latched: Cause | None = None) -> ToggleResult: ...
-
-    def _push_door_open(self, jm: JointModel, start: float = 0.0) -> ToggleResult:
+    def push_open(self, jm: JointModel, start: float = 0.0) -> ToggleResult:
         """Open a door by pushing the back face of its handle with the inner face of a finger pad (see
         :mod:`skills.door_push`): descend behind the handle, then swing the pad along the door's arc,
         ``depth`` into the face, measuring the door's angle from where the pad rests on the face (the
@@ -142,15 +123,15 @@ class DoorPushing:
         def tcp_for(pad_edge: np.ndarray) -> np.ndarray:
             return top_down(pad_edge - p.plan.pad_offset * door.e_x, yaw)
 
-        self._descend_to(tcp_for(door.point_at(start * door.travel, door.contact + np.array([p.plan.gap, 0.0]))))
-        self.phase = "actuating"
-        result = self._swing_door(door, tcp_for, start)
-        self.phase = "retreating"
-        self._let_go_and_retreat()
-        self.phase = "moving"
+        self.pinch.descend_to(tcp_for(door.point_at(start * door.travel, door.contact + np.array([p.plan.gap, 0.0]))))
+        self.watch.phase = "actuating"
+        result = self.swing(door, tcp_for, start)
+        self.watch.phase = "retreating"
+        self.retreat.let_go_and_retreat()
+        self.watch.phase = "moving"
         return result
 
-    def _push_door_closed(self, jm: JointModel, start: float = 0.0) -> ToggleResult:
+    def push_closed(self, jm: JointModel, start: float = 0.0) -> ToggleResult:
         """Close a door by pushing its plate down with the edges of both finger pads, the fingers straddling
         the handle (they close along the hinge): the pads' outer edge (``pad_half_width`` along the
         gripper's x = the door's ``e_x``) rests on the plate's top face ``close_x`` from the hinge and
@@ -160,22 +141,22 @@ class DoorPushing:
         c = self.config
         p = c.push
         door = DoorPush.of(jm, p.plan.height)
-        yaw = self.grasp_yaw(jm)  # fingers along the hinge: the gripper's x is the door's e_x
+        yaw = self.pinch.grasp_yaw(jm)  # fingers along the hinge: the gripper's x is the door's e_x
         on_plate = np.array([p.plan.close_x, door.plate_top - p.plan.depth])
 
         def tcp_for(edge: np.ndarray) -> np.ndarray:
             return top_down(edge - p.plan.pad_half_width * door.e_x, yaw)
 
         above_plate = on_plate + np.array([0.0, p.plan.depth + p.plan.gap])
-        self._descend_to(tcp_for(door.point_at((1.0 - start) * door.travel, above_plate)))
+        self.pinch.descend_to(tcp_for(door.point_at((1.0 - start) * door.travel, above_plate)))
 
-        self.phase = "actuating"
+        self.watch.phase = "actuating"
         lead = p.plan.lead / (door.travel * p.plan.close_x)
         end = 1.0  # closed
-        ticks = round(p.plan.close_time * self.slowdown / c.motion.tick)
-        contact = max(p.judgement.contact_force, p.judgement.contact_noise_margin * self.filtered_noise_now())
+        ticks = round(p.plan.close_time * self.watch.slowdown / c.motion.tick)
+        contact = max(p.judgement.contact_force, p.judgement.contact_noise_margin * self.watch.filtered_noise_now())
         per_tick = c.motion.tick / (
-            self.slowdown * door.travel * p.plan.close_x
+            self.watch.slowdown * door.travel * p.plan.close_x
         )  # of the travel per tick, for 1 m/s at the pads
 
         def scheduled(k: float) -> float:  # where the pads are sent at (schedule) tick k: slow onto the lid
@@ -198,7 +179,7 @@ class DoorPushing:
         progress = 0.0
         pressed_from: float | None = None  # the progress at which the pads first pressed on the plate
         self.ik.set_joints(self.robot.joint_positions())
-        turn_at_start = door.turn_of(self._pad_edge(door, p.plan.pad_half_width))
+        turn_at_start = door.turn_of(self.pad_edge(door, p.plan.pad_half_width))
         result = None
         k = 0
         schedule = 0.0  # the schedule's clock [ticks]: slowed while the pads search for the plate
@@ -212,15 +193,15 @@ class DoorPushing:
                 step = min(1.0, speed * per_tick / nominal) if nominal > 0 else 1.0
             schedule += step
             s = min(scheduled(schedule), max(progress, start) + lead)
-            closing_in = max(0.0, 1.0 - k * c.motion.tick / (p.plan.approach_time * self.slowdown)) * (
+            closing_in = max(0.0, 1.0 - k * c.motion.tick / (p.plan.approach_time * self.watch.slowdown)) * (
                 p.plan.gap + p.plan.depth
             )
-            self._tick(tcp_for(door.point_at((1.0 - s) * door.travel, on_plate + np.array([0.0, closing_in]))))
-            turn = door.turn_of(self._pad_edge(door, p.plan.pad_half_width))
-            progress = self.progress = start + (turn_at_start - turn) / door.travel
+            self.motion.tick(tcp_for(door.point_at((1.0 - s) * door.travel, on_plate + np.array([0.0, closing_in]))))
+            turn = door.turn_of(self.pad_edge(door, p.plan.pad_half_width))
+            progress = self.pinch.progress = start + (turn_at_start - turn) / door.travel
             angle = (1.0 - max(progress, 0.0)) * door.travel
-            forces.append(float(self.force_in_base @ door.motion_direction(angle)))  # opposing a closing motion
-            magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
+            forces.append(float(self.watch.force_in_base @ door.motion_direction(angle)))  # opposing a closing motion
+            magnitude = math.sqrt(self.watch.force_in_base @ self.watch.force_in_base)  # np.linalg.norm, bit for bit
             if pressed_from is None and forces[-1] > contact:
                 pressed_from = progress
                 # the command runs the arm's tracking lag ahead of the pads (~1.5 mm at ``search_speed``): pressed
@@ -240,16 +221,16 @@ class DoorPushing:
                                       forces=forces, cause=Cause.LOCKED_PUSHED)  # fmt: skip
                 break
         if result is None:
-            result = self._verdict(progress, forces, Cause.LOCKED_PUSHED)
+            result = self.pinch.verdict(progress, forces, Cause.LOCKED_PUSHED)
         # off the plate along its normal before letting go: held pressed on a latched plate (the command runs
         # ``lead`` into it) while the gripper opened, a harsh latch's play built 65 N on the wrist
-        self._back_off(door, (1.0 - max(progress, 0.0)) * door.travel + math.pi / 2)
-        self.phase = "retreating"
-        self._let_go_and_retreat()
-        self.phase = "moving"
+        self.back_off(door, (1.0 - max(progress, 0.0)) * door.travel + math.pi / 2)
+        self.watch.phase = "retreating"
+        self.retreat.let_go_and_retreat()
+        self.watch.phase = "moving"
         return result
 
-    def _top_up_door(self, jm: JointModel) -> ToggleResult:
+    def top_up(self, jm: JointModel) -> ToggleResult:
         """Push a door the pinch opened on to its end stop, under its plate: a handle that lags the fingers
         leaves the door short of the stop (78 deg under the harsh grip), and a door short of it sinks back
         under its own weight (to 66 deg within 45 s) over its neighbour's handle, onto which the next
@@ -265,7 +246,7 @@ class DoorPushing:
         c = self.config
         p = c.push
         door = DoorPush.of(jm, p.plan.height)
-        yaw = self.grasp_yaw(jm)  # fingers along the hinge: the gripper's x is the door's e_x
+        yaw = self.pinch.grasp_yaw(jm)  # fingers along the hinge: the gripper's x is the door's e_x
         free_edge = door.contact[0] + HANDLE_MARGIN - HANDLE_SIZE / 2  # the plate's far edge from the hinge
         x_start = free_edge * math.cos(p.top_up_plan.top_up_from) + p.top_up_plan.top_up_clearance
         x_end = (
@@ -281,43 +262,43 @@ class DoorPushing:
                 door.origin + (edge_x + p.plan.pad_half_width) * door.e_x + height_at(edge_x) * door.e_z, yaw
             )
 
-        cautious, self.cautious = self.cautious, True  # beside a door standing at an unknown angle
+        cautious, self.pinch.cautious = self.pinch.cautious, True  # beside a door standing at an unknown angle
         try:
-            self._descend_to(tcp_for(x_start))
+            self.pinch.descend_to(tcp_for(x_start))
         finally:
-            self.cautious = cautious
-        self.phase = "actuating"
+            self.pinch.cautious = cautious
+        self.watch.phase = "actuating"
         path = math.hypot(
             x_start - x_end, p.top_up_plan.top_up_height - p.top_up_plan.top_up_low
         )  # (the dive is part of the way)
-        ticks = max(1, round(path / p.top_up_plan.top_up_speed * self.slowdown / c.motion.tick))
+        ticks = max(1, round(path / p.top_up_plan.top_up_speed * self.watch.slowdown / c.motion.tick))
         stop = min(
             c.judgement.blocked_magnitude,
-            p.top_up_plan.top_up_force + p.top_up_plan.top_up_noise_margin * self.filtered_noise_now(),
+            p.top_up_plan.top_up_force + p.top_up_plan.top_up_noise_margin * self.watch.filtered_noise_now(),
         )
         forces: list[float] = []
         edge_x = x_start
         self.ik.set_joints(self.robot.joint_positions())
         for k in range(1, ticks + round(c.motion.settle_time / c.motion.tick) + 1):
-            self._tick(tcp_for(x_start + (x_end - x_start) * min(k / ticks, 1.0)))  # at a constant speed
-            edge_x = float((self._pad_edge(door, -p.plan.pad_half_width) - door.origin) @ door.e_x)
-            forces.append(float(-self.force_in_base @ door.e_x))
-            magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
+            self.motion.tick(tcp_for(x_start + (x_end - x_start) * min(k / ticks, 1.0)))  # at a constant speed
+            edge_x = float((self.pad_edge(door, -p.plan.pad_half_width) - door.origin) @ door.e_x)
+            forces.append(float(-self.watch.force_in_base @ door.e_x))
+            magnitude = math.sqrt(self.watch.force_in_base @ self.watch.force_in_base)  # np.linalg.norm, bit for bit
             if magnitude > stop:
                 break  # held where it stands, or in its end stop
         progress = math.atan2(height_at(edge_x), max(edge_x, 1e-6)) / door.travel  # the underside's angle there
-        result = self._verdict(progress, forces)
-        self._back_off(door, 0.0)  # off the plate (along e_x) before lifting
-        self.phase = "retreating"
-        self._let_go_and_retreat()
-        self.phase = "moving"
+        result = self.pinch.verdict(progress, forces)
+        self.back_off(door, 0.0)  # off the plate (along e_x) before lifting
+        self.watch.phase = "retreating"
+        self.retreat.let_go_and_retreat()
+        self.watch.phase = "moving"
         return result
 
-    def _pad_edge(self, door: DoorPush, offset: float) -> np.ndarray:
+    def pad_edge(self, door: DoorPush, offset: float) -> np.ndarray:
         """The pushing pad edge, ``offset`` from the TCP along the door's ``e_x``, where the robot measures it [m]."""
         return self.robot.tcp_pose_in_base()[:3, 3] + offset * door.e_x
 
-    def _swing_door(self, door: DoorPush, tcp_for, start: float = 0.0) -> ToggleResult:
+    def swing(self, door: DoorPush, tcp_for, start: float = 0.0) -> ToggleResult:
         """Swing the pad along the door's arc from ``start`` (fraction of the travel) up to the end stop;
         decide moved, blocked or failed.
 
@@ -338,7 +319,11 @@ class DoorPushing:
 
         def pressed(k: int) -> np.ndarray:  # the pad's point on the door at tick k: climbing the face at first
             return np.array(
-                [x, door.contact[1] + p.plan.climb * min(k * c.motion.tick / (p.plan.climb_time * self.slowdown), 1.0)]
+                [
+                    x,
+                    door.contact[1]
+                    + p.plan.climb * min(k * c.motion.tick / (p.plan.climb_time * self.watch.slowdown), 1.0),
+                ]
             )
 
         def climb_turn(k: int) -> float:  # what the climb alone adds to the pad's turn about the hinge [rad]
@@ -346,8 +331,8 @@ class DoorPushing:
 
         lead = p.plan.lead / (door.travel * float(np.hypot(*door.contact)))
         end = 1.0 + p.plan.overtravel
-        contact = max(p.judgement.contact_force, p.judgement.contact_noise_margin * self.filtered_noise_now())
-        ticks = round(c.actuation.actuate_time * self.slowdown / c.motion.tick)
+        contact = max(p.judgement.contact_force, p.judgement.contact_noise_margin * self.watch.filtered_noise_now())
+        ticks = round(c.actuation.actuate_time * self.watch.slowdown / c.motion.tick)
         pace = (end - start) / ticks  # of the travel per tick, past the slow start
         slow_span = max(
             0.0, c.actuation.breakaway_fraction - start
@@ -360,20 +345,22 @@ class DoorPushing:
         last_pressed, last_face = start, 0.0  # progress and face angle when the pad last pressed on the face
         track: collections.deque[tuple[float, float]] = collections.deque()  # (progress, face) pressed, in a row
         self.ik.set_joints(self.robot.joint_positions())
-        turn_at_start = door.turn_of(self._pad_edge(door, p.plan.pad_offset))
+        turn_at_start = door.turn_of(self.pad_edge(door, p.plan.pad_offset))
         for k in range(1, last_tick + 1 + round(2 * c.motion.settle_time / c.motion.tick)):
             paced = pacing.at(k)
             s = min(start + paced, end, max(progress, start) + lead)
-            closing_in = max(0.0, 1.0 - k * c.motion.tick / (p.plan.approach_time * self.slowdown)) * (
+            closing_in = max(0.0, 1.0 - k * c.motion.tick / (p.plan.approach_time * self.watch.slowdown)) * (
                 p.plan.gap + p.plan.depth
             )
-            self._tick(tcp_for(door.point_at(s * door.travel, pressed(k) + np.array([closing_in, 0.0]))))
-            pad_edge = self._pad_edge(door, p.plan.pad_offset)
-            progress = self.progress = start + (door.turn_of(pad_edge) - turn_at_start - climb_turn(k)) / door.travel
+            self.motion.tick(tcp_for(door.point_at(s * door.travel, pressed(k) + np.array([closing_in, 0.0]))))
+            pad_edge = self.pad_edge(door, p.plan.pad_offset)
+            progress = self.pinch.progress = (
+                start + (door.turn_of(pad_edge) - turn_at_start - climb_turn(k)) / door.travel
+            )
             angle = max(progress, 0.0) * door.travel
-            normal = float(self.force_in_base @ door.face_normal(angle))
-            forces.append(float(-self.force_in_base @ door.motion_direction(angle)))
-            magnitude = math.sqrt(self.force_in_base @ self.force_in_base)  # np.linalg.norm, bit for bit
+            normal = float(self.watch.force_in_base @ door.face_normal(angle))
+            forces.append(float(-self.watch.force_in_base @ door.motion_direction(angle)))
+            magnitude = math.sqrt(self.watch.force_in_base @ self.watch.force_in_base)  # np.linalg.norm, bit for bit
             if s > 1.0 and magnitude > c.actuation.overtravel_force:  # in the end stop: stop here
                 end = max(1.0, min(progress, s))
             face = door.angle_from_contact(pad_edge) / door.travel
@@ -387,15 +374,15 @@ class DoorPushing:
             held = (
                 len(track) > 0
                 and pressed_at is not None
-                and self._held_part_way(track, pressed_at[1], p.judgement.held_turn / door.travel, normal)
+                and self.held_part_way(track, pressed_at[1], p.judgement.held_turn / door.travel, normal)
             )
             if held:
-                self._back_off(door, angle)
+                self.back_off(door, angle)
                 return ToggleResult("blocked", f"{HELD_PART_WAY} ({face:.0%} of the travel)", progress, max(forces),
                                     forces=forces, cause=Cause.HELD_PART_WAY, held_at=face)  # fmt: skip
             slid = pressed_at is not None and progress - pressed_at[0] >= p.judgement.slide_turn / door.travel
             if slid and pressed_at is not None and face - pressed_at[1] < 0.5 * (progress - pressed_at[0]):
-                self._back_off(door, angle)
+                self.back_off(door, angle)
                 if (
                     start >= c.judgement.blocked_progress
                 ):  # a door held part-way open is stuck, not latched: no evidence
@@ -406,19 +393,19 @@ class DoorPushing:
             if progress < c.judgement.blocked_progress and (
                 normal > p.judgement.blocked_force or magnitude > c.judgement.blocked_magnitude
             ):
-                self._back_off(door, angle)
+                self.back_off(door, angle)
                 return ToggleResult("blocked", PUSHED_IN_VAIN, progress, max(forces), forces=forces,
                                     cause=Cause.LOCKED_PUSHED)  # fmt: skip
-        self._back_off(door, max(progress, 0.0) * door.travel)
+        self.back_off(door, max(progress, 0.0) * door.travel)
         if last_pressed < c.judgement.moved_fraction:
             # the pad lost the face before the door was open: it went over the post (a latched door, inside the
             # slide test's 7 deg: it read "moved" with the door shut) or the door is elsewhere. How far the door
             # went is how far its face turned while pressed.
             at = start + (max(last_face - pressed_at[1], 0.0) if pressed_at is not None else 0.0)
-            return self._verdict(at, forces, Cause.LOCKED_PUSHED if start < c.judgement.blocked_progress else None)
-        return self._verdict(progress, forces)  # a latch was decided on the way: short of it, no evidence
+            return self.pinch.verdict(at, forces, Cause.LOCKED_PUSHED if start < c.judgement.blocked_progress else None)
+        return self.pinch.verdict(progress, forces)  # a latch was decided on the way: short of it, no evidence
 
-    def _held_part_way(
+    def held_part_way(
         self, track: collections.deque[tuple[float, float]], first_face: float, turn: float, normal: float
     ) -> bool:
         """Whether the door stopped part-way against the push (a lock's rod at its wall), the pad pressed on its face
@@ -438,14 +425,14 @@ class DoorPushing:
             return False  # (further, the door is in its end stop: open)
         if progress - begun >= turn and face - face_then < 0.5 * (progress - begun):
             return True
-        window = max(2, round(c.judgement.stall_window * self.slowdown / c.motion.tick))
+        window = max(2, round(c.judgement.stall_window * self.watch.slowdown / c.motion.tick))
         return (
             normal > c.judgement.stall_force
             and len(track) >= window
             and abs(face - track[-window][1]) < c.judgement.stall_progress
         )
 
-    def _back_off(self, door: DoorPush, angle: float) -> None:
+    def back_off(self, door: DoorPush, angle: float) -> None:
         """Take the pad off the handle's face (along its normal, :meth:`DoorPush.face_normal` at ``angle``; a
         quarter turn more is the plate's top face) before lifting: pressed on, it would drag the handle up with
         it."""
@@ -455,9 +442,9 @@ class DoorPushing:
         away[:3, 3] += p.plan.gap * door.face_normal(angle)
         self.ik.set_joints(self.robot.joint_positions())
         try:
-            self.move_to(away, c.motion.release_time)
+            self.motion.move_to(away, c.motion.release_time)
         except IKFailure:
             pass  # lifting next
 
 
-__all__ = ["DoorPush", "DoorPushConfig", "DoorPushing", "PUSHED_IN_VAIN"]
+__all__ = ["DoorPush", "DoorPushConfig", "DoorPusher", "PUSHED_IN_VAIN"]

@@ -489,7 +489,7 @@ class RobotWorld:
 
     def _stands_at(self, marker: int) -> float | None:
         """Where a part whose small motion is read from its marker close up and that does not swing up (a lever)
-        stands before a try (fraction of its travel; :attr:`Toggler.head_start`), or None: not looked at."""
+        stands before a try (fraction of its travel; :attr:`Pinch.head_start`), or None: not looked at."""
         handling = self.joint_models[marker].handling
         if handling.swings_up or handling.verdict != "arc" or not handling.read_close_up:
             return None

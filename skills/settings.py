@@ -51,7 +51,7 @@ class MotionConfig:
     """Time of the short moves off a load (backing off after a force stop, a pad off a door's plate before letting
     go), and of a held handle's way back per 10 % of the travel it covered [s]."""
     transit_height: float = 0.35
-    """TCP height of the waypoint of a move from afar (``Toggler.travel_to``) [m]: well above the 8 cm box
+    """TCP height of the waypoint of a move from afar (``GuardedMotion.travel_to``) [m]: well above the 8 cm box
     and its 3.5 cm handles."""
     transit_xy: tuple[float, float] = (0.42, 0.0)
     """Where that waypoint is, in the base frame [m]: over the middle of the reachable workspace."""
@@ -96,7 +96,7 @@ class SensingConfig:
     force_filter_max_samples: int = 30
     """Longest running median of the wrench [ticks]. A longer median is later by half its growth, so every
     motion in contact (descent, closing on the handle, actuation, pushes) is slowed by the same ratio
-    (:attr:`Toggler.slowdown`): a force rising against a stop then builds no more during the delay than it
+    (:attr:`ForceWatch.slowdown`): a force rising against a stop then builds no more during the delay than it
     does with the 5-tick median. At 15 N of noise a 23-tick median at full pace met a door shut on its lid
     with 100 N (random agent)."""
     force_limit: float = 60.0
@@ -141,7 +141,7 @@ class ApproachConfig:
     112 N on the wrist in one tick, and the servos went on pressing with 55-70 N while the 40 ms late, filtered
     reading caught up with the 60 N guard (wrist camera's hand-eye pose 20 mm off; issue 37)."""
     touch_speed: float = 0.006
-    """TCP speed over ``touch_height`` [m/s] (slower by :attr:`Toggler.slowdown`): the impact of the touch, one
+    """TCP speed over ``touch_height`` [m/s] (slower by :attr:`ForceWatch.slowdown`): the impact of the touch, one
     tick's spike, grows with it (fingers on a handle's top: 112 N at 4.5 cm/s, 22-45 N at 0.5-1.1 cm/s), and so
     does the servos' tracking lag they press on with while the filtered reading catches up."""
     cautious_descend_time: float = 6.5
@@ -167,7 +167,7 @@ class ApproachConfig:
     ``base_rise`` above where it let go: the arm folded over its own shoulder to reach there (a drawer pulled
     towards the base, the TCP 0.176 m from its axis), and straight up the gripper's knuckle met link 2 (224 N
     true) 6 cm up, with 1 cm of clearance where it let go; moved out first, never under 6 mm (robot model). An
-    approach to above such a part comes in from it at ``base_rise`` (:meth:`Toggler._approach`)."""
+    approach to above such a part comes in from it at ``base_rise`` (:meth:`Pinch.approach`)."""
     base_rise: float = 0.035
     """How far the gripper rises above where it let go before it moves out to ``base_radius`` [m]: clear of the
     35 mm post it straddled, which moving across would push; and the height above the grasp point from which a
@@ -260,7 +260,7 @@ class ActuationConfig:
     handle is. (Under the harsh grip the lag is a fifth of the fingers' turn, fingers at 98 deg leaving a
     door at 78: more over-travel met the end stop with 70 N jolts; a top-up push finishes those doors.)"""
     overtravel_comply: bool = True
-    """Yield across the path in the over-travel too (:meth:`Toggler._yield_across`), until the end stop is felt
+    """Yield across the path in the over-travel too (:meth:`GuardedMotion.yield_across`), until the end stop is felt
     (``end_stop_force``), then return to the planned arc: the planned arc's mismatch with the door's true arc grows
     past the travel (a door still rising, near upright), and held on the arc it loaded the grasp with ~32 N
     *across* the motion (2-5 N along it), on which the handle's stick-slip in the pads put one-tick spikes of
@@ -325,7 +325,7 @@ class JudgementConfig:
     """Least progress (fraction of the travel) over ``stall_window`` of a part that has not stalled: a free part
     covers ~2 % in that time; a slide met by a pin crept 0.6 % in 0.15 s as the load rose 10 N a tick."""
     stall_window: float = 0.05
-    """Time over which a stall is measured [s] (longer by :attr:`Toggler.slowdown` with the motions)."""
+    """Time over which a stall is measured [s] (longer by :attr:`ForceWatch.slowdown` with the motions)."""
     end_stop_force: float = 20.0
     """Filtered force magnitude past the travel that tells a pinched door has reached its end stop [N] (a
     lagging handle pressed into it loads the grasp with 20-30 N, one that follows closely 47 N; weak pads
@@ -367,7 +367,7 @@ class RetreatConfig:
     pushes) to clear what stopped the lift [m]: a pad is 30 mm long, a post 12 mm wide."""
     gentle_release_speed: float = 0.4
     """Rate at which the gripper's commanded closure ramps open to let go of a handle [1/s], divided by
-    :attr:`Toggler.slowdown`: the servo alone snaps the fingers open at ~2/s, and an inner knuckle swinging out
+    :attr:`ForceWatch.slowdown`: the servo alone snaps the fingers open at ~2/s, and an inner knuckle swinging out
     under the plate of an open door (one the world did not count as standing over the part) met it with 38 N in
     one tick and 93 N before the late, filtered reading passed the guard (paper-test-2, harsh; 34 N ramped)."""
     lift_time: float = 0.8
@@ -414,7 +414,7 @@ class DoorPushPlan:
     deg only, the pads met a door fallen shut at ~40 mm/s with 72 N)."""
     press_speed: float = 0.004
     """Speed of the pads along the arc once they press on the plate, until the door has followed them by
-    ``blocked_progress`` of its travel (:meth:`DoorPushing._push_door_closed`) [m/s]: a door held open by its
+    ``blocked_progress`` of its travel (:meth:`DoorPusher.push_closed`) [m/s]: a door held open by its
     locker rests on the lock's pin (it sinks onto it under its own weight), and the pads, pressed into a plate that
     does not give, load the wrist by the arm's stiffness (15-35 N/mm) times their speed while the harsh reading is
     ~60 ms late. Sped up to the schedule's pace as the contact was felt, a door held at 61 deg put 56-104 N true on
@@ -451,7 +451,7 @@ class DoorPushJudgement:
     """Normal force on the handle's back face that means the pad is pressing on it [N] (10 sigma of the harsh
     F/T noise; a light free door may turn before it is felt: then no slide test is needed)..."""
     contact_noise_margin: float = 3.0
-    """... or this many times the noise of the filtered force (:meth:`Toggler.filtered_noise_now`), if larger:
+    """... or this many times the noise of the filtered force (:meth:`ForceWatch.filtered_noise_now`), if larger:
     at 15 N of F/T noise the noise alone passed 3 N before the pads met a door latched open, its push was then
     counted from there and had gone past ``blocked_progress`` when the plate pressed back (64 N)."""
     slide_turn: float = math.radians(7.0)
@@ -476,7 +476,7 @@ class TopUpPlan:
     """The push on up under a door's plate that finishes a door left short of its end stop."""
 
     top_up_from: float = math.radians(50.0)
-    """Lowest door angle a top-up push (:meth:`DoorPushing._top_up_door`) is placed for [rad]: a pinch that
+    """Lowest door angle a top-up push (:meth:`DoorPusher.top_up`) is placed for [rad]: a pinch that
     carried its fingers past ``moved_fraction`` left the door above it (the handle lags the fingers by up to a
     quarter of their turn)."""
     top_up_height: float = 0.055
@@ -507,7 +507,7 @@ class TopUpPlan:
     friction, mass) pressed back with up to 12 N (12 draws). Stopped here, a door held at 56-72 deg or in its
     stop took 18-24 N true under the harsh reading, against 40-50 N at ``blocked_magnitude``..."""
     top_up_noise_margin: float = 5.0
-    """... plus this many times the noise of the filtered force (:meth:`Toggler.filtered_noise_now`, per axis:
+    """... plus this many times the noise of the filtered force (:meth:`ForceWatch.filtered_noise_now`, per axis:
     its magnitude over three axes reaches ~5 times it), up to ``blocked_magnitude``."""
 
 
@@ -519,12 +519,12 @@ class DoorPushConfig:
     judgement: DoorPushJudgement = field(default_factory=DoorPushJudgement)
     top_up_plan: TopUpPlan = field(default_factory=TopUpPlan)
     close_by_push: bool = True
-    """Shut a door by pushing its plate down (:meth:`DoorPushing._push_door_closed`), not by pinching its
+    """Shut a door by pushing its plate down (:meth:`DoorPusher.push_closed`), not by pinching its
     handle: pinched shut, the handle pivots ~85 deg between the pads against their torsional friction, and
     under the harsh grip it lagged the fingers by 7 deg, the wrist force rising to 33 N and then released
     in a stick-slip jolt of 70 N. Pushed, the pads move into the plate and need no friction."""
     top_up: bool = True
-    """Push on to the end stop a door a pinch opened without feeling the stop (:meth:`DoorPushing._top_up_door`)."""
+    """Push on to the end stop a door a pinch opened without feeling the stop (:meth:`DoorPusher.top_up`)."""
 
     def changed(self, **settings: Any) -> DoorPushConfig:
         """This config with the named settings changed, each by its own name whatever its part."""

@@ -103,7 +103,7 @@ def joint_load(
 
 def measured_progress(log: ToggleLog, tcp: np.ndarray) -> np.ndarray:
     """``(n,)`` fraction of the travel covered towards the other state, from TCP positions on the perceived joint
-    (as ``skills.primitives.Toggler._progress`` measures it) [-]."""
+    (as ``skills.primitives.Pinch.progress_of`` measures it) [-]."""
     p = tcp[:, :3, 3]
     begin = 0.0 if log.opening else 1.0
     start = _grasp_point_at(log, begin)

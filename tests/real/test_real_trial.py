@@ -259,7 +259,7 @@ def test_the_worlds_primitives_run_the_cells_thresholds():
     assert (
         world.toggler.config.sensing.force_limit,
         world.toggler.config.judgement.blocked_force,
-        world.toggler.limit,
+        world.toggler.watch.limit,
     ) == (45, 15, 45)
     assert world.survey.toggler is world.toggler  # the survey moved the arm with them too
 

@@ -12,9 +12,9 @@ import numpy as np
 from dm_control import mjcf
 
 from puzzlebox.models.xarm7 import build_xarm7
+from puzzlebox.skills.force_watch import _median_rows
 from puzzlebox.skills.joint_model import cross
 from puzzlebox.skills.kinematics import ArmKinematics, _se3, top_down
-from puzzlebox.skills.primitives import _median_rows
 
 
 def test_the_velocity_qp_gives_mink_solve_iks_velocities_with_and_without_binding_limits():

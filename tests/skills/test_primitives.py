@@ -197,11 +197,11 @@ def test_a_withdrawal_backs_off_a_held_grip_only_until_the_load_is_relieved():
     way (-40 N)."""
     robot = _HeldTCP(stiffness=20_000.0, stretch=0.003)
     toggler = Toggler(robot)
-    toggler.guard = False  # as in a withdrawal
+    toggler.watch.guard = False  # as in a withdrawal
     for _ in range(toggler.config.sensing.force_filter_samples):
-        toggler._sense()
+        toggler.watch.sense()
     assert np.linalg.norm(toggler.force_in_base) == pytest.approx(60.0, rel=0.02)
-    toggler._relieve()
+    toggler.motion.relieve()
     load = robot.wrench()[0]
     assert abs(load) < 10.0, load
 
@@ -269,7 +269,7 @@ def test_a_lift_near_the_base_rises_over_the_post_then_moves_out_before_rising_o
     azimuth = np.radians(69.7)
     start = np.array([radius * np.cos(azimuth), radius * np.sin(azimuth), 0.108])
     robot = _FreeTCP(top_down(start, 0.5))
-    Toggler(robot)._lift_clear(c.approach.approach_height)
+    Toggler(robot).retreat.lift_clear(c.approach.approach_height)
     path = np.array(robot.path)
     out = np.hypot(path[:, 0], path[:, 1])
     end = path[-1]
@@ -341,7 +341,7 @@ def test_an_approach_to_a_handle_near_the_base_comes_in_low_from_outside_and_kee
     target = top_down(np.array([radius * np.cos(azimuth), radius * np.sin(azimuth), 0.108]), np.radians(-47.6))
     robot = _ApproachingArm()
     toggler = Toggler(robot)
-    toggler._descend_to(target)
+    toggler.pinch.descend_to(target)
     path = np.array(robot.path)
     out = np.hypot(path[:, 0], path[:, 1])
     assert path[-1] == pytest.approx(target[:3, 3], abs=0.003)
@@ -364,8 +364,8 @@ def test_a_cautious_descent_runs_at_a_constant_speed_no_faster_than_its_mean():
     target = top_down(np.array([0.40, 0.10, 0.108]), 0.3)
     robot = _ApproachingArm()
     toggler = Toggler(robot)
-    toggler.cautious = True
-    toggler._descend_to(target)
+    toggler.pinch.cautious = True
+    toggler.pinch.descend_to(target)
     path = np.array(robot.path)
     over = np.hypot(*(path[:, :2] - target[:2, 3]).T) < 1e-3  # the descent: straight down over the grasp point
     assert path[over, 2].max() == pytest.approx(target[2, 3] + c.approach.approach_height, abs=0.002)
@@ -415,10 +415,12 @@ def test_an_opening_finger_that_meets_a_plate_stops_at_a_light_touch_and_lets_go
     c = PrimitiveConfig()
     snapped = _PlateBesideKnuckle()
     snapping = Toggler(snapped)
-    snapping.guard = False  # (it stops at the 60 N guard: the true force has passed it by then)
-    snapping._gripper(c.approach.pregrasp_closure, c.motion.release_time)
+    snapping.watch.guard = False  # (it stops at the 60 N guard: the true force has passed it by then)
+    snapped.command_gripper(c.approach.pregrasp_closure)  # the servo alone snaps the fingers open
+    for _ in range(round(c.motion.release_time / c.motion.tick)):
+        snapping.motion.tick(snapping.ik.tcp_pose())
     assert snapped.peak >= 90.0
     robot = _PlateBesideKnuckle()
-    Toggler(robot)._open_gently(c.approach.pregrasp_closure)
+    Toggler(robot).retreat.open_gently(c.approach.pregrasp_closure)
     assert robot.peak < c.retreat.lift_contact_force + 10.0, robot.peak
     assert robot.closure < 0.93 - 0.1  # the handle let go

@@ -176,7 +176,7 @@ def test_a_cautious_descent_is_not_stopped_by_sensor_noise(seed):
             toggler = Toggler(session.robot, config)
             result = toggler.toggle(jm, cautious=True)
             assert result.outcome == outcome, result
-            assert toggler.force_noise() == pytest.approx(7.0, rel=0.2)
+            assert toggler.watch.noise() == pytest.approx(7.0, rel=0.2)
 
 
 @pytest.mark.parametrize("seed", [4, 6])
@@ -195,8 +195,8 @@ def test_at_15_n_of_sensor_noise_a_latched_part_reads_blocked_and_a_free_one_mov
             assert toggler.toggle(slide).outcome == slide_outcome
             assert session.component_states().tolist() == [int(slide_outcome == "moved"), 0]
     toggler = Toggler(session.robot)
-    assert (toggler.filter_samples(15.0), toggler.tare_samples(15.0)) == (23, 225)
-    assert (toggler.filter_samples(0.3), toggler.tare_samples(0.3)) == (5, 10)  # the realistic sensor's
+    assert (toggler.watch.filter_samples(15.0), toggler.watch.tare_samples(15.0)) == (23, 225)
+    assert (toggler.watch.filter_samples(0.3), toggler.watch.tare_samples(0.3)) == (5, 10)  # the realistic sensor's
 
 
 def test_a_box_far_from_the_overview_camera_is_found_and_solved_end_to_end():
