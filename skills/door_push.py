@@ -98,6 +98,36 @@ class DoorPush:
         return math.atan2(b, a) - math.acos(max(-1.0, min(1.0, self.contact[0] / radius)))
 
 
+@dataclass(frozen=True)
+class ClosingSchedule:
+    """Where a closing push sends the pads at each tick of its schedule: from ``start`` to ``end`` (fractions of
+    the closing travel) over ``ticks``, slow at both ends (smoothstep), so that the pads meet the lid slowly."""
+
+    start: float
+    end: float
+    ticks: int
+
+    def at(self, k: float) -> float:
+        """Where the pads are sent at (schedule) tick ``k``."""
+        u = min(1.0, k / self.ticks)
+        return self.start + (self.end - self.start) * u * u * (3 - 2 * u)
+
+    def tick_at(self, s: float) -> float:
+        """The schedule tick at which the pads are sent to ``s``: :meth:`at`'s inverse."""
+        start, end = self.start, self.end
+        x = min(max((s - start) / (end - start), 0.0), 1.0) if end > start else 1.0
+        return self.ticks * (0.5 - math.sin(math.asin(1.0 - 2.0 * x) / 3.0))  # the smoothstep's inverse
+
+    @staticmethod
+    def held_offset(door: DoorPush, gap: float, depth: float, close_x: float) -> float:
+        """A command s sends the pads' edge to ``depth`` into the plate, and their progress is measured from where
+        they were first, ``gap`` above it: pads that follow the command exactly measure s + this, so pads measured at
+        progress q are where the command q - this sends them [fraction of the travel]."""
+        held_offset = math.atan2(door.plate_top + gap, close_x) - math.atan2(door.plate_top - depth, close_x)
+        held_offset /= door.travel
+        return held_offset
+
+
 class DoorPusher:
     """Pushes doors (see the module docstring): the pad's plan and its reading, moved by the pinch's descent, the
     guarded motion and the retreat."""
@@ -159,21 +189,9 @@ class DoorPusher:
             self.watch.slowdown * door.travel * p.plan.close_x
         )  # of the travel per tick, for 1 m/s at the pads
 
-        def scheduled(k: float) -> float:  # where the pads are sent at (schedule) tick k: slow onto the lid
-            u = min(1.0, k / ticks)
-            return start + (end - start) * u * u * (3 - 2 * u)
-
-        def schedule_at(s: float) -> float:  # the schedule tick at which the pads are sent to s: scheduled's inverse
-            x = min(max((s - start) / (end - start), 0.0), 1.0) if end > start else 1.0
-            return ticks * (0.5 - math.sin(math.asin(1.0 - 2.0 * x) / 3.0))  # the smoothstep's inverse
-
-        # A command s sends the pads' edge to ``depth`` into the plate, and their progress is measured from where they
-        # were first, ``gap`` above it: pads that follow the command exactly measure s + held_offset, so pads measured
-        # at progress q are where the command q - held_offset sends them.
-        held_offset = math.atan2(door.plate_top + p.plan.gap, p.plan.close_x) - math.atan2(
-            door.plate_top - p.plan.depth, p.plan.close_x
-        )
-        held_offset /= door.travel
+        closing = ClosingSchedule(start, end, ticks)
+        scheduled, schedule_at = closing.at, closing.tick_at
+        held_offset = closing.held_offset(door, p.plan.gap, p.plan.depth, p.plan.close_x)
 
         forces: list[float] = []
         progress = 0.0
@@ -222,8 +240,12 @@ class DoorPusher:
                 break
         if result is None:
             result = self.pinch.verdict(progress, forces, Cause.LOCKED_PUSHED)
-        # off the plate along its normal before letting go: held pressed on a latched plate (the command runs
-        # ``lead`` into it) while the gripper opened, a harsh latch's play built 65 N on the wrist
+        return self._off_the_plate(door, progress, result)
+
+    def _off_the_plate(self, door: DoorPush, progress: float, result: ToggleResult) -> ToggleResult:
+        """Back the pads off a closing push's plate along its normal (the door at ``progress`` of the closing
+        travel), let go and retreat; returns ``result``. Held pressed on a latched plate (the command runs ``lead``
+        into it) while the gripper opened, a harsh latch's play built 65 N on the wrist."""
         self.back_off(door, (1.0 - max(progress, 0.0)) * door.travel + math.pi / 2)
         self.watch.phase = "retreating"
         self.retreat.let_go_and_retreat()
@@ -371,39 +393,74 @@ class DoorPusher:
                 track.append((progress, face))
             else:
                 track.clear()  # (the turn over which the pad slid is measured pressed all the while)
-            held = (
-                len(track) > 0
-                and pressed_at is not None
-                and self.held_part_way(track, pressed_at[1], p.judgement.held_turn / door.travel, normal)
-            )
-            if held:
-                self.back_off(door, angle)
-                return ToggleResult("blocked", f"{HELD_PART_WAY} ({face:.0%} of the travel)", progress, max(forces),
-                                    forces=forces, cause=Cause.HELD_PART_WAY, held_at=face)  # fmt: skip
-            slid = pressed_at is not None and progress - pressed_at[0] >= p.judgement.slide_turn / door.travel
-            if slid and pressed_at is not None and face - pressed_at[1] < 0.5 * (progress - pressed_at[0]):
-                self.back_off(door, angle)
-                if (
-                    start >= c.judgement.blocked_progress
-                ):  # a door held part-way open is stuck, not latched: no evidence
-                    return ToggleResult("failed", f"Jammed: the door held at {start:.0%} of its travel",
-                                        progress, max(forces), forces=forces, cause=Cause.JAMMED)  # fmt: skip
-                return ToggleResult("blocked", LATCHED[Cause.LOCKED_PAD_SLID], progress, max(forces),
-                                    forces=forces, cause=Cause.LOCKED_PAD_SLID)  # fmt: skip
-            if progress < c.judgement.blocked_progress and (
-                normal > p.judgement.blocked_force or magnitude > c.judgement.blocked_magnitude
-            ):
-                self.back_off(door, angle)
-                return ToggleResult("blocked", PUSHED_IN_VAIN, progress, max(forces), forces=forces,
-                                    cause=Cause.LOCKED_PUSHED)  # fmt: skip
+            stopped = self._held(door, angle, start, progress, face, normal, magnitude, pressed_at, track, forces)
+            if stopped is not None:
+                return stopped
         self.back_off(door, max(progress, 0.0) * door.travel)
-        if last_pressed < c.judgement.moved_fraction:
+        return self._swung(start, progress, (last_pressed, last_face), pressed_at, forces)
+
+    def _swung(
+        self,
+        start: float,
+        progress: float,
+        last_pressed: tuple[float, float],
+        pressed_at: tuple[float, float] | None,
+        forces: list[float],
+    ) -> ToggleResult:
+        """The verdict of a swing that ran its course from ``start`` to ``progress`` (fractions of the travel), the
+        pad last pressed on the face at ``last_pressed`` (progress, face) and first at ``pressed_at``."""
+        c = self.config
+        if last_pressed[0] < c.judgement.moved_fraction:
             # the pad lost the face before the door was open: it went over the post (a latched door, inside the
             # slide test's 7 deg: it read "moved" with the door shut) or the door is elsewhere. How far the door
             # went is how far its face turned while pressed.
-            at = start + (max(last_face - pressed_at[1], 0.0) if pressed_at is not None else 0.0)
+            at = start + (max(last_pressed[1] - pressed_at[1], 0.0) if pressed_at is not None else 0.0)
             return self.pinch.verdict(at, forces, Cause.LOCKED_PUSHED if start < c.judgement.blocked_progress else None)
         return self.pinch.verdict(progress, forces)  # a latch was decided on the way: short of it, no evidence
+
+    def _held(
+        self,
+        door: DoorPush,
+        angle: float,
+        start: float,
+        progress: float,
+        face: float,
+        normal: float,
+        magnitude: float,
+        pressed_at: tuple[float, float] | None,
+        track: collections.deque[tuple[float, float]],
+        forces: list[float],
+    ) -> ToggleResult | None:
+        """A swing's judgement at one tick (the pad at ``progress`` of the travel, the face it presses on at ``face``,
+        ``normal`` [N] on it and ``magnitude`` [N] on the wrist): held part-way, the pad sliding along a face that
+        does not turn (latched, or jammed if the door stood part-way open), or pushed in vain; the pad backed off the
+        face then. None: go on."""
+        c = self.config
+        p = c.push
+        held = (
+            len(track) > 0
+            and pressed_at is not None
+            and self.held_part_way(track, pressed_at[1], p.judgement.held_turn / door.travel, normal)
+        )
+        if held:
+            self.back_off(door, angle)
+            return ToggleResult("blocked", f"{HELD_PART_WAY} ({face:.0%} of the travel)", progress, max(forces),
+                                forces=forces, cause=Cause.HELD_PART_WAY, held_at=face)  # fmt: skip
+        slid = pressed_at is not None and progress - pressed_at[0] >= p.judgement.slide_turn / door.travel
+        if slid and pressed_at is not None and face - pressed_at[1] < 0.5 * (progress - pressed_at[0]):
+            self.back_off(door, angle)
+            if start >= c.judgement.blocked_progress:  # a door held part-way open is stuck, not latched: no evidence
+                return ToggleResult("failed", f"Jammed: the door held at {start:.0%} of its travel",
+                                    progress, max(forces), forces=forces, cause=Cause.JAMMED)  # fmt: skip
+            return ToggleResult("blocked", LATCHED[Cause.LOCKED_PAD_SLID], progress, max(forces),
+                                forces=forces, cause=Cause.LOCKED_PAD_SLID)  # fmt: skip
+        if progress < c.judgement.blocked_progress and (
+            normal > p.judgement.blocked_force or magnitude > c.judgement.blocked_magnitude
+        ):
+            self.back_off(door, angle)
+            return ToggleResult("blocked", PUSHED_IN_VAIN, progress, max(forces), forces=forces,
+                                cause=Cause.LOCKED_PUSHED)  # fmt: skip
+        return None
 
     def held_part_way(
         self, track: collections.deque[tuple[float, float]], first_face: float, turn: float, normal: float

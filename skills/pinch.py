@@ -11,7 +11,7 @@ import collections
 import collections.abc
 import functools
 import math
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -29,6 +29,28 @@ MAX_HEAD_START = 0.5
 """Largest :attr:`Pinch.head_start` believed [-]: a part seen further along is not where its state says."""
 INCOMPLETE_TRAVEL = "IncompleteTravel"
 """Reason prefix of a motion that ran its course short of ``moved_fraction`` (no latch read)."""
+
+
+@dataclass(frozen=True)
+class PinchPath:
+    """The plan of a pinch's actuation (:meth:`Pinch.plan`)."""
+
+    lead: float
+    """How far the command may run ahead of the measured progress [fraction of the travel]."""
+    end: float
+    """Where the command ends [fraction of the travel]: past 1 for a door's over-travel."""
+    pacing: Pacing
+    """Where the command is at each tick: a slow start, then a ramp up."""
+    last_tick: int
+    """Ticks of the command (the over-travel at half pace)."""
+    held_along: np.ndarray | None
+    """Axis along which the path yields to only part of the load (``Handling.axis_yield``), or None."""
+    returning: float
+    """Share of the path's offset kept per tick past the travel [-]."""
+    window: int
+    """Ticks over which a stall is measured."""
+    press_limit: float
+    """Load against the motion that already means held for a handle pressed or pulled along its post [N]."""
 
 
 class Pinch:
@@ -160,7 +182,9 @@ class Pinch:
         self.watch.phase = "moving"
         return result
 
-    def actuate(self, jm: JointModel, sign: float, begin: float, at_grasp: np.ndarray) -> ToggleResult:
+    def plan(self, jm: JointModel, sign: float, begin: float, at_grasp: np.ndarray) -> PinchPath:
+        """The actuation's plan for the part of joint model ``jm`` grasped at ``at_grasp`` (4x4), moving from
+        ``begin`` (0 closed, 1 open) in direction ``sign``: pure, no sensor read."""
         c = self.config
         along_post = float(sign * jm.motion_direction(begin) @ at_grasp[:3, 2])  # cosine to the approach axis
         pressed = along_post > math.cos(c.actuation.press_angle)
@@ -175,8 +199,6 @@ class Pinch:
         if pressed:  # at press_pace at the most (a careful toggle may already go slower)
             slowdown *= max(1.0, (c.actuation.careful_pace if self.careful else 1.0) / c.actuation.press_pace)
         ticks = round(c.actuation.actuate_time * slowdown / c.motion.tick)
-        forces: list[float] = []
-        progress = 0.0
         path_length = (
             jm.travel
             if jm.joint == "slide"
@@ -191,23 +213,38 @@ class Pinch:
         pacing = Pacing(
             pace, pace * c.actuation.breakaway_pace, c.actuation.breakaway_fraction
         )  # slow start, then a ramp up
-        last_tick = pacing.ticks_to(1.0 + 2 * (end - 1.0))
-        progress_at_peak = 0.0
-        in_end_stop = False  # felt the door reach its end stop: open, whatever the pads do next
-        across = np.zeros(3)  # the path's offset across itself, yielding to the load there [m, base frame]
-        yields = jm.handling.yields_across
-        held_along = None if jm.handling.axis_yield == 1.0 else jm.axis  # (a load along it: yielded to in part)
-        axis_yield = jm.handling.axis_yield
-        returning = 1.0 - c.motion.tick / c.motion.comply_return_time  # the offset kept per tick past the travel
-        window = max(2, round(c.judgement.stall_window * slowdown / c.motion.tick))
         press_limit = (
             max(c.judgement.press_force, c.judgement.press_noise_margin * self.watch.filtered_noise_now())
             if pressed or pulled
             else math.inf
         )
-        recent: collections.deque[float] = collections.deque(maxlen=window)  # progress over the last stall_window
+        return PinchPath(
+            lead=lead,
+            end=end,
+            pacing=pacing,
+            last_tick=pacing.ticks_to(1.0 + 2 * (end - 1.0)),
+            held_along=None if jm.handling.axis_yield == 1.0 else jm.axis,  # (a load along it: yielded to in part)
+            returning=1.0 - c.motion.tick / c.motion.comply_return_time,  # the offset kept per tick past the travel
+            window=max(2, round(c.judgement.stall_window * slowdown / c.motion.tick)),
+            press_limit=press_limit,
+        )
+
+    def actuate(self, jm: JointModel, sign: float, begin: float, at_grasp: np.ndarray) -> ToggleResult:
+        """Carry the grasped handle along its path (:meth:`plan`), reading the load against the motion every tick:
+        held (a lock) ends it ``blocked`` and takes the handle back; run to its end, :meth:`settle` judges it."""
+        c = self.config
+        path = self.plan(jm, sign, begin, at_grasp)
+        forces: list[float] = []
+        progress = 0.0
+        lead, end, pacing, press_limit = path.lead, path.end, path.pacing, path.press_limit
+        progress_at_peak = 0.0
+        in_end_stop = False  # felt the door reach its end stop: open, whatever the pads do next
+        across = np.zeros(3)  # the path's offset across itself, yielding to the load there [m, base frame]
+        yields = jm.handling.yields_across
+        held_along, axis_yield, returning = path.held_along, jm.handling.axis_yield, path.returning
+        recent: collections.deque[float] = collections.deque(maxlen=path.window)  # progress over the last stall_window
         self.ik.set_joints(self.robot.joint_positions())
-        for k in range(1, last_tick + 1):
+        for k in range(1, path.last_tick + 1):
             paced = pacing.at(k)
             paced = paced if paced <= 1.0 else 1.0 + 0.5 * (paced - 1.0)  # past the travel at half pace
             s = min(end, paced, max(progress, 0.0) + lead)
@@ -263,6 +300,23 @@ class Pinch:
                     "blocked", f"{HELD_PART_WAY} ({progress:.0%} of the travel)", progress, max(forces), forces=forces,
                     cause=Cause.HELD_PART_WAY, held_at=progress,
                 )  # fmt: skip
+        return self.settle(jm, sign, begin, at_grasp, end, lead, across, in_end_stop, forces)
+
+    def settle(
+        self,
+        jm: JointModel,
+        sign: float,
+        begin: float,
+        at_grasp: np.ndarray,
+        end: float,
+        lead: float,
+        across: np.ndarray,
+        in_end_stop: bool,
+        forces: list[float],
+    ) -> ToggleResult:
+        """Let the part catch up with the actuation's ``end`` target (fraction of the travel) and judge where it got:
+        ``moved``, ``blocked`` (pulled without progress: taken back to ``at_grasp``) or ``failed``."""
+        c = self.config
         for _ in range(round(2 * c.motion.settle_time / c.motion.tick)):  # let the part catch up with the end target
             progress = self.progress = self.progress_of(jm, sign, begin)
             target = self.pose_along(jm, begin + sign * min(end, max(progress, 0.0) + lead), at_grasp, begin)

@@ -21,7 +21,7 @@ vanished, as a door's does when it stands open, moved; one still at its closed p
 means the handle slipped out of the pads: with a weak grip a latched door's did, with hardly any force).
 
 A part that will not move as its kind says (a misread marker: the pipeline was told its kind wrong) is tried as the
-other kinds its perceived geometry allows, in the same try (:meth:`RobotWorld._try_other_kinds`). The rule: a part not
+other kinds its perceived geometry allows, in the same try (:mod:`skills.other_kinds`). The rule: a part not
 yet moved as the kind in use is tried as other kinds (i) when the world would give it up (every attempt failed: as that
 kind the fingers closed on nothing, or the path carried nothing), or (ii) when it is blocked as that kind a second time.
 A first blocked try is never second-guessed: the pull of a wrong kind's path reads exactly as a lock does, and a lock is
@@ -52,13 +52,13 @@ import numpy as np
 
 from puzzlebox.models import ComponentObservation, SceneObservation, TryResult
 from puzzlebox.models.calibration import CellCalibration
-from puzzlebox.models.disassembly_kinds import family_kind_names
 from puzzlebox.models.geometry import wrap_angle
-from puzzlebox.models.kinds import get_kind, registered_kinds
+from puzzlebox.models.kinds import get_kind
 from puzzlebox.models.robot import Robot
 from puzzlebox.models.try_outcome import Cause
 from puzzlebox.skills.door_clearance import lean_away, near_open_door
 from puzzlebox.skills.joint_model import JointModel, joint_model
+from puzzlebox.skills.other_kinds import OtherKinds
 from puzzlebox.skills.perception import MarkerDetection, MarkerDetector, kind_of, lid_height, upright_pose
 from puzzlebox.skills.primitives import PrimitiveConfig, Toggler, ToggleResult
 from puzzlebox.skills.scene_survey import SceneSurvey, SurveyConfig
@@ -81,6 +81,22 @@ def _stopped_descending(result: ToggleResult) -> bool:
     push's descent, or that of the push on under a door's plate that followed a push run short."""
     last = result.last_stop()
     return not result.not_pushed and last.cause is Cause.FORCE_LIMIT and last.stopped_while == "descending"
+
+
+@dataclass
+class _Effort:
+    """What the tries of one action cost: the largest filtered wrist force [N], the simulated and wall time [s]
+    and the toggles made."""
+
+    peak: float = 0.0
+    sim_time: float = 0.0
+    wall_time: float = 0.0
+    attempts: int = 0
+
+    def add(self, result: ToggleResult) -> None:
+        self.peak = max(self.peak, result.peak_force)
+        self.sim_time = self.sim_time + result.sim_time
+        self.wall_time = self.wall_time + result.wall_time
 
 
 @dataclass(frozen=True)
@@ -180,6 +196,8 @@ class RobotWorld:
     that also keeps what it found, so a video shows the pipeline's own detections."""
 
     def __post_init__(self) -> None:
+        self.other_kinds = OtherKinds(self)
+        """Tries a part as kinds it was not told."""
         self.kinds = dict(self.marker_map)
         """Marker id -> the kind its part is handled as: the told kind until another moved it (module docstring)."""
         self.found_kinds: dict[int, str] = {}
@@ -229,10 +247,52 @@ class RobotWorld:
         marker = self.markers[index]
         opening = self.states[index] == 0
         before = self.ground_truth(marker) if self.ground_truth else None
-        reasons: list[str] = []
-        peak = 0.0
-        sim_time = wall_time = 0.0
-        attempts = 0
+        effort = _Effort()
+        result, failures, empty = self._retried(marker, opening, effort)
+        outcome = self._sensed_outcome(result, marker, opening)
+        if self._door_stayed_shut(outcome, marker):
+            # the fingers went the whole way and the door stayed: weak pads slid along its post (a latch,
+            # or a door heavier than they hold). A push tells which: it turns a free door, a latch holds it.
+            result = self.toggler.toggle(self.joint_models[marker], opening, push=True)
+            effort.attempts += 1
+            effort.add(result)
+            outcome = self._sensed_outcome(result, marker, opening)
+            if self._door_stayed_shut(outcome, marker):
+                outcome = TryResult("blocked", HELD_UNDER_PINCH_AND_PUSH, cause=Cause.LOCKED_PINCH_AND_PUSH)
+        tried: tuple[str, ...] = ()
+        if self.other_kinds.due(marker, outcome, failures):
+            outcome, other, tried = self.other_kinds.try_them(marker, opening, outcome, empty)
+            effort.attempts += len(tried)
+            if other is not None:
+                result = other
+                effort.add(other)
+        if outcome.moved:
+            self.states[index] ^= 1
+            self.moved_as.add(marker)
+            if self.kinds[marker] != kind_of(self.marker_map, marker):  # (a kind used since a grasp held as it)
+                self.found_kinds[marker] = self.kinds[marker]
+        elif outcome.outcome == "blocked":
+            self.blocked_as.add(marker)
+        if outcome.outcome == "failed" and failures > self.config.max_retries:
+            outcome = TryResult(
+                "failed", f"{outcome.reason} ({effort.attempts} attempts)", give_up=True, cause=outcome.cause
+            )
+        after = self.ground_truth(marker) if self.ground_truth else None
+        self.log.append(
+            ActionLog(
+                index, marker, kind_of(self.kinds, marker), outcome.outcome, outcome.reason, outcome.moved,
+                result.progress, effort.peak, effort.attempts, effort.sim_time, effort.wall_time,
+                None if before is None else bool(before != after), tried, outcome.cause,
+            )
+        )  # fmt: skip
+        return outcome
+
+    def _retried(self, marker: int, opening: bool, effort: _Effort) -> tuple[ToggleResult, int, bool]:
+        """Toggle ``marker``'s part as the kind in use, retrying a failed try up to ``max_retries`` times (leaning
+        less, topping up the doors over it, looking where a door stands, measuring the part again); the tries'
+        cost goes to ``effort``. Gives the last toggle's result, how many failed, and whether a grasp closed on
+        nothing where the kind in use has its handle."""
+        failures = 0
         is_door = self._swings_up(marker)  # (a door, or any kind that swings up out of the lid plane)
         door_at = None
         raised = False  # a door left part-way where no look sees it
@@ -243,9 +303,10 @@ class RobotWorld:
         overhanging = self._doors_overhanging(marker, opening)
         jm = self.joint_models[marker]
         lean = lean_away([self.joint_models[d] for d in overhanging], *(jm.grasp_point_at(f) for f in (0.0, 1.0)))
-        empty = False  # a grasp closed on nothing where the kind in use has its handle
+        empty = False
+        judgement = self.toggler.config.judgement
         for attempt in range(1 + self.config.max_retries):
-            attempts = attempt + 1
+            effort.attempts = attempt + 1
             stands_at = self._stands_at(marker)
             result: ToggleResult = self.toggler.toggle(
                 self.joint_models[marker],
@@ -257,22 +318,17 @@ class RobotWorld:
                 lean=lean,
                 stands_at=stands_at,
             )
-            peak, sim_time, wall_time = (
-                max(peak, result.peak_force),
-                sim_time + result.sim_time,
-                wall_time + result.wall_time,
-            )
+            effort.add(result)
             empty = empty or result.closed_on_nothing
-            if result.outcome == "failed" and result.progress >= self.toggler.config.judgement.moved_fraction:
+            if result.outcome == "failed" and result.progress >= judgement.moved_fraction:
                 # stopped (force limit, slip) after carrying the handle most of the way: look before retrying
                 # (a door's marker must be seen where an open door's is: one the pads let go part-way hides
                 # it behind its own raised handle, as an open one shows it edge-on)
                 if self._overview_verdict(marker, opening, unseen_moved=not is_door).moved:
-                    result.outcome, result.reason, result.cause = "moved", "", None
-                    result.stopped_while, result.pushed_on, result.not_pushed = "", None, False
+                    result.seen_moved()
             if result.outcome != "failed":
                 break
-            reasons.append(result.reason)
+            failures += 1
             if lean is not None and result.cause is Cause.UNREACHABLE:
                 # leaning out of reach (tilted 20 deg outwards, the flange stands ~6 cm further out): half as much
                 # next time (10 deg still cleared a post), then upright
@@ -281,13 +337,11 @@ class RobotWorld:
                 # the fingers met something on the way down beside a door that may stand short of its stop,
                 # leaning over this part: push that door up into its stop, then descend again
                 for door in overhanging:
-                    topped = self.toggler.toggle(self.joint_models[door], True, raised=True)
-                    peak, sim_time = max(peak, topped.peak_force), sim_time + topped.sim_time
-                    wall_time += topped.wall_time
+                    effort.add(self.toggler.toggle(self.joint_models[door], True, raised=True))
             if attempt < self.config.max_retries and is_door:
                 door_at = self._fraction_open(marker)  # a failed try may leave a door part-way: see where
                 # part-way and unseen: a pinch would descend onto it (195 N); it is pushed up under its plate
-                raised = door_at is None and result.progress >= self.toggler.config.judgement.blocked_progress
+                raised = door_at is None and result.progress >= judgement.blocked_progress
             if (
                 attempt < self.config.max_retries
                 and opening
@@ -295,152 +349,9 @@ class RobotWorld:
                 and (door_at is None or abs(door_at) < 0.05)
             ):
                 self._remeasure(marker)  # only a closed part shows its closed pose
-        if (
-            is_door
-            and opening
-            and result.outcome == "failed"
-            and result.progress >= self.toggler.config.judgement.blocked_progress
-        ):
+        if is_door and opening and result.outcome == "failed" and result.progress >= judgement.blocked_progress:
             self.unsettled.add(marker)  # the next try of it looks first
-        outcome = self._sensed_outcome(result, marker, opening)
-        if self._door_stayed_shut(outcome, marker):
-            # the fingers went the whole way and the door stayed: weak pads slid along its post (a latch,
-            # or a door heavier than they hold). A push tells which: it turns a free door, a latch holds it.
-            result = self.toggler.toggle(self.joint_models[marker], opening, push=True)
-            attempts += 1
-            peak, sim_time = max(peak, result.peak_force), sim_time + result.sim_time
-            wall_time += result.wall_time
-            outcome = self._sensed_outcome(result, marker, opening)
-            if self._door_stayed_shut(outcome, marker):
-                outcome = TryResult("blocked", HELD_UNDER_PINCH_AND_PUSH, cause=Cause.LOCKED_PINCH_AND_PUSH)
-        tried: tuple[str, ...] = ()
-        if self._other_kinds_due(marker, outcome, reasons):
-            outcome, other, tried = self._try_other_kinds(marker, opening, outcome, empty)
-            attempts += len(tried)
-            if other is not None:
-                result, peak = other, max(peak, other.peak_force)
-                sim_time, wall_time = sim_time + other.sim_time, wall_time + other.wall_time
-        if outcome.moved:
-            self.states[index] ^= 1
-            self.moved_as.add(marker)
-            if self.kinds[marker] != kind_of(self.marker_map, marker):  # (a kind used since a grasp held as it)
-                self.found_kinds[marker] = self.kinds[marker]
-        elif outcome.outcome == "blocked":
-            self.blocked_as.add(marker)
-        if outcome.outcome == "failed" and len(reasons) > self.config.max_retries:
-            outcome = TryResult("failed", f"{outcome.reason} ({attempts} attempts)", give_up=True, cause=outcome.cause)
-        after = self.ground_truth(marker) if self.ground_truth else None
-        self.log.append(
-            ActionLog(
-                index, marker, kind_of(self.kinds, marker), outcome.outcome, outcome.reason, outcome.moved,
-                result.progress, peak, attempts, sim_time, wall_time, None if before is None else bool(before != after),
-                tried, outcome.cause,
-            )
-        )  # fmt: skip
-        return outcome
-
-    def _other_kinds_due(self, marker: int, outcome: TryResult, reasons: list[str]) -> bool:
-        """Whether ``marker``'s part, just tried as the kind in use with ``outcome`` (``reasons``: its failed
-        attempts'), is now tried as other kinds (the rule in the module docstring)."""
-        c = self.config
-        if not c.other_kinds or marker in self.moved_as or self.other_kind_rounds.get(marker, 0) >= c.other_kind_rounds:
-            return False
-        if outcome.outcome == "failed":
-            return len(reasons) > c.max_retries  # the world would give it up
-        return outcome.outcome == "blocked" and marker in self.blocked_as  # blocked again
-
-    def _other_kinds(self, marker: int, held: bool) -> list[str]:
-        """The kinds other than the one in use that ``marker``'s part may be, most plausible first: registered
-        kinds whose ``lift`` fits the marker's perceived height above the lid and whose handle is not where a grasp
-        on it closed on nothing; those of the family of the kinds the world was told first (the paper's, when all
-        are), then (``held``: the grasp held the handle) those whose handle stands where the kind in use has it,
-        then in registration order."""
-        c = self.config
-        in_use = self.joint_models[marker]
-        family = set(family_kind_names(tuple(self.marker_map.values())))
-        empty = self.empty_handles.get(marker, [])
-        ranked = []
-        for order, name in enumerate(registered_kinds()):
-            if name == in_use.kind or abs(self.marker_heights[marker] - get_kind(name).lift) > c.lift_tolerance:
-                continue
-            grasp = self._joint_model(marker, name).grasp_point
-            if any(np.linalg.norm(grasp - e) < c.same_handle for e in empty):
-                continue
-            elsewhere = bool(np.linalg.norm(grasp - in_use.grasp_point) >= c.same_handle)
-            ranked.append((name not in family, held and elsewhere, order, name))
-        return [name for *_, name in sorted(ranked)]
-
-    def _try_other_kinds(
-        self, marker: int, opening: bool, first: TryResult, empty: bool
-    ) -> tuple[TryResult, ToggleResult | None, tuple[str, ...]]:
-        """Try ``marker``'s part as up to ``other_kinds`` other kinds (:meth:`_other_kinds`), one careful attempt
-        each, after ``first``, its outcome as the kind in use (``empty``: a grasp of it closed on nothing). Gives the
-        try's outcome, the last toggle's result with the effort of them all (None if no other kind fits) and the
-        kinds tried. A kind that moves the part is kept (:attr:`found_kinds`); one whose grasp held where the kind in
-        use closed on nothing, or that carried the part past ``blocked_progress``, is used from then on (the first
-        that carried it, else the first that held)."""
-        c = self.config
-        in_use = self.joint_models[marker]
-        if empty:
-            self.empty_handles.setdefault(marker, []).append(in_use.grasp_point)
-        candidates = self._other_kinds(marker, held=first.outcome == "blocked")[: c.other_kinds]
-        if not candidates:
-            return first, None, ()
-        self.other_kind_rounds[marker] = self.other_kind_rounds.get(marker, 0) + 1
-        total: ToggleResult | None = None
-        blocked = [first] if first.outcome == "blocked" else []
-        adopt: JointModel | None = None
-        adopt_carried = False
-        tried: list[str] = []
-        # the part itself, as the door in use, may stand open over the other kinds' grasp points
-        own_door = self._lowest_open(marker, 0 if opening else 1) if in_use.handling.swings_up else None
-        for kind in candidates:
-            tried.append(kind)
-            self.joint_models[marker] = jm = self._joint_model(marker, kind)
-            self.kinds[marker] = kind
-            grasp = jm.grasp_point_at(0.0 if opening else 1.0)
-            cautious = c.other_kinds_cautious and (
-                bool(self._doors_overhanging(marker, opening))
-                or (own_door is not None and near_open_door(in_use, own_door, grasp, c.door_clearance))
-            )
-            result = self.toggler.toggle(
-                jm, opening, where_is=lambda: self._fraction_open(marker), careful=True, cautious=cautious
-            )
-            if result.outcome == "failed" and result.progress >= self.toggler.config.judgement.moved_fraction:
-                if self._overview_verdict(marker, opening, unseen_moved=not jm.handling.swings_up).moved:
-                    result.outcome, result.reason, result.cause = "moved", "", None
-                    result.stopped_while, result.pushed_on, result.not_pushed = "", None, False
-            outcome = self._sensed_outcome(result, marker, opening)
-            if total is not None:
-                result.peak_force = max(result.peak_force, total.peak_force)
-                result.sim_time, result.wall_time = result.sim_time + total.sim_time, result.wall_time + total.wall_time
-            total = result
-            if outcome.moved:  # (try_toggle keeps it in found_kinds)
-                self.blocked_as.discard(marker)
-                return TryResult("moved", f"moved as a {kind}, not a {in_use.kind}"), total, tuple(tried)
-            carried = result.progress >= self.toggler.config.judgement.blocked_progress
-            if result.closed_on_nothing:
-                self.empty_handles.setdefault(marker, []).append(jm.grasp_point)
-            elif (adopt is None or (not adopt_carried and carried)) and (
-                (outcome.outcome == "blocked" and empty) or (jm.handling.swings_up and carried)
-            ):
-                # its handle is there (held, or carried part of the way): this kind from now on; one that carried
-                # the handle part of the way before it was held outranks one held at once (a wheel told a slide,
-                # pushed without progress as a door, then held part-way as a wheel: a wheel)
-                adopt, adopt_carried = jm, carried
-            if outcome.outcome == "blocked":
-                blocked.append(outcome)
-        self.joint_models[marker] = adopt or in_use
-        self.kinds[marker] = (adopt or in_use).kind
-        if adopt is not None:
-            self.blocked_as.discard(marker)
-            if adopt.handling.swings_up and opening:
-                self.unsettled.add(marker)  # the next try of it looks first
-        if blocked:
-            held = ", ".join(tried)
-            also = TryResult("blocked", f"{blocked[0].reason} (also tried as {held})", cause=blocked[0].cause)
-            return also, total, tuple(tried)
-        return first, total, tuple(tried)
+        return result, failures, empty
 
     def _doors_overhanging(self, marker: int, opening: bool) -> list[int]:
         """The other doors that may stand open (believed open, or left part-way by a failed try) over where

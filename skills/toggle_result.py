@@ -54,6 +54,12 @@ class ToggleResult:
     not_pushed: bool = False
     """A door the pads lost stands part-way where no look sees it: it was not pushed."""
 
+    def seen_moved(self) -> None:
+        """The world saw the part at its other state after this try failed past ``moved_fraction`` (a stop, a slip
+        near the end): a plain ``moved``, its cause and reason dropped."""
+        self.outcome, self.reason, self.cause = "moved", "", None
+        self.stopped_while, self.pushed_on, self.not_pushed = "", None, False
+
     def last_stop(self) -> ToggleResult:
         """The motion the try ended with: the push on under the plate if there was one, else this one."""
         return self.pushed_on if self.pushed_on is not None else self
