@@ -81,7 +81,7 @@ def _aimed_beside(world, marker: int, offset: float):
     """The joint model of ``marker`` as perceived through a wrong hand-eye pose: ``offset`` [m] beside the handle
     along the fingers' closing axis (the TCP's y axis of ``top_down``), where the descent misses the handle."""
     jm = world.joint_models[marker]
-    yaw = world.toggler.grasp_yaw(jm)
+    yaw = world.toggler.pinch.grasp_yaw(jm)
     beside = offset * np.array([np.sin(yaw), -np.cos(yaw), 0.0])
     return dataclasses.replace(jm, origin=jm.origin + beside, grasp_point=jm.grasp_point + beside)
 
