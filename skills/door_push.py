@@ -15,6 +15,7 @@ when closed); opening turns ``e_x`` towards ``e_z`` by the door angle.
 from __future__ import annotations
 
 import collections
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -26,7 +27,7 @@ from puzzlebox.skills.errors import IKFailure
 from puzzlebox.skills.joint_model import GRASP_DEPTH, JointModel, cross
 from puzzlebox.skills.kinematics import top_down
 from puzzlebox.skills.pacing import Pacing
-from puzzlebox.skills.pinch import Pinch
+from puzzlebox.skills.pinch import Pinch, TryArgs
 from puzzlebox.skills.settings import DoorPushConfig
 from puzzlebox.skills.toggle_result import HELD_PART_WAY, LATCHED, ToggleResult
 
@@ -136,7 +137,7 @@ class DoorPusher:
         self.pinch, self.retreat, self.motion, self.watch = pinch, pinch.retreat, pinch.motion, pinch.watch
         self.robot, self.config, self.ik = pinch.robot, pinch.config, pinch.ik
 
-    def push_open(self, jm: JointModel, start: float = 0.0) -> ToggleResult:
+    def push_open(self, jm: JointModel, start: float, args: TryArgs) -> ToggleResult:
         """Open a door by pushing the back face of its handle with the inner face of a finger pad (see
         :mod:`skills.door_push`): descend behind the handle, then swing the pad along the door's arc,
         ``depth`` into the face, measuring the door's angle from where the pad rests on the face (the
@@ -153,7 +154,9 @@ class DoorPusher:
         def tcp_for(pad_edge: np.ndarray) -> np.ndarray:
             return top_down(pad_edge - p.plan.pad_offset * door.e_x, yaw)
 
-        self.pinch.descend_to(tcp_for(door.point_at(start * door.travel, door.contact + np.array([p.plan.gap, 0.0]))))
+        self.pinch.descend_to(
+            tcp_for(door.point_at(start * door.travel, door.contact + np.array([p.plan.gap, 0.0]))), args
+        )
         self.watch.phase = "actuating"
         result = self.swing(door, tcp_for, start)
         self.watch.phase = "retreating"
@@ -161,7 +164,7 @@ class DoorPusher:
         self.watch.phase = "moving"
         return result
 
-    def push_closed(self, jm: JointModel, start: float = 0.0) -> ToggleResult:
+    def push_closed(self, jm: JointModel, start: float, args: TryArgs) -> ToggleResult:
         """Close a door by pushing its plate down with the edges of both finger pads, the fingers straddling
         the handle (they close along the hinge): the pads' outer edge (``pad_half_width`` along the
         gripper's x = the door's ``e_x``) rests on the plate's top face ``close_x`` from the hinge and
@@ -178,7 +181,7 @@ class DoorPusher:
             return top_down(edge - p.plan.pad_half_width * door.e_x, yaw)
 
         above_plate = on_plate + np.array([0.0, p.plan.depth + p.plan.gap])
-        self.pinch.descend_to(tcp_for(door.point_at((1.0 - start) * door.travel, above_plate)))
+        self.pinch.descend_to(tcp_for(door.point_at((1.0 - start) * door.travel, above_plate)), args)
 
         self.watch.phase = "actuating"
         lead = p.plan.lead / (door.travel * p.plan.close_x)
@@ -252,7 +255,7 @@ class DoorPusher:
         self.watch.phase = "moving"
         return result
 
-    def top_up(self, jm: JointModel) -> ToggleResult:
+    def top_up(self, jm: JointModel, args: TryArgs) -> ToggleResult:
         """Push a door the pinch opened on to its end stop, under its plate: a handle that lags the fingers
         leaves the door short of the stop (78 deg under the harsh grip), and a door short of it sinks back
         under its own weight (to 66 deg within 45 s) over its neighbour's handle, onto which the next
@@ -284,11 +287,8 @@ class DoorPusher:
                 door.origin + (edge_x + p.plan.pad_half_width) * door.e_x + height_at(edge_x) * door.e_z, yaw
             )
 
-        cautious, self.pinch.cautious = self.pinch.cautious, True  # beside a door standing at an unknown angle
-        try:
-            self.pinch.descend_to(tcp_for(x_start))
-        finally:
-            self.pinch.cautious = cautious
+        # beside a door standing at an unknown angle: cautious, whatever the try
+        self.pinch.descend_to(tcp_for(x_start), dataclasses.replace(args, cautious=True))
         self.watch.phase = "actuating"
         path = math.hypot(
             x_start - x_end, p.top_up_plan.top_up_height - p.top_up_plan.top_up_low

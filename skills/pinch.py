@@ -32,6 +32,26 @@ INCOMPLETE_TRAVEL = "IncompleteTravel"
 
 
 @dataclass(frozen=True)
+class TryArgs:
+    """How one toggle is made, as the pinch and the pushes read it (a value passed along, never left on a part)."""
+
+    cautious: bool = False
+    """Descend slowly, stopped at a light touch: a door may stand open over the part (``toggle(cautious=True)``)."""
+    careful: bool = False
+    """Move in contact at ``careful_pace``: a part tried as a kind it was not told (``toggle(careful=True)``)."""
+    head_start: float = 0.0
+    """Fraction of the travel towards the other state the part stood at when the toggle began
+    (``toggle(stands_at=...)``), counted into the progress that tells it reached its stop: the fingers' progress
+    counts from the perceived closed (or open) pose, and the handle of a lever left part-way is that much ahead
+    of them (a lever rests up to ~20 % pressed once lifted, a try taken back leaves it at 30-45 %). Its stop
+    was met with the fingers at 57-73 % and read ``held part-way``; taken back, the lever was tried again and
+    again until the grasp closed on nothing."""
+    lean: np.ndarray | None = None
+    """Horizontal vector (base frame) along which the gripper leans over the part, by ``lean_angle`` times its
+    length (``toggle(lean=...)``), or None: upright."""
+
+
+@dataclass(frozen=True)
 class PinchPath:
     """The plan of a pinch's actuation (:meth:`Pinch.plan`)."""
 
@@ -66,20 +86,6 @@ class Pinch:
             maxlen=max(2, round(c.judgement.slip_window / c.motion.tick) + 1)
         )
         """Gripper closures over the last ``slip_window`` of the toggle in progress (the slip test)."""
-        self.cautious = False
-        """Whether the toggle in progress descends cautiously (``toggle(cautious=True)``)."""
-        self.careful = False
-        """Whether the toggle in progress moves in contact at ``careful_pace`` (``toggle(careful=True)``)."""
-        self.head_start = 0.0
-        """Fraction of the travel towards the other state a part stood at when the toggle in progress began
-        (``toggle(stands_at=...)``), counted into the progress that tells it reached its stop: the fingers' progress
-        counts from the perceived closed (or open) pose, and the handle of a lever left part-way is that much ahead
-        of them (a lever rests up to ~20 % pressed once lifted, a try taken back leaves it at 30-45 %). Its stop
-        was met with the fingers at 57-73 % and read ``held part-way``; taken back, the lever was tried again and
-        again until the grasp closed on nothing."""
-        self.lean: np.ndarray | None = None
-        """Horizontal vector (base frame) along which the gripper leans over the part of the toggle in progress,
-        by ``lean_angle`` times its length (``toggle(lean=...)``), or None: upright."""
 
     # -- the toggle --------------------------------------------------------------------------------
     def grasp_yaw(self, jm: JointModel) -> float:
@@ -90,7 +96,7 @@ class Pinch:
         direction = jm.axis if jm.handling.grasp == "along_axis" else jm.motion_direction(0.0)
         return float(np.arctan2(direction[1], direction[0]) + np.pi / 2)
 
-    def descend_to(self, target: np.ndarray) -> None:
+    def descend_to(self, target: np.ndarray, args: TryArgs) -> None:
         """Open to the pre-grasp closure, travel above ``target`` (4x4; :meth:`approach`), tare the F/T there and
         descend onto it."""
         c = self.config
@@ -108,10 +114,10 @@ class Pinch:
         samples = self.watch.filter_samples(self.watch.rest_noise)
         self.watch.window = collections.deque(maxlen=samples)
         self.watch.slowdown = (
-            samples / c.sensing.force_filter_samples / (c.actuation.careful_pace if self.careful else 1.0)
+            samples / c.sensing.force_filter_samples / (c.actuation.careful_pace if args.careful else 1.0)
         )
         self.watch.phase = "descending"
-        if self.cautious:  # the whole way slowly, under the light touch
+        if args.cautious:  # the whole way slowly, under the light touch
             slow = c.approach.cautious_descend_time * height / c.approach.approach_height
         else:
             # quickly down to where the fingers could first meet a handle they were aimed beside, then slowly, so
@@ -157,12 +163,12 @@ class Pinch:
         self.motion.move_to(above, c.retreat.retreat_time)
         return height
 
-    def run(self, jm: JointModel, sign: float) -> ToggleResult:
+    def run(self, jm: JointModel, sign: float, args: TryArgs) -> ToggleResult:
         c = self.config
         begin = 0.0 if sign > 0 else 1.0
         grasp_yaw = self.grasp_yaw(jm)
-        at_grasp = self.leaning(top_down(jm.grasp_point_at(begin), grasp_yaw))
-        self.descend_to(at_grasp)
+        at_grasp = self.leaning(top_down(jm.grasp_point_at(begin), grasp_yaw), args.lean)
+        self.descend_to(at_grasp, args)
         self.watch.phase = "grasping"
         found = self.motion.close_slowly(settle=jm.handling.grasp == "across_motion")
         if found.any():  # the handle stands that far beside where it was aimed: the path starts from it
@@ -176,13 +182,13 @@ class Pinch:
             raise GraspFailure(f"the gripper closed on nothing at {np.round(at_grasp[:3, 3], 3).tolist()}")
 
         self.watch.phase = "actuating"
-        result = self.actuate(jm, sign, begin, at_grasp)
+        result = self.actuate(jm, sign, begin, at_grasp, args)
         self.watch.phase = "retreating"
         self.retreat.let_go_and_retreat()
         self.watch.phase = "moving"
         return result
 
-    def plan(self, jm: JointModel, sign: float, begin: float, at_grasp: np.ndarray) -> PinchPath:
+    def plan(self, jm: JointModel, sign: float, begin: float, at_grasp: np.ndarray, args: TryArgs) -> PinchPath:
         """The actuation's plan for the part of joint model ``jm`` grasped at ``at_grasp`` (4x4), moving from
         ``begin`` (0 closed, 1 open) in direction ``sign``: pure, no sensor read."""
         c = self.config
@@ -193,11 +199,11 @@ class Pinch:
         pulled = (
             along_post < -math.cos(c.actuation.press_angle)
             and not jm.handling.swings_up
-            and self.head_start < MAX_HEAD_START
+            and args.head_start < MAX_HEAD_START
         )
         slowdown = self.watch.slowdown
         if pressed:  # at press_pace at the most (a careful toggle may already go slower)
-            slowdown *= max(1.0, (c.actuation.careful_pace if self.careful else 1.0) / c.actuation.press_pace)
+            slowdown *= max(1.0, (c.actuation.careful_pace if args.careful else 1.0) / c.actuation.press_pace)
         ticks = round(c.actuation.actuate_time * slowdown / c.motion.tick)
         path_length = (
             jm.travel
@@ -229,11 +235,11 @@ class Pinch:
             press_limit=press_limit,
         )
 
-    def actuate(self, jm: JointModel, sign: float, begin: float, at_grasp: np.ndarray) -> ToggleResult:
+    def actuate(self, jm: JointModel, sign: float, begin: float, at_grasp: np.ndarray, args: TryArgs) -> ToggleResult:
         """Carry the grasped handle along its path (:meth:`plan`), reading the load against the motion every tick:
         held (a lock) ends it ``blocked`` and takes the handle back; run to its end, :meth:`settle` judges it."""
         c = self.config
-        path = self.plan(jm, sign, begin, at_grasp)
+        path = self.plan(jm, sign, begin, at_grasp, args)
         forces: list[float] = []
         progress = 0.0
         lead, end, pacing, press_limit = path.lead, path.end, path.pacing, path.press_limit
@@ -291,7 +297,7 @@ class Pinch:
             recent.append(progress)
             stalled = len(recent) == recent.maxlen and progress - recent[0] < c.judgement.stall_progress
             held = held or (stalled and opposing > c.judgement.stall_force and s <= 1.0)
-            if held and progress + self.head_start >= c.judgement.moved_fraction:
+            if held and progress + args.head_start >= c.judgement.moved_fraction:
                 end = max(progress, 0.0)  # at its stop short of the perceived travel: pushed no further
                 break
             if held:  # (progress >= blocked_progress: tested above)
@@ -300,7 +306,7 @@ class Pinch:
                     "blocked", f"{HELD_PART_WAY} ({progress:.0%} of the travel)", progress, max(forces), forces=forces,
                     cause=Cause.HELD_PART_WAY, held_at=progress,
                 )  # fmt: skip
-        return self.settle(jm, sign, begin, at_grasp, end, lead, across, in_end_stop, forces)
+        return self.settle(jm, sign, begin, at_grasp, end, lead, across, in_end_stop, forces, args)
 
     def settle(
         self,
@@ -313,6 +319,7 @@ class Pinch:
         across: np.ndarray,
         in_end_stop: bool,
         forces: list[float],
+        args: TryArgs,
     ) -> ToggleResult:
         """Let the part catch up with the actuation's ``end`` target (fraction of the travel) and judge where it got:
         ``moved``, ``blocked`` (pulled without progress: taken back to ``at_grasp``) or ``failed``."""
@@ -328,7 +335,7 @@ class Pinch:
                 if not in_end_stop:
                     raise
                 break
-        reached = self.progress_of(jm, sign, begin) + self.head_start
+        reached = self.progress_of(jm, sign, begin) + args.head_start
         result = self.verdict(reached, forces, Cause.LOCKED_PULLED)
         result.end_stop_felt = in_end_stop
         if result.outcome == "blocked":
@@ -373,15 +380,15 @@ class Pinch:
         ):
             raise SlipDetected(f"the handle slipped out of the grasp after {progress:.0%} of the travel")
 
-    def leaning(self, upright: np.ndarray) -> np.ndarray:
+    def leaning(self, upright: np.ndarray, lean: np.ndarray | None) -> np.ndarray:
         """``upright`` (a top-down TCP pose, 4x4) turned by ``lean_angle`` about its closing axis (y) so that the
-        gripper's upper part leans along :attr:`lean`'s component across that axis; unchanged without a lean,
+        gripper's upper part leans along ``lean``'s component across that axis; unchanged without a lean,
         or when the lean lies along the closing axis (turning the pads off the handle's faces would not do)."""
-        if self.lean is None or self.config.approach.lean_angle == 0.0:
+        if lean is None or self.config.approach.lean_angle == 0.0:
             return upright
-        strength = float(np.linalg.norm(self.lean))
+        strength = float(np.linalg.norm(lean))
         closing = upright[:3, 1]
-        across = self.lean - float(self.lean @ closing) * closing
+        across = lean - float(lean @ closing) * closing
         across[2] = 0.0
         size = float(np.linalg.norm(across))
         if size < 0.5 * strength:
@@ -406,4 +413,4 @@ class Pinch:
         return sign * jm.fraction_between(jm.grasp_point_at(begin), self.robot.tcp_pose_in_base()[:3, 3])
 
 
-__all__ = ["INCOMPLETE_TRAVEL", "MAX_HEAD_START", "Pinch", "SLIPPED_OFF"]
+__all__ = ["INCOMPLETE_TRAVEL", "MAX_HEAD_START", "Pinch", "SLIPPED_OFF", "TryArgs"]

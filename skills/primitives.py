@@ -56,7 +56,7 @@ from puzzlebox.skills.force_watch import ForceWatch
 from puzzlebox.skills.guarded_motion import GuardedMotion
 from puzzlebox.skills.joint_model import JointModel
 from puzzlebox.skills.kinematics import ArmKinematics
-from puzzlebox.skills.pinch import MAX_HEAD_START, Pinch
+from puzzlebox.skills.pinch import MAX_HEAD_START, Pinch, TryArgs
 from puzzlebox.skills.retreat import Retreat
 from puzzlebox.skills.settings import PrimitiveConfig
 from puzzlebox.skills.toggle_result import ToggleResult
@@ -169,32 +169,30 @@ class Toggler:
         tried as a kind it was not told). ``stands_at``: where a part that does not swing up was just seen to stand
         (fraction of its travel, 0 closed, 1 open; :attr:`head_start`)."""
         wall = time.perf_counter()
-        self.pinch.cautious = cautious
-        self.pinch.careful = careful
         ahead = None if stands_at is None or jm.handling.swings_up else (stands_at if opening else 1.0 - stands_at)
-        self.pinch.head_start = 0.0 if ahead is None else min(max(ahead, 0.0), MAX_HEAD_START)
-        self.pinch.lean = lean
+        head_start = 0.0 if ahead is None else min(max(ahead, 0.0), MAX_HEAD_START)
+        args = TryArgs(cautious=cautious, careful=careful, head_start=head_start, lean=lean)
         start_time = self.robot.time
         self.watch.reset()
         c = self.config
         pushable = jm.handling.swings_up and c.door_push
         covered = None if door_at is None else (door_at if opening else 1.0 - door_at)
         if pushable and opening and raised:
-            result = self._attempt(lambda: self.doors.top_up(jm))
+            result = self._attempt(lambda: self.doors.top_up(jm, args))
         elif pushable and (
             push or (not opening and c.push.close_by_push) or (covered or 0.0) >= c.judgement.blocked_progress
         ):
-            result = self._push_on(jm, opening, 0.0 if covered is None else covered, where_is)
+            result = self._push_on(jm, opening, 0.0 if covered is None else covered, args, where_is)
         else:
-            result = self._attempt(lambda: self.pinch.run(jm, 1.0 if opening else -1.0))
+            result = self._attempt(lambda: self.pinch.run(jm, 1.0 if opening else -1.0, args))
             empty = result.cause is Cause.GRASP_EMPTY
             if pushable and opening and result.outcome == "moved" and not result.end_stop_felt and c.push.top_up:
-                self._attempt(lambda: self.doors.top_up(jm))  # best effort: the pinch's verdict stands
+                self._attempt(lambda: self.doors.top_up(jm, args))  # best effort: the pinch's verdict stands
             if pushable and result.cause in PADS_LOST_HOLD:
                 # the pads could not hold the handle: push the door instead, in the same try, from where it stands
                 covered = self._push_start(result, opening, where_is)
                 if covered is not None:
-                    result = self._push_on(jm, opening, covered, where_is)
+                    result = self._push_on(jm, opening, covered, args, where_is)
                 elif result.progress < c.judgement.moved_fraction:  # (past it, the world looks whether it moved)
                     result.reason += "; the door stands part-way where it cannot be seen: not pushed"
                     result.not_pushed = True
@@ -209,6 +207,7 @@ class Toggler:
         jm: JointModel,
         opening: bool,
         covered: float,
+        args: TryArgs,
         where_is: collections.abc.Callable[[], float | None] | None = None,
     ) -> ToggleResult:
         """:meth:`_push`, and an opening push that lost the handle's face short of the travel (``IncompleteTravel``:
@@ -217,25 +216,25 @@ class Toggler:
         its handle hides its marker), whose verdict then stands (the world checks a ``moved`` against the
         marker). A door seen lower is left to a retry's push from where it stands: under a plate that low
         the top-up's pads pass over it and read "moved"."""
-        result = self._push(jm, opening, covered)
+        result = self._push(jm, opening, covered, args)
         if opening and self.config.push.top_up and result.cause is Cause.INCOMPLETE_TRAVEL:
             if where_is is not None and where_is() is not None:
                 return result
-            topped = self._attempt(lambda: self.doors.top_up(jm))
+            topped = self._attempt(lambda: self.doors.top_up(jm, args))
             if topped.outcome == "moved":
                 return topped
             result.reason += f"; pushed on under its plate: {topped.reason}"
             result.pushed_on = topped
         return result
 
-    def _push(self, jm: JointModel, opening: bool, covered: float) -> ToggleResult:
+    def _push(self, jm: JointModel, opening: bool, covered: float, args: TryArgs) -> ToggleResult:
         """Push door ``jm`` open or shut from where it stands, ``covered`` (fraction of this motion's travel),
         beginning ``push.start_margin`` behind it: a door let go part-way falls back ~1 deg while the arm
         comes round, and behind the handle the pad only sits higher on the post (~1.7 mm per deg)."""
         c = self.config
         start = min(max(covered - c.push.plan.start_margin, 0.0), c.judgement.moved_fraction)
         push = self.doors.push_open if opening else self.doors.push_closed
-        return self._attempt(lambda: push(jm, start))
+        return self._attempt(lambda: push(jm, start, args))
 
     def _push_start(
         self, pinch: ToggleResult, opening: bool, where_is: collections.abc.Callable[[], float | None] | None

@@ -20,6 +20,7 @@ from puzzlebox.models.xarm7 import HOME_QPOS, build_xarm7
 from puzzlebox.skills import MarkerDetector, joint_model, lid_height, select_markers, upright_pose
 from puzzlebox.skills.errors import ConfigError, IKFailure
 from puzzlebox.skills.kinematics import ArmKinematics, top_down
+from puzzlebox.skills.pinch import TryArgs
 from puzzlebox.skills.primitives import PrimitiveConfig, Toggler
 from puzzlebox.skills.settings import DOOR_PARTS, PHASES
 from puzzlebox.twin.nominal_calibration import nominal_calibration
@@ -341,7 +342,7 @@ def test_an_approach_to_a_handle_near_the_base_comes_in_low_from_outside_and_kee
     target = top_down(np.array([radius * np.cos(azimuth), radius * np.sin(azimuth), 0.108]), np.radians(-47.6))
     robot = _ApproachingArm()
     toggler = Toggler(robot)
-    toggler.pinch.descend_to(target)
+    toggler.pinch.descend_to(target, TryArgs())
     path = np.array(robot.path)
     out = np.hypot(path[:, 0], path[:, 1])
     assert path[-1] == pytest.approx(target[:3, 3], abs=0.003)
@@ -364,8 +365,7 @@ def test_a_cautious_descent_runs_at_a_constant_speed_no_faster_than_its_mean():
     target = top_down(np.array([0.40, 0.10, 0.108]), 0.3)
     robot = _ApproachingArm()
     toggler = Toggler(robot)
-    toggler.pinch.cautious = True
-    toggler.pinch.descend_to(target)
+    toggler.pinch.descend_to(target, TryArgs(cautious=True))
     path = np.array(robot.path)
     over = np.hypot(*(path[:, :2] - target[:2, 3]).T) < 1e-3  # the descent: straight down over the grasp point
     assert path[over, 2].max() == pytest.approx(target[2, 3] + c.approach.approach_height, abs=0.002)
