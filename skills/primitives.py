@@ -86,6 +86,7 @@ class Toggler:
         self.retreat = Retreat(self.motion, rest_posture)
         self.pinch = Pinch(self.retreat)
         self.doors = DoorPusher(self.pinch)
+        self._parts = (self.watch, self.motion, self.retreat, self.pinch, self.doors)
 
     @property
     def robot(self) -> Robot:
@@ -94,7 +95,7 @@ class Toggler:
     @robot.setter
     def robot(self, robot: Robot) -> None:
         """Another interface to the same arm (an observer wrapping it): every part reads and moves through it."""
-        for part in (self.watch, self.motion, self.retreat, self.pinch, self.doors):
+        for part in self._parts:
             part.robot = robot
 
     @property
@@ -103,7 +104,7 @@ class Toggler:
 
     @config.setter
     def config(self, config: PrimitiveConfig) -> None:
-        for part in (self.watch, self.motion, self.retreat, self.pinch, self.doors):
+        for part in self._parts:
             part.config = config
 
     @property

@@ -11,7 +11,7 @@ the twin, by the memory agent trained on other boxes of those kinds.
 2. The memory (``DIR/memory.sqlite``): trained symbolically, one episode on each chain not held out. The training
    set was chosen on validation, never on the test chains: with 3 other chains held out of the rest, a memory of
    every remaining chain (42) took 5.33 actions on them, one of 9 chains 6.67 and one of 20 random boxes 6.33
-   (``runs/k15/val-*``, 50 seeds each).
+   (50 seeds each).
 3. Symbolic (``DIR/symbolic-chains``, ``DIR/symbolic-random``): every chain and every random box, ``runs`` seeds
    each (from 500).
 4. Twin (``DIR/twin-ideal``, ``DIR/twin-realistic``): the held-out chains, ``runs`` seeds each (from 0), under the

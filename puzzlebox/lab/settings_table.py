@@ -77,8 +77,7 @@ def table() -> str:
         "",
     ]
     top = settings.PrimitiveConfig()
-    parts = [(f"`PrimitiveConfig.{f.name}`", getattr(top, f.name)) for f in dataclasses.fields(top)]
-    parts = [(name, value) for name, value in parts if dataclasses.is_dataclass(value) and "push" not in name]
+    parts = [(f"`PrimitiveConfig.{f.name}`", getattr(top, f.name)) for f in dataclasses.fields(top) if f.name != "push"]
     parts += [(f"`PrimitiveConfig.push.{f.name}`", getattr(top.push, f.name)) for f in dataclasses.fields(top.push)]
     parts = [(name, value) for name, value in parts if dataclasses.is_dataclass(value)]
     own = [
