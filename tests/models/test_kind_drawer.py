@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from puzzlebox.models import Box, Component, Goal, LockRule, PuzzleSpec
+from puzzlebox.models.box_export import compile_box
 from puzzlebox.models.generator import RandomGraphConfig, generate_chain, generate_random, paper_family
 from puzzlebox.models.generator.layout import Layout, LayoutConfig
 from puzzlebox.models.kinds import (
@@ -248,3 +249,23 @@ def test_the_layout_puts_nothing_past_a_drawers_front():
     layout.place_first("drawer")
     assert layout.candidate(0, "wheel", 0.0) is None  # straight ahead: in front of the drawer, past its front
     assert layout.candidate(0, "wheel", math.pi / 2) is not None  # beside it
+
+
+
+def test_no_moving_part_touches_the_shell_anywhere_in_its_travel():
+    """A drawer's tray rests on the shell's top face (0 mm apart) and is kept out of contact with it, as every
+    part on the lid is: with that contact, the lid pressed a tray drawn at the hand's pace (15 mm/s) up with 20 N
+    and held it with as much friction (MuJoCo's pyramidal cone couples a contact's damping to the sliding
+    speed), and the hand read a free drawer as locked."""
+    spec = generate_random(RandomGraphConfig(8, family=family_named("all")), 93000)  # two drawers
+    assert sum(c.kind == "drawer" for c in spec.components) >= 1
+    model, _ = compile_box(spec)  # the box alone
+    data = mujoco.MjData(model)
+    shell = model.geom("shell").id
+    joints = [model.joint(f"{c.name}:joint") for c in spec.components]
+    for fraction in np.linspace(0.0, 1.0, 11):
+        for joint in joints:
+            data.qpos[joint.qposadr[0]] = fraction * joint.range[1]
+        mujoco.mj_forward(model, data)
+        touching = [model.geom(c.geom2 if c.geom1 == shell else c.geom1).name for c in data.contact if shell in (c.geom1, c.geom2)]
+        assert not touching, f"at {fraction:.0%} of the travel"
