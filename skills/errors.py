@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import TYPE_CHECKING
 
 from puzzlebox.models.try_outcome import Cause
+
+if TYPE_CHECKING:
+    from puzzlebox.skills.judgement import PinchTrace
 
 
 class SkillError(Exception):
@@ -89,3 +93,5 @@ class SlipDetected(SkillError):
     """The handle left the grasp during the motion (the gripper closed past the handle's width)."""
 
     cause = Cause.SLIPPED
+    trace: PinchTrace | None = None
+    """The readings of the pinch its judgement read the slip from (a :class:`skills.judgement.PinchTrace`), or None."""

@@ -19,12 +19,12 @@ from scipy.spatial.transform import Rotation
 from puzzlebox.models.try_outcome import Cause
 from puzzlebox.skills.errors import GraspFailure, SlipDetected
 from puzzlebox.skills.joint_model import JointModel
+from puzzlebox.skills.judgement import Decision, Judgement, PinchJudge, PinchLimits, PinchTrace, Reading, verdict
 from puzzlebox.skills.kinematics import top_down
 from puzzlebox.skills.pacing import Pacing
 from puzzlebox.skills.retreat import Retreat, out_to_radius
 from puzzlebox.skills.toggle_result import HELD_PART_WAY, LATCHED, ToggleResult
 
-SLIPPED_OFF = LATCHED[Cause.LOCKED_SLIPPED_OFF]
 MAX_HEAD_START = 0.5
 """Largest :attr:`Pinch.head_start` believed [-]: a part seen further along is not where its state says."""
 INCOMPLETE_TRAVEL = "IncompleteTravel"
@@ -82,10 +82,12 @@ class Pinch:
         c = self.config
         self.progress = 0.0
         """Measured progress of the current toggle's actuation so far (kept when a stop ends it)."""
-        self.closures: collections.deque[float] = collections.deque(
-            maxlen=max(2, round(c.judgement.slip_window / c.motion.tick) + 1)
-        )
-        """Gripper closures over the last ``slip_window`` of the toggle in progress (the slip test)."""
+        self.slip_ticks = max(2, round(c.judgement.slip_window / c.motion.tick) + 1)
+        """Gripper closures the slip test compares (``slip_window`` in ticks, plus one)."""
+        self.grasp_closure = 0.0
+        """Gripper closure once the current toggle's handle was grasped [-]."""
+        self.judge: PinchJudge | None = None
+        """The judgement of the current (or last) toggle's actuation (:mod:`skills.judgement`)."""
 
     # -- the toggle --------------------------------------------------------------------------------
     def grasp_yaw(self, jm: JointModel) -> float:
@@ -175,9 +177,7 @@ class Pinch:
             jm = replace(jm, origin=jm.origin + found, grasp_point=jm.grasp_point + found)
             at_grasp = at_grasp.copy()
             at_grasp[:3, 3] += found
-        grasp_closure = self.robot.gripper_opening()
-        self.closures.clear()
-        self.closures.append(grasp_closure)
+        grasp_closure = self.grasp_closure = self.robot.gripper_opening()
         if grasp_closure >= c.judgement.empty_grasp_closure:
             raise GraspFailure(f"the gripper closed on nothing at {np.round(at_grasp[:3, 3], 3).tolist()}")
 
@@ -240,15 +240,13 @@ class Pinch:
         held (a lock) ends it ``blocked`` and takes the handle back; run to its end, :meth:`settle` judges it."""
         c = self.config
         path = self.plan(jm, sign, begin, at_grasp, args)
-        forces: list[float] = []
+        limits = PinchLimits(path.press_limit, path.window, args.head_start, self.slip_ticks, self.grasp_closure)
+        judge = self.judge = PinchJudge(c.judgement, limits)
         progress = 0.0
-        lead, end, pacing, press_limit = path.lead, path.end, path.pacing, path.press_limit
-        progress_at_peak = 0.0
-        in_end_stop = False  # felt the door reach its end stop: open, whatever the pads do next
+        lead, end, pacing = path.lead, path.end, path.pacing
         across = np.zeros(3)  # the path's offset across itself, yielding to the load there [m, base frame]
         yields = jm.handling.yields_across
         held_along, axis_yield, returning = path.held_along, jm.handling.axis_yield, path.returning
-        recent: collections.deque[float] = collections.deque(maxlen=path.window)  # progress over the last stall_window
         self.ik.set_joints(self.robot.joint_positions())
         for k in range(1, path.last_tick + 1):
             paced = pacing.at(k)
@@ -261,52 +259,26 @@ class Pinch:
             direction = sign * jm.motion_direction(fraction)
             opposing = float(-np.dot(self.watch.force_in_base, direction))
             if yields:  # once the end stop is felt, back to the planned arc: its load tells the door is open
-                if s <= 1.0 or (c.actuation.overtravel_comply and not in_end_stop):
+                if s <= 1.0 or (c.actuation.overtravel_comply and not judge.in_end_stop):
                     across = self.motion.yield_across(across, direction, held_along, axis_yield)
                 else:
                     across = across * returning
-            forces.append(opposing)
             progress = self.progress = self.progress_of(jm, sign, begin)
-            if opposing >= max(forces):
-                progress_at_peak = progress
-            try:
-                self.check_grip(progress)
-            except SlipDetected:
-                if progress_at_peak < c.judgement.blocked_progress and max(forces) >= c.judgement.push_force:
-                    # the part held while pulled until the pads slid off its handle: a latch, not a slip
-                    return ToggleResult("blocked", SLIPPED_OFF, progress, max(forces),
-                                        forces=forces, cause=Cause.LOCKED_SLIPPED_OFF)  # fmt: skip
-                if in_end_stop:  # the pads slid off a post pressed into its end stop: the door is open
-                    return ToggleResult("moved", "", progress, max(forces), forces=forces, end_stop_felt=True)
-                raise
             magnitude = math.sqrt(self.watch.force_in_base @ self.watch.force_in_base)  # np.linalg.norm, bit for bit
-            in_end_stop = in_end_stop or (s > 1.0 and magnitude > c.judgement.end_stop_force)
-            if s > 1.0 and magnitude > c.actuation.overtravel_force:  # past the travel and pushing hard: stop here
-                end = max(1.0, min(progress, s))
-            held = opposing > press_limit and s <= 1.0  # a handle pressed along its post: held at a light force
-            if (
-                opposing > c.judgement.blocked_force or magnitude > c.judgement.blocked_magnitude or held
-            ) and progress < c.judgement.blocked_progress:
-                self.motion.take_back(
-                    functools.partial(self.motion.move_to, at_grasp, 0.5)
-                )  # back to where the handle was grasped
-                return ToggleResult(
-                    "blocked", LATCHED[Cause.LOCKED_NO_PROGRESS], progress, max(forces), forces=forces,
-                    cause=Cause.LOCKED_NO_PROGRESS,
-                )  # fmt: skip
-            recent.append(progress)
-            stalled = len(recent) == recent.maxlen and progress - recent[0] < c.judgement.stall_progress
-            held = held or (stalled and opposing > c.judgement.stall_force and s <= 1.0)
-            if held and progress + args.head_start >= c.judgement.moved_fraction:
+            decision = judge.read(Reading(s, opposing, magnitude, progress, self.robot.gripper_opening()))
+            if decision is Decision.GO_ON:
+                if s > 1.0 and magnitude > c.actuation.overtravel_force:  # past the travel and pushing hard: stop
+                    end = max(1.0, min(progress, s))
+                continue
+            if decision is Decision.AT_STOP:
                 end = max(progress, 0.0)  # at its stop short of the perceived travel: pushed no further
                 break
-            if held:  # (progress >= blocked_progress: tested above)
+            if decision is Decision.HELD_EARLY:  # back to where the handle was grasped
+                self.motion.take_back(functools.partial(self.motion.move_to, at_grasp, 0.5))
+            elif decision is Decision.HELD_PART_WAY:
                 self.motion.take_back(functools.partial(self.return_along, jm, sign, begin, progress, at_grasp, across))
-                return ToggleResult(
-                    "blocked", f"{HELD_PART_WAY} ({progress:.0%} of the travel)", progress, max(forces), forces=forces,
-                    cause=Cause.HELD_PART_WAY, held_at=progress,
-                )  # fmt: skip
-        return self.settle(jm, sign, begin, at_grasp, end, lead, across, in_end_stop, forces, args)
+            return self.result_of(judge.ended(decision), judge.forces, judge.trace())
+        return self.settle(jm, sign, begin, at_grasp, end, lead, across, args)
 
     def settle(
         self,
@@ -317,30 +289,28 @@ class Pinch:
         end: float,
         lead: float,
         across: np.ndarray,
-        in_end_stop: bool,
-        forces: list[float],
         args: TryArgs,
     ) -> ToggleResult:
         """Let the part catch up with the actuation's ``end`` target (fraction of the travel) and judge where it got:
         ``moved``, ``blocked`` (pulled without progress: taken back to ``at_grasp``) or ``failed``."""
         c = self.config
+        judge = self.judge
+        assert judge is not None  # (set by actuate)
         for _ in range(round(2 * c.motion.settle_time / c.motion.tick)):  # let the part catch up with the end target
             progress = self.progress = self.progress_of(jm, sign, begin)
             target = self.pose_along(jm, begin + sign * min(end, max(progress, 0.0) + lead), at_grasp, begin)
             target[:3, 3] += across
             self.motion.tick(target)
-            try:
-                self.check_grip(progress)
-            except SlipDetected:
-                if not in_end_stop:
-                    raise
+            decision = judge.settle_read(progress, self.robot.gripper_opening())
+            if decision is Decision.AT_STOP:
                 break
+            if decision is not Decision.GO_ON:
+                return self.result_of(judge.ended(decision), judge.forces, judge.trace())
         reached = self.progress_of(jm, sign, begin) + args.head_start
-        result = self.verdict(reached, forces, Cause.LOCKED_PULLED)
-        result.end_stop_felt = in_end_stop
-        if result.outcome == "blocked":
+        judgement = judge.verdict(reached, Cause.LOCKED_PULLED)
+        if judgement.outcome == "blocked":
             self.motion.take_back(functools.partial(self.motion.move_to, at_grasp, 0.5))
-        return result
+        return self.result_of(judgement, judge.forces, judge.trace(reached))
 
     def return_along(
         self, jm: JointModel, sign: float, begin: float, covered: float, at_grasp: np.ndarray, across: np.ndarray
@@ -357,28 +327,32 @@ class Pinch:
             self.motion.tick(target)
 
     def verdict(self, progress: float, forces: list[float], latched: Cause | None = None) -> ToggleResult:
-        """How a motion that ran its course ended: ``moved`` past ``moved_fraction`` of the travel; ``blocked``
-        (cause ``latched``, when given) short of ``blocked_progress`` after at least ``push_force`` against
-        the motion (``forces`` [N], one per tick); else ``failed``."""
-        c = self.config
-        peak = max(forces)
-        if progress >= c.judgement.moved_fraction:
-            return ToggleResult("moved", "", progress, peak, forces=forces)
-        if latched is not None and progress < c.judgement.blocked_progress and peak >= c.judgement.push_force:
-            return ToggleResult("blocked", LATCHED[latched], progress, peak, forces=forces, cause=latched)
-        return ToggleResult(
-            "failed", f"{INCOMPLETE_TRAVEL}: only {progress:.0%} of the travel covered", progress, peak, forces=forces,
-            cause=Cause.INCOMPLETE_TRAVEL,
-        )  # fmt: skip
+        """How a motion that ran its course ended (:func:`skills.judgement.verdict`): ``moved`` past
+        ``moved_fraction`` of the travel; ``blocked`` (cause ``latched``, when given) short of ``blocked_progress``
+        after at least ``push_force`` against the motion (``forces`` [N], one per tick); else ``failed``."""
+        return self.result_of(verdict(self.config.judgement, progress, forces, latched), forces)
 
-    def check_grip(self, progress: float) -> None:
-        closure = self.robot.gripper_opening()
-        self.closures.append(closure)
-        if (
-            closure >= self.config.judgement.empty_grasp_closure
-            or closure > min(self.closures) + self.config.judgement.slip_closure_rise
-        ):
-            raise SlipDetected(f"the handle slipped out of the grasp after {progress:.0%} of the travel")
+    @staticmethod
+    def result_of(judgement: Judgement, forces: list[float], trace: PinchTrace | None = None) -> ToggleResult:
+        """The toggle's result of a judgement, its reason rendered from its cause; a slip raises
+        :class:`SlipDetected` (no evidence: the toggle's retries decide what follows)."""
+        cause, progress = judgement.cause, judgement.progress
+        if cause is Cause.SLIPPED:
+            slip = SlipDetected(f"the handle slipped out of the grasp after {progress:.0%} of the travel")
+            slip.trace = trace
+            raise slip
+        if cause is None:
+            reason = ""
+        elif cause is Cause.HELD_PART_WAY:
+            reason = f"{HELD_PART_WAY} ({progress:.0%} of the travel)"
+        elif cause is Cause.INCOMPLETE_TRAVEL:
+            reason = f"{INCOMPLETE_TRAVEL}: only {progress:.0%} of the travel covered"
+        else:
+            reason = LATCHED[cause]
+        return ToggleResult(
+            judgement.outcome, reason, progress, judgement.peak_opposing_force, forces=forces, cause=cause,
+            end_stop_felt=judgement.end_stop_felt, held_at=judgement.held_at, trace=trace,
+        )  # fmt: skip
 
     def leaning(self, upright: np.ndarray, lean: np.ndarray | None) -> np.ndarray:
         """``upright`` (a top-down TCP pose, 4x4) turned by ``lean_angle`` about its closing axis (y) so that the
@@ -413,4 +387,4 @@ class Pinch:
         return sign * jm.fraction_between(jm.grasp_point_at(begin), self.robot.tcp_pose_in_base()[:3, 3])
 
 
-__all__ = ["INCOMPLETE_TRAVEL", "MAX_HEAD_START", "Pinch", "SLIPPED_OFF", "TryArgs"]
+__all__ = ["INCOMPLETE_TRAVEL", "MAX_HEAD_START", "Pinch", "TryArgs"]

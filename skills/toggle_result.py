@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from puzzlebox.models.try_outcome import Cause, Outcome
+
+if TYPE_CHECKING:
+    from puzzlebox.skills.judgement import PinchTrace
 
 LATCHED: dict[Cause, str] = {
     Cause.LOCKED_NO_PROGRESS: "latched: force rose without progress",
@@ -53,6 +57,9 @@ class ToggleResult:
     still while the pad slid along it)."""
     not_pushed: bool = False
     """A door the pads lost stands part-way where no look sees it: it was not pushed."""
+    trace: PinchTrace | None = None
+    """The readings the pinch's judgement read this result from (:func:`skills.judgement.judge_pinch` judges them
+    again offline); None for a result a pinch's judgement did not give (a push, an error)."""
 
     def seen_moved(self) -> None:
         """The world saw the part at its other state after this try failed past ``moved_fraction`` (a stop, a slip
