@@ -18,15 +18,13 @@ scalars, and the file's context) and each toggle's arrays, written atomically.
 
 from __future__ import annotations
 
-import io
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from puzzlebox.models.atomic import write_atomically
+from puzzlebox.models.npz_file import load_header, save_npz
 
 PHASES: tuple[str, ...] = ("moving", "approaching", "descending", "grasping", "actuating", "retreating")
 """What the primitive may be doing at a tick (``skills.primitives.Toggler.phase``); a log stores the index."""
@@ -120,19 +118,12 @@ class ToggleLog:
 def save_toggles(path: str | Path, toggles: list[ToggleLog], context: dict[str, Any] | None = None) -> Path:
     """Write ``toggles`` (and the file's ``context``) to ``path`` (``.npz``) atomically."""
     header = {"format": FORMAT, "context": context or {}, "toggles": [t.header() for t in toggles]}
-    arrays: dict[str, np.ndarray] = {"header": np.frombuffer(json.dumps(header).encode(), dtype=np.uint8)}
+    arrays: dict[str, np.ndarray] = {}
     for i, t in enumerate(toggles):
         for name in ARRAYS:
             value = np.asarray(getattr(t, name))
             arrays[f"{i}.{name}"] = value.astype(np.int8 if name == "phase" else np.float64)
-
-    def write(tmp: Path) -> None:
-        buffer = io.BytesIO()
-        # the checker matches **arrays against allow_pickle too: its keys are "header" and "<i>.<name>"
-        np.savez_compressed(buffer, **arrays)  # pyright: ignore[reportArgumentType]
-        tmp.write_bytes(buffer.getvalue())
-
-    return write_atomically(path, write)
+    return save_npz(path, header, arrays)
 
 
 def load_toggles(path: str | Path) -> tuple[list[ToggleLog], dict[str, Any]]:
@@ -142,12 +133,7 @@ def load_toggles(path: str | Path) -> tuple[list[ToggleLog], dict[str, Any]]:
         ValueError: not such a file (its format is named).
     """
     with np.load(path) as data:
-        try:
-            header = json.loads(bytes(data["header"]).decode())
-        except (KeyError, UnicodeDecodeError, json.JSONDecodeError) as err:
-            raise ValueError(f"{path}: not a toggle log ({err})") from None
-        if header.get("format") != FORMAT:
-            raise ValueError(f"{path}: format {header.get('format')!r}, expected {FORMAT!r}")
+        header = load_header(data, path, FORMAT, "a toggle log")
         toggles = []
         for i, h in enumerate(header["toggles"]):
             arrays = {name: np.array(data[f"{i}.{name}"]) for name in ARRAYS}

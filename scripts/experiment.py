@@ -12,6 +12,7 @@ the reality gap in the twin.
                                  [--workers W | --ray ...]
     python scripts/experiment.py regression --out DIR [--reference REGRESSION.json] [--quick] [--workers W | --ray ...]
     python scripts/experiment.py sysid --out DIR [--workers W] [--cells 0,1,2] [--quick]
+    python scripts/experiment.py tries --out DIR [--workers W] [--quick]
     python scripts/experiment.py disassembly --agents memory,dual,dqn,model-based --out DIR [--quick] [--runs R]
                                  [--seeds S] [--workers W | --ray ...] [--validation] [--no-holding-rule]
     python scripts/experiment.py kinds --out DIR [--quick] [--runs R] [--workers W]
@@ -62,6 +63,12 @@ change meant to keep the behaviour keeps it bit for bit.
 compliance from logged robot data of toggles (oracle trials in the twin under ``realistic``, three cells) and
 reports the nominal and the fitted twin's prediction errors of the wrench and the part's motion on held-out
 toggles: ``DIR/sysid.{json,md,png}``, every trial's log in ``DIR/logs/``; the same command resumes.
+
+``tries`` (``puzzlebox/lab/tries_experiment.py``) records every try of twin trials (the paper test boxes under
+``ideal``, ``realistic`` and ``harsh``, runs with a misreported kind, hard boxes) with the readings the pinch's
+judgement read and the simulator's truth, one file per trial in ``DIR/tries/``, then runs the judgement offline on
+every recorded pinch: ``DIR/tries.{json,md}`` (agreement with the truth per profile, split and cause, with confusion
+matrices; the time a judgement takes) and ``DIR/sample.npz`` (a few pinches of each cause); the same command resumes.
 
 ``disassembly`` (``learning/experiments/disassembly.py``) trains every agent on the measured ``lab-computer-a``
 and tests it on ``lab-computer-b`` and 10 variants of it (RAM sticks and GPU cables added or removed, every pose

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import collections
 import collections.abc
+import math
 from dataclasses import dataclass
 from enum import StrEnum
 
@@ -98,6 +99,8 @@ class PinchJudge:
         self.config, self.limits = config, limits
         self.forces: list[float] = []
         """Load against the motion at each tick [N]."""
+        self.peak = -math.inf
+        """The largest of :attr:`forces` [N]."""
         self.progress = 0.0
         self.progress_at_peak = 0.0
         self.in_end_stop = False
@@ -122,11 +125,12 @@ class PinchJudge:
         c, lim = self.config, self.limits
         self.readings.append(r)
         self.forces.append(r.opposing)
+        self.peak = max(self.peak, r.opposing)  # max(self.forces), kept as it grows
         self.progress = r.progress
-        if r.opposing >= max(self.forces):
+        if r.opposing >= self.peak:
             self.progress_at_peak = r.progress
         if self.slipped(r.closure):
-            if self.progress_at_peak < c.blocked_progress and max(self.forces) >= c.push_force:
+            if self.progress_at_peak < c.blocked_progress and self.peak >= c.push_force:
                 return Decision.SLIPPED_OFF_LOCKED  # the part held while pulled until the pads slid off its handle
             return Decision.SLIPPED_AT_END_STOP if self.in_end_stop else Decision.SLIPPED
         self.in_end_stop = self.in_end_stop or (r.commanded > 1.0 and r.magnitude > c.end_stop_force)
@@ -159,7 +163,7 @@ class PinchJudge:
         :attr:`Decision.GO_ON`, which go on to :meth:`verdict`)."""
         if decision in (Decision.GO_ON, Decision.AT_STOP):
             raise ValueError(f"{decision} does not end a try; the verdict judges it")
-        peak, progress = max(self.forces), self.progress
+        peak, progress = self.peak, self.progress
         if decision is Decision.HELD_EARLY:
             return Judgement("blocked", Cause.LOCKED_NO_PROGRESS, progress, peak, decision=decision)
         if decision is Decision.HELD_PART_WAY:

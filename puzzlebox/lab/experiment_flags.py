@@ -23,6 +23,7 @@ FAULTS = "faults"
 TWIN_LEARNING = "twin-learning"
 HARD_SETS = "hard-sets"
 REGRESSION = "regression"
+TRIES = "tries"
 SYSID = "sysid"
 KINDS = "kinds"
 MANIPULATION = "manipulation"
@@ -35,6 +36,7 @@ PROTOCOL_NAMES = (
     TWIN_LEARNING,
     HARD_SETS,
     REGRESSION,
+    TRIES,
     SYSID,
     DISASSEMBLY,
     KINDS,

@@ -1,7 +1,8 @@
 """Every protocol of ``experiment.py`` from its settings (:class:`ExperimentFlags`): the paper's symbolic ones
 (``puzzlebox.lab.paper_protocols``) and the twin's — ``reality`` (``reality_sweep``), ``twin-learning``, ``hard-sets``
 (``hard_grid``),
-``kinds`` (``kinds_experiment``), ``manipulation`` (``manipulation_experiment``), ``sysid``, ``disassembly``
+``kinds`` (``kinds_experiment``), ``manipulation`` (``manipulation_experiment``), ``sysid``, ``tries``
+(``tries_experiment``), ``disassembly``
 (``disassembly_run``) and ``faults``. Each checks the flags it takes, writes ``DIR/<name>.config.json``, runs
 (resuming what a previous run of the same command finished) and hands its report (``DIR/<name>.md``) and wall time
 to ``echo``. A mistake in the settings is an :class:`ExperimentSettingsError`; the learning layer's refusal an
@@ -25,6 +26,7 @@ from puzzlebox.lab.experiment_flags import (
     REALITY,
     REGRESSION,
     SYSID,
+    TRIES,
     TWIN_LEARNING,
     ExperimentFlags,
     release_outputs,
@@ -40,7 +42,7 @@ def run_experiment(flags: ExperimentFlags, echo: Echo = print) -> None:
     """Check ``flags`` and run its protocol."""
     flags.check()
     runs = {REALITY: run_reality, FAULTS: run_faults, TWIN_LEARNING: run_twin_learning, HARD_SETS: run_hard_sets,
-            REGRESSION: run_regression, SYSID: run_sysid,
+            REGRESSION: run_regression, SYSID: run_sysid, TRIES: run_tries,
             DISASSEMBLY: run_disassembly, KINDS: run_kinds, MANIPULATION: run_manipulation}  # fmt: skip
     try:
         runs.get(flags.protocol, run_paper_protocols)(flags, echo)
@@ -221,6 +223,22 @@ def run_sysid(flags: ExperimentFlags, echo: Echo = print) -> None:
     except LearningError as err:
         raise ExperimentFailed(str(err)) from err
     report(out, SYSID, summary, echo)
+
+
+def run_tries(flags: ExperimentFlags, echo: Echo = print) -> None:
+    """A corpus of recorded tries, and the pinch's judgement measured on it offline against the truth."""
+    from puzzlebox.lab.tries_experiment import TriesConfig, run_tries
+
+    flags.only("--out, --workers and --quick", "agents", "runs", "seeds", "ray", "memory")
+    flags.check_workers(show=True)
+    config = TriesConfig().quick() if flags.quick else TriesConfig()
+    out = flags.out_dir(directory_only=True)
+    flags.write_config(out, TRIES, tries=asdict(config))
+    try:
+        summary = run_tries(out, config, flags.workers)
+    except LearningError as err:
+        raise ExperimentFailed(str(err)) from err
+    report(out, TRIES, summary, echo)
 
 
 def cell_seeds(cells: str) -> tuple[int, ...]:

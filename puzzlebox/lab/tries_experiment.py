@@ -1,0 +1,183 @@
+"""``experiment.py tries``: record every try of a set of twin trials into a corpus, then measure the pinch's
+judgement on it offline (:mod:`puzzlebox.lab.try_corpus`).
+
+The trials: the paper's three test boxes under each profile (``ideal``, ``realistic``, ``harsh``, each with its
+cell's calibration), runs with one kind misreported (``realistic``), and hard boxes of each family (``realistic``),
+each solved by the dual agent from an empty memory. The split: the paper boxes are the ``development`` part (the
+judgement's thresholds were set over the project's history on them, at other seeds); the hard boxes, drawn from a
+seed range used nowhere else, and the misreported runs are ``held-out``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from puzzlebox.lab.cli import write_json
+from puzzlebox.lab.hard_sets import FAMILY_NAMES, hard_box
+from puzzlebox.lab.reality_sweep import calibration_task
+from puzzlebox.lab.runner import RecordStore, Task, make_executor, run_tasks
+from puzzlebox.lab.try_corpus import RecordedTry, judge_corpus, load_tries, sample, save_tries
+from puzzlebox.learning import make_agent, run_episode
+from puzzlebox.models import PuzzleSpec
+from puzzlebox.models.atomic import write_atomically
+from puzzlebox.models.calibration import CellCalibration
+from puzzlebox.models.generator import paper_family
+from puzzlebox.models.kinds import get_kind
+from puzzlebox.models.spec_loading import spec_from_dict
+from puzzlebox.twin.reality import RealityProfile, load_profile
+
+
+@dataclass(frozen=True)
+class TriesConfig:
+    """What ``experiment.py tries`` records."""
+
+    profiles: tuple[str, ...] = ("ideal", "realistic", "harsh")
+    paper_seeds: tuple[int, ...] = (7000, 7001, 7002, 7003)
+    """Trial seeds (placements) of each paper test box under each profile."""
+    misreported: int = 12
+    """Runs with one kind misreported (``realistic``; box ``i % 3``, seed ``7100 + i``)."""
+    hard_boxes: int = 2
+    """Hard boxes of each family (seeds from :attr:`hard_seed`), one placement each (``realistic``)."""
+    hard_seed: int = 97_000
+    agent: str = "dual"
+    max_actions: int = 20
+
+    def quick(self) -> TriesConfig:
+        """CI size: one placement per profile, two misreported runs, one hard box of one family."""
+        return dataclasses.replace(self, paper_seeds=(7000,), misreported=2, hard_boxes=1)
+
+
+def _trials(config: TriesConfig) -> Iterator[tuple[str, PuzzleSpec, int, str, bool, str]]:
+    """(key, spec, seed, profile, one kind misreported, split) of every trial."""
+    paper = paper_family("test", seed=0)
+    for profile in config.profiles:
+        for spec in paper:
+            for seed in config.paper_seeds:
+                yield f"{profile}-{spec.name}-s{seed}", spec, seed, profile, False, "development"
+    for i in range(config.misreported):
+        yield f"misreported-{paper[i % 3].name}-s{7100 + i}", paper[i % 3], 7100 + i, "realistic", True, "held-out"
+    for family in FAMILY_NAMES:
+        for b in range(config.hard_boxes):
+            spec = hard_box(family, config.hard_seed + b)
+            yield f"hard-{spec.name}", spec, config.hard_seed + b, "realistic", False, "held-out"
+
+
+def record_task(settings: dict[str, Any], context: dict[str, Any]) -> dict[str, Any]:
+    """Run one trial with every toggle recorded (a runner task); the tries go to ``context["file"]``."""
+    from puzzlebox.lab.twin_trial import evaluation_world, wrong_kind  # MuJoCo only in the task
+    from puzzlebox.learning.belief import CELL_BELIEF
+    from puzzlebox.skills import SkillError
+    from puzzlebox.twin.errors import SimulationDiverged
+    from puzzlebox.twin.session import TwinSession
+
+    start = time.perf_counter()
+    spec, seed = spec_from_dict(settings["spec"]), settings["seed"]
+    profile = RealityProfile.from_dict(settings["profile"])
+    calibration = CellCalibration.from_dict(settings["calibration"])
+    tries: list[RecordedTry] = []
+    with TwinSession(spec, seed=seed, reality=profile) as session:
+        told = wrong_kind(session.spec, seed) if settings["misreported"] else {}
+        world = evaluation_world(session, session.robot, calibration, seed, told)
+        base = {"key": settings["key"], "profile": settings["profile_name"], "box": spec.name, "seed": seed,
+                "split": settings["split"], "misreported": told}  # fmt: skip
+        _record_toggles(world, session, tries, base)
+        agent = make_agent(settings["agent"], session.spec, belief=CELL_BELIEF)
+        try:
+            result = run_episode(agent, world, spec.name, seed, settings["max_actions"])
+            solved, ended = result.solved, result.ended
+        except (SkillError, SimulationDiverged) as err:  # the tries recorded so far are kept
+            solved, ended = False, f"{type(err).__name__}: {err}"
+    save_tries(context["file"], tries)
+    return {"key": settings["key"], "solved": solved, "ended": ended, "tries": len(tries),
+            "pinches": sum(t.trace is not None for t in tries), "wall_time_s": time.perf_counter() - start}  # fmt: skip
+
+
+def _record_toggles(world: Any, session: Any, tries: list[RecordedTry], base: dict[str, Any]) -> None:
+    """Wrap ``world``'s toggle primitive on the instance: each toggle's result, readings and (evaluation only)
+    the part's true state and fraction before and after it go to ``tries``."""
+    toggler, spec = world.toggler, session.spec
+    index = {c.name: i for i, c in enumerate(spec.components)}
+    travels = [get_kind(c.kind).travel for c in spec.components]
+    original = toggler.toggle
+
+    def toggle(jm: Any, opening: bool = True, *args: Any, **kwargs: Any) -> Any:
+        marker = next((m for m, model in world.joint_models.items() if model is jm), -1)
+        i = index[world.names[marker]]
+        before = (int(session.component_states()[i]), float(session.component_positions()[i]))
+        result = original(jm, opening, *args, **kwargs)
+        after = (int(session.component_states()[i]), float(session.component_positions()[i]))
+        truth = {"state_before": before[0], "state_after": after[0],
+                 "fraction_before": before[1] / travels[i], "fraction_after": after[1] / travels[i]}  # fmt: skip
+        context = {**base, "action": len(world.log) + 1, "component": world.names[marker], "kind": jm.kind,
+                   "opening": bool(opening)}  # fmt: skip
+        cause = result.cause.value if result.cause is not None else None
+        tries.append(RecordedTry(context, result.outcome, cause, truth, result.trace))
+        return result
+
+    toggler.toggle = toggle
+
+
+def run_tries(out: Path, config: TriesConfig, workers: int | None = None) -> dict[str, Any]:
+    """Record (or resume recording) the corpus into ``out/tries/`` and judge it; returns the summary also written
+    to ``out/tries.json`` (and ``out/tries.md``)."""
+    out.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    profiles = {name: load_profile(name) for name in config.profiles}
+    records = out / "records"
+    with make_executor(workers, None) as executor:
+        spec0 = paper_family("test", seed=0)[0]
+        calibrations = [Task(f"calibration-{name}", calibration_task, {"spec": spec0.to_dict(), "profile": p.to_dict()})
+                        for name, p in profiles.items()]  # fmt: skip
+        done = run_tasks(calibrations, RecordStore(records / "calibrations"), executor, desc="calibrations")
+        done.raise_for_failures()
+        cal = {name: done.records[f"calibration-{name}"]["calibration"] for name in profiles}
+        tasks = [
+            Task(key, record_task, {"key": key, "spec": spec.to_dict(), "seed": seed,
+                                    "profile": profiles[profile].to_dict(), "profile_name": profile,
+                                    "calibration": cal[profile], "misreported": misreported, "split": split,
+                                    "agent": config.agent, "max_actions": config.max_actions},
+                 context={"file": str(out / "tries" / f"{key}.npz")})
+            for key, spec, seed, profile, misreported, split in _trials(config)
+        ]  # fmt: skip
+        report = run_tasks(tasks, RecordStore(records / "trials"), executor, desc="recorded trials",
+                           postfix=lambda r: f"tries {sum(x['tries'] for x in r.values())}")  # fmt: skip
+        report.raise_for_failures()
+    tries = [t for task in tasks for t in load_tries(out / "tries" / f"{task.key}.npz")]
+    summary = {"trials": len(tasks), "tries": len(tries), **judge_corpus(tries),
+               "wall_time_s": time.perf_counter() - start}  # fmt: skip
+    write_json(out / "tries.json", summary)
+    save_tries(out / "sample.npz", sample(tries))
+    write_atomically(out / "tries.md", lambda tmp: tmp.write_text(markdown(summary)))
+    return summary
+
+
+def _row(name: str, tally: dict[str, Any]) -> str:
+    c = tally["confusion"]
+    agreement = "-" if tally["agreement"] is None else f"{100 * tally['agreement']:.2f} %"
+    return (f"| {name} | {tally['pinches']} | {tally['same_as_live']} | {agreement} | {c['moved']['moved']} / "
+            f"{c['moved']['not moved']} | {c['blocked']['moved']} / {c['blocked']['not moved']} | "
+            f"{c['failed']['moved']} / {c['failed']['not moved']} |")  # fmt: skip
+
+
+def markdown(summary: dict[str, Any]) -> str:
+    """The report: the judgement's agreement with the truth per group, with each group's confusion matrix."""
+    head = ("| group | pinches | judged as live | agreement (evidence) | moved: truly moved / not | "
+            "blocked: truly moved / not | failed: truly moved / not |\n|---|---|---|---|---|---|---|")  # fmt: skip
+    lines = [
+        "# The pinch's judgement on the corpus of recorded tries", "",
+        f"{summary['trials']} trials, {summary['tries']} tries; the judgement run offline on every recorded pinch "
+        f"({summary['ms_per_judgement']:.3f} ms a pinch). Tries no pinch judgement concluded: "
+        f"{json.dumps(summary['unjudged'])}.", "", head, _row("all", summary["all"]["all"]),
+    ]  # fmt: skip
+    for group in ("split", "profile", "cause"):
+        lines += [_row(f"{group} {k}", v) for k, v in summary[group].items()]
+    return "\n".join(lines) + "\n"
+
+
+__all__ = ["TriesConfig", "record_task", "run_tries"]
