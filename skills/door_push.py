@@ -14,7 +14,6 @@ when closed); opening turns ``e_x`` towards ``e_z`` by the door angle.
 
 from __future__ import annotations
 
-import collections
 import dataclasses
 import math
 from dataclasses import dataclass
@@ -23,13 +22,21 @@ import numpy as np
 
 from puzzlebox.models.kinds import HANDLE_HEIGHT, HANDLE_MARGIN, HANDLE_SIZE
 from puzzlebox.models.try_outcome import Cause
+from puzzlebox.skills.door_judgement import (
+    ClosingJudge,
+    ClosingLimits,
+    ClosingReading,
+    SwingJudge,
+    SwingLimits,
+    SwingReading,
+)
 from puzzlebox.skills.errors import IKFailure
 from puzzlebox.skills.joint_model import GRASP_DEPTH, JointModel, cross
 from puzzlebox.skills.kinematics import top_down
 from puzzlebox.skills.pacing import Pacing
 from puzzlebox.skills.pinch import Pinch, TryArgs
 from puzzlebox.skills.settings import DoorPushConfig
-from puzzlebox.skills.toggle_result import HELD_PART_WAY, LATCHED, ToggleResult
+from puzzlebox.skills.toggle_result import LATCHED, ToggleResult
 
 PUSHED_IN_VAIN = LATCHED[Cause.LOCKED_PUSHED]
 
@@ -196,9 +203,8 @@ class DoorPusher:
         scheduled, schedule_at = closing.at, closing.tick_at
         held_offset = closing.held_offset(door, p.plan.gap, p.plan.depth, p.plan.close_x)
 
-        forces: list[float] = []
+        judge = ClosingJudge(c.judgement, p.judgement, ClosingLimits(start, contact))
         progress = 0.0
-        pressed_from: float | None = None  # the progress at which the pads first pressed on the plate
         self.ik.set_joints(self.robot.joint_positions())
         turn_at_start = door.turn_of(self.pad_edge(door, p.plan.pad_half_width))
         result = None
@@ -207,6 +213,7 @@ class DoorPusher:
         while schedule < ticks + round(2 * c.motion.settle_time / c.motion.tick):
             k += 1
             step = 1.0
+            pressed_from = judge.pressed_from  # the progress at which the pads first pressed on the plate
             engaged = pressed_from is not None and progress - max(pressed_from, start) >= c.judgement.blocked_progress
             if not engaged:  # searching for the plate, or pressed on it but not yet seen to follow the pads
                 nominal = scheduled(schedule + 1.0) - scheduled(schedule)
@@ -221,28 +228,24 @@ class DoorPusher:
             turn = door.turn_of(self.pad_edge(door, p.plan.pad_half_width))
             progress = self.pinch.progress = start + (turn_at_start - turn) / door.travel
             angle = (1.0 - max(progress, 0.0)) * door.travel
-            forces.append(float(self.watch.force_in_base @ door.motion_direction(angle)))  # opposing a closing motion
+            opposing = float(self.watch.force_in_base @ door.motion_direction(angle))  # opposing a closing motion
             magnitude = math.sqrt(self.watch.force_in_base @ self.watch.force_in_base)  # np.linalg.norm, bit for bit
-            if pressed_from is None and forces[-1] > contact:
-                pressed_from = progress
+            ended = judge.read(ClosingReading(progress, opposing, magnitude))
+            if pressed_from is None and judge.pressed_from is not None:
                 # the command runs the arm's tracking lag ahead of the pads (~1.5 mm at ``search_speed``): pressed
                 # on a plate that does not give, it loads the wrist by the arm's stiffness times that lag whatever
                 # is sent next, while the reading is late. Sent back to where the pads are, they press on from
                 # there at ``press_speed``.
                 schedule = min(schedule, schedule_at(progress - held_offset))
-            if progress >= c.judgement.moved_fraction and magnitude > p.judgement.end_force:
+            if ended is True:
                 # the plate is on the lid: stop at once. (Easing on to where the pads were, a door that fell
                 # shut and was met on the lid at 15 mm/s loaded the wrist by 5-8 N per tick to 71 N.)
                 break
-            pushed = progress - (start if pressed_from is None else max(pressed_from, start))
-            # (a door that fell shut ahead of the pads is first pressed on the lid: closed, not latched)
-            short = progress < c.judgement.moved_fraction and pushed < c.judgement.blocked_progress
-            if short and (forces[-1] > c.judgement.blocked_force or magnitude > c.judgement.blocked_magnitude):
-                result = ToggleResult("blocked", PUSHED_IN_VAIN, progress, max(forces),
-                                      forces=forces, cause=Cause.LOCKED_PUSHED)  # fmt: skip
+            if ended is not False:
+                result = Pinch.result_of(ended, judge.forces)
                 break
         if result is None:
-            result = self.pinch.verdict(progress, forces, Cause.LOCKED_PUSHED)
+            result = Pinch.result_of(judge.verdict(progress), judge.forces)
         return self._off_the_plate(door, progress, result)
 
     def _off_the_plate(self, door: DoorPush, progress: float, result: ToggleResult) -> ToggleResult:
@@ -361,11 +364,12 @@ class DoorPusher:
         )  # the start of the travel, driven slowly as a pinch's
         pacing = Pacing(pace, pace * c.actuation.breakaway_pace, slow_span)  # slow start, then a ramp up
         last_tick = pacing.ticks_to(end - start)
-        forces: list[float] = []
+        limits = SwingLimits(
+            start, contact, p.judgement.held_turn / door.travel, p.judgement.slide_turn / door.travel,
+            max(2, round(c.judgement.stall_window * self.watch.slowdown / c.motion.tick)),
+        )  # fmt: skip
+        judge = SwingJudge(c.judgement, p.judgement, limits)
         progress = 0.0
-        pressed_at: tuple[float, float] | None = None  # (progress, face angle) when the pad first pressed
-        last_pressed, last_face = start, 0.0  # progress and face angle when the pad last pressed on the face
-        track: collections.deque[tuple[float, float]] = collections.deque()  # (progress, face) pressed, in a row
         self.ik.set_joints(self.robot.joint_positions())
         turn_at_start = door.turn_of(self.pad_edge(door, p.plan.pad_offset))
         for k in range(1, last_tick + 1 + round(2 * c.motion.settle_time / c.motion.tick)):
@@ -381,113 +385,17 @@ class DoorPusher:
             )
             angle = max(progress, 0.0) * door.travel
             normal = float(self.watch.force_in_base @ door.face_normal(angle))
-            forces.append(float(-self.watch.force_in_base @ door.motion_direction(angle)))
+            opposing = float(-self.watch.force_in_base @ door.motion_direction(angle))
             magnitude = math.sqrt(self.watch.force_in_base @ self.watch.force_in_base)  # np.linalg.norm, bit for bit
             if s > 1.0 and magnitude > c.actuation.overtravel_force:  # in the end stop: stop here
                 end = max(1.0, min(progress, s))
             face = door.angle_from_contact(pad_edge) / door.travel
-            if normal > contact:
-                last_pressed, last_face = progress, face
-                if pressed_at is None:
-                    pressed_at = (progress, face)
-                track.append((progress, face))
-            else:
-                track.clear()  # (the turn over which the pad slid is measured pressed all the while)
-            stopped = self._held(door, angle, start, progress, face, normal, magnitude, pressed_at, track, forces)
-            if stopped is not None:
-                return stopped
+            ended = judge.read(SwingReading(progress, face, normal, opposing, magnitude))
+            if ended is not None:
+                self.back_off(door, angle)
+                return Pinch.result_of(ended, judge.forces, judge.trace())
         self.back_off(door, max(progress, 0.0) * door.travel)
-        return self._swung(start, progress, (last_pressed, last_face), pressed_at, forces)
-
-    def _swung(
-        self,
-        start: float,
-        progress: float,
-        last_pressed: tuple[float, float],
-        pressed_at: tuple[float, float] | None,
-        forces: list[float],
-    ) -> ToggleResult:
-        """The verdict of a swing that ran its course from ``start`` to ``progress`` (fractions of the travel), the
-        pad last pressed on the face at ``last_pressed`` (progress, face) and first at ``pressed_at``."""
-        c = self.config
-        if last_pressed[0] < c.judgement.moved_fraction:
-            # the pad lost the face before the door was open: it went over the post (a latched door, inside the
-            # slide test's 7 deg: it read "moved" with the door shut) or the door is elsewhere. How far the door
-            # went is how far its face turned while pressed.
-            at = start + (max(last_pressed[1] - pressed_at[1], 0.0) if pressed_at is not None else 0.0)
-            return self.pinch.verdict(at, forces, Cause.LOCKED_PUSHED if start < c.judgement.blocked_progress else None)
-        return self.pinch.verdict(progress, forces)  # a latch was decided on the way: short of it, no evidence
-
-    def _held(
-        self,
-        door: DoorPush,
-        angle: float,
-        start: float,
-        progress: float,
-        face: float,
-        normal: float,
-        magnitude: float,
-        pressed_at: tuple[float, float] | None,
-        track: collections.deque[tuple[float, float]],
-        forces: list[float],
-    ) -> ToggleResult | None:
-        """A swing's judgement at one tick (the pad at ``progress`` of the travel, the face it presses on at ``face``,
-        ``normal`` [N] on it and ``magnitude`` [N] on the wrist): held part-way, the pad sliding along a face that
-        does not turn (latched, or jammed if the door stood part-way open), or pushed in vain; the pad backed off the
-        face then. None: go on."""
-        c = self.config
-        p = c.push
-        held = (
-            len(track) > 0
-            and pressed_at is not None
-            and self.held_part_way(track, pressed_at[1], p.judgement.held_turn / door.travel, normal)
-        )
-        if held:
-            self.back_off(door, angle)
-            return ToggleResult("blocked", f"{HELD_PART_WAY} ({face:.0%} of the travel)", progress, max(forces),
-                                forces=forces, cause=Cause.HELD_PART_WAY, held_at=face)  # fmt: skip
-        slid = pressed_at is not None and progress - pressed_at[0] >= p.judgement.slide_turn / door.travel
-        if slid and pressed_at is not None and face - pressed_at[1] < 0.5 * (progress - pressed_at[0]):
-            self.back_off(door, angle)
-            if start >= c.judgement.blocked_progress:  # a door held part-way open is stuck, not latched: no evidence
-                return ToggleResult("failed", f"Jammed: the door held at {start:.0%} of its travel",
-                                    progress, max(forces), forces=forces, cause=Cause.JAMMED)  # fmt: skip
-            return ToggleResult("blocked", LATCHED[Cause.LOCKED_PAD_SLID], progress, max(forces),
-                                forces=forces, cause=Cause.LOCKED_PAD_SLID)  # fmt: skip
-        if progress < c.judgement.blocked_progress and (
-            normal > p.judgement.blocked_force or magnitude > c.judgement.blocked_magnitude
-        ):
-            self.back_off(door, angle)
-            return ToggleResult("blocked", PUSHED_IN_VAIN, progress, max(forces), forces=forces,
-                                cause=Cause.LOCKED_PUSHED)  # fmt: skip
-        return None
-
-    def held_part_way(
-        self, track: collections.deque[tuple[float, float]], first_face: float, turn: float, normal: float
-    ) -> bool:
-        """Whether the door stopped part-way against the push (a lock's rod at its wall), the pad pressed on its face
-        over ``track`` ((progress, face) per tick, the latest last; ticks older than ``turn`` of the pad's travel
-        are dropped): after the face had turned with the pad past ``blocked_progress`` of the travel since it
-        first pressed (at ``first_face``), short of ``moved_fraction``, either the pad slid along the face over
-        ``turn`` while the face turned less than half as much, or the face stood still (``stall_progress`` over
-        ``stall_window``) with ``normal`` [N] on it above ``stall_force`` (the pad, held back by its lead, turns
-        slowly along a face that does not give: a door held at 27 % was pressed with 51 N before it had slid 3
-        deg). A face that never turned is a latch or a jam, judged by the slide test since the first press."""
-        c = self.config
-        progress, face = track[-1]
-        while len(track) > 1 and track[1][0] <= progress - turn:
-            track.popleft()
-        begun, face_then = track[0]
-        if face_then - first_face < c.judgement.blocked_progress or face >= c.judgement.moved_fraction:
-            return False  # (further, the door is in its end stop: open)
-        if progress - begun >= turn and face - face_then < 0.5 * (progress - begun):
-            return True
-        window = max(2, round(c.judgement.stall_window * self.watch.slowdown / c.motion.tick))
-        return (
-            normal > c.judgement.stall_force
-            and len(track) >= window
-            and abs(face - track[-window][1]) < c.judgement.stall_progress
-        )
+        return Pinch.result_of(judge.verdict(progress), judge.forces, judge.trace(progress))
 
     def back_off(self, door: DoorPush, angle: float) -> None:
         """Take the pad off the handle's face (along its normal, :meth:`DoorPush.face_normal` at ``angle``; a

@@ -17,6 +17,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from puzzlebox.models.try_outcome import Cause
+from puzzlebox.skills.door_judgement import SwingTrace
 from puzzlebox.skills.errors import GraspFailure, SlipDetected
 from puzzlebox.skills.joint_model import JointModel
 from puzzlebox.skills.judgement import Decision, Judgement, PinchJudge, PinchLimits, PinchTrace, Reading, verdict
@@ -333,7 +334,9 @@ class Pinch:
         return self.result_of(verdict(self.config.judgement, progress, forces, latched), forces)
 
     @staticmethod
-    def result_of(judgement: Judgement, forces: list[float], trace: PinchTrace | None = None) -> ToggleResult:
+    def result_of(
+        judgement: Judgement, forces: list[float], trace: PinchTrace | SwingTrace | None = None
+    ) -> ToggleResult:
         """The toggle's result of a judgement, its reason rendered from its cause; a slip raises
         :class:`SlipDetected` (no evidence: the toggle's retries decide what follows)."""
         cause, progress = judgement.cause, judgement.progress
@@ -344,14 +347,17 @@ class Pinch:
         if cause is None:
             reason = ""
         elif cause is Cause.HELD_PART_WAY:
-            reason = f"{HELD_PART_WAY} ({progress:.0%} of the travel)"
+            reason = f"{HELD_PART_WAY} ({judgement.held_at:.0%} of the travel)"
+        elif cause is Cause.JAMMED:
+            reason = f"Jammed: the door held at {judgement.held_at:.0%} of its travel"
         elif cause is Cause.INCOMPLETE_TRAVEL:
             reason = f"{INCOMPLETE_TRAVEL}: only {progress:.0%} of the travel covered"
         else:
             reason = LATCHED[cause]
         return ToggleResult(
             judgement.outcome, reason, progress, judgement.peak_opposing_force, forces=forces, cause=cause,
-            end_stop_felt=judgement.end_stop_felt, held_at=judgement.held_at, trace=trace,
+            end_stop_felt=judgement.end_stop_felt, trace=trace,
+            held_at=judgement.held_at if cause is Cause.HELD_PART_WAY else None,
         )  # fmt: skip
 
     def leaning(self, upright: np.ndarray, lean: np.ndarray | None) -> np.ndarray:

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 from puzzlebox.models.try_outcome import Cause, Outcome
 
 if TYPE_CHECKING:
+    from puzzlebox.skills.door_judgement import SwingTrace
     from puzzlebox.skills.judgement import PinchTrace
 
 LATCHED: dict[Cause, str] = {
@@ -57,9 +58,10 @@ class ToggleResult:
     still while the pad slid along it)."""
     not_pushed: bool = False
     """A door the pads lost stands part-way where no look sees it: it was not pushed."""
-    trace: PinchTrace | None = None
-    """The readings the pinch's judgement read this result from (:func:`skills.judgement.judge_pinch` judges them
-    again offline); None for a result a pinch's judgement did not give (a push, an error)."""
+    trace: PinchTrace | SwingTrace | None = None
+    """The readings the judgement read this result from, a pinch's (:func:`skills.judgement.judge_pinch`) or a
+    door's opening swing's (:func:`skills.door_judgement.judge_swing`), to judge them again offline; None for a
+    result no recorded judgement gave (a closing push, a top-up, an error)."""
 
     def seen_moved(self) -> None:
         """The world saw the part at its other state after this try failed past ``moved_fraction`` (a stop, a slip
