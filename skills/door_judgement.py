@@ -18,6 +18,7 @@ Each judge is fed tick by tick by :class:`skills.door_push.DoorPusher`, which ob
 from __future__ import annotations
 
 import collections
+import math
 from dataclasses import dataclass
 
 from puzzlebox.models.try_outcome import Cause
@@ -64,6 +65,8 @@ class SwingJudge:
         self.judgement, self.push, self.limits = judgement, push, limits
         self.forces: list[float] = []
         """Load against the motion at each tick [N]."""
+        self.peak = -math.inf
+        """The largest of :attr:`forces` [N]."""
         self.readings: list[SwingReading] = []
         self.pressed_at: tuple[float, float] | None = None
         """(progress, face) when the pad first pressed on the face."""
@@ -77,6 +80,7 @@ class SwingJudge:
         c, lim = self.judgement, self.limits
         self.readings.append(r)
         self.forces.append(r.opposing)
+        self.peak = max(self.peak, r.opposing)  # max(self.forces), kept as it grows
         if r.normal > lim.contact:
             self.last_pressed = (r.progress, r.face)
             if self.pressed_at is None:
@@ -84,7 +88,7 @@ class SwingJudge:
             self.track.append((r.progress, r.face))
         else:
             self.track.clear()  # (the turn over which the pad slid is measured pressed all the while)
-        pressed_at, peak = self.pressed_at, max(self.forces)
+        pressed_at, peak = self.pressed_at, self.peak
         if self.track and pressed_at is not None and self.held_part_way(pressed_at[1], r.normal):
             return Judgement("blocked", Cause.HELD_PART_WAY, r.progress, peak, held_at=r.face)
         slid = pressed_at is not None and r.progress - pressed_at[0] >= lim.slide_turn

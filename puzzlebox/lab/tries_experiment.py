@@ -95,7 +95,7 @@ def record_task(settings: dict[str, Any], context: dict[str, Any]) -> dict[str, 
             solved, ended = False, f"{type(err).__name__}: {err}"
     save_tries(context["file"], tries)
     return {"key": settings["key"], "solved": solved, "ended": ended, "tries": len(tries),
-            "pinches": sum(t.trace is not None for t in tries), "wall_time_s": time.perf_counter() - start}  # fmt: skip
+            "judged": sum(t.trace is not None for t in tries), "wall_time_s": time.perf_counter() - start}  # fmt: skip
 
 
 def _record_toggles(world: Any, session: Any, tries: list[RecordedTry], base: dict[str, Any]) -> None:
@@ -167,15 +167,16 @@ def _row(name: str, tally: dict[str, Any]) -> str:
 
 def markdown(summary: dict[str, Any]) -> str:
     """The report: the judgement's agreement with the truth per group, with each group's confusion matrix."""
-    head = ("| group | pinches | judged as live | agreement (evidence) | moved: truly moved / not | "
+    head = ("| group | judged | judged as live | agreement (evidence) | moved: truly moved / not | "
             "blocked: truly moved / not | failed: truly moved / not |\n|---|---|---|---|---|---|---|")  # fmt: skip
     lines = [
-        "# The pinch's judgement on the corpus of recorded tries", "",
-        f"{summary['trials']} trials, {summary['tries']} tries; the judgement run offline on every recorded pinch "
-        f"({summary['ms_per_judgement']:.3f} ms a pinch). Tries no pinch judgement concluded: "
-        f"{json.dumps(summary['unjudged'])}.", "", head, _row("all", summary["all"]["all"]),
+        "# The hand's judgement on the corpus of recorded tries", "",
+        f"{summary['trials']} trials, {summary['tries']} tries; the judgement run offline on every recorded pinch and "
+        f"door swing ({summary['ms_per_judgement']:.3f} ms each). Tries no recorded judgement concluded (closing "
+        f"pushes, top-ups, failed grasps), by cause: {json.dumps(summary['unjudged'])}.", "", head,
+        _row("all", summary["all"]["all"]),
     ]  # fmt: skip
-    for group in ("split", "profile", "cause"):
+    for group in ("motion", "split", "profile", "cause"):
         lines += [_row(f"{group} {k}", v) for k, v in summary[group].items()]
     return "\n".join(lines) + "\n"
 

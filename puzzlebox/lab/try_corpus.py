@@ -27,12 +27,15 @@ import numpy as np
 
 from puzzlebox.models.npz_file import load_header, save_npz
 from puzzlebox.models.try_outcome import Cause
-from puzzlebox.skills.judgement import PinchLimits, PinchTrace, Reading, judge_pinch
-from puzzlebox.skills.settings import JudgementConfig
+from puzzlebox.skills.door_judgement import SwingLimits, SwingReading, SwingTrace, judge_swing
+from puzzlebox.skills.judgement import Judgement, PinchLimits, PinchTrace, Reading, judge_pinch
+from puzzlebox.skills.settings import PrimitiveConfig
 
 FORMAT = "puzzlebox-tries/1"
 READING_COLUMNS = ("commanded", "opposing", "magnitude", "progress", "closure")
-"""The columns of a try's ``actuation`` array, one row per :class:`Reading`."""
+"""The columns of a pinch's ``actuation`` array, one row per :class:`Reading`."""
+SWING_COLUMNS = ("progress", "face", "normal", "opposing", "magnitude")
+"""The columns of a door swing's ``actuation`` array, one row per :class:`SwingReading`."""
 
 
 @dataclass(frozen=True)
@@ -47,8 +50,9 @@ class RecordedTry:
     """Its cause (a :class:`models.try_outcome.Cause` value), None for moved."""
     truth: dict[str, Any]
     """Evaluation only: ``state_before``, ``state_after`` (0/1), ``fraction_before``, ``fraction_after`` [-]."""
-    trace: PinchTrace | None
-    """The pinch's readings, or None: the toggle's result came from no pinch judgement (a push, a failed grasp)."""
+    trace: PinchTrace | SwingTrace | None
+    """The readings its judgement read, a pinch's or a door's opening swing's, or None: the toggle's result came from
+    no recorded judgement (a closing push, a top-up, a failed grasp)."""
 
     @property
     def truly_moved(self) -> bool:
@@ -61,11 +65,15 @@ def save_tries(path: str | Path, tries: Iterable[RecordedTry]) -> Path:
     arrays: dict[str, np.ndarray] = {}
     for i, t in enumerate(tries):
         h = {"context": t.context, "outcome": t.outcome, "cause": t.cause, "truth": t.truth, "trace": None}
-        if t.trace is not None:
-            h["trace"] = {"limits": dataclasses.asdict(t.trace.limits), "reached": t.trace.reached}
+        if isinstance(t.trace, PinchTrace):
+            h["trace"] = {"kind": "pinch", "limits": dataclasses.asdict(t.trace.limits), "reached": t.trace.reached}
             rows = [[getattr(r, c) for c in READING_COLUMNS] for r in t.trace.actuation]
             arrays[f"{i}.actuation"] = np.array(rows, dtype=np.float64).reshape(-1, len(READING_COLUMNS))
             arrays[f"{i}.settling"] = np.array(t.trace.settling, dtype=np.float64).reshape(-1, 2)
+        elif isinstance(t.trace, SwingTrace):
+            h["trace"] = {"kind": "swing", "limits": dataclasses.asdict(t.trace.limits), "ended_at": t.trace.ended_at}
+            rows = [[getattr(r, c) for c in SWING_COLUMNS] for r in t.trace.readings]
+            arrays[f"{i}.actuation"] = np.array(rows, dtype=np.float64).reshape(-1, len(SWING_COLUMNS))
         header.append(h)
     return save_npz(path, {"format": FORMAT, "tries": header}, arrays)
 
@@ -80,12 +88,15 @@ def load_tries(path: str | Path) -> list[RecordedTry]:
         header = load_header(data, path, FORMAT, "a file of tries")
         tries = []
         for i, h in enumerate(header["tries"]):
-            trace = None
-            if h["trace"] is not None:
+            trace: PinchTrace | SwingTrace | None = None
+            if h["trace"] is not None and h["trace"]["kind"] == "pinch":
                 readings = tuple(Reading(*map(float, row)) for row in data[f"{i}.actuation"])
                 settling = tuple((float(p), float(c)) for p, c in data[f"{i}.settling"])
                 limits = PinchLimits(**h["trace"]["limits"])
                 trace = PinchTrace(limits, readings, settling, h["trace"]["reached"])
+            elif h["trace"] is not None:
+                swings = tuple(SwingReading(*map(float, row)) for row in data[f"{i}.actuation"])
+                trace = SwingTrace(SwingLimits(**h["trace"]["limits"]), swings, h["trace"]["ended_at"])
             tries.append(RecordedTry(h["context"], h["outcome"], h["cause"], h["truth"], trace))
     return tries
 
@@ -127,12 +138,12 @@ class Tally:
                 "agreement": self.agreement, "confusion": self.confusion}  # fmt: skip
 
 
-def judge_corpus(tries: Iterable[RecordedTry], config: JudgementConfig | None = None) -> dict[str, Any]:
-    """The judgement on every recorded pinch of ``tries``, offline: tallies overall, per profile, per split, per
-    live cause; the tries no pinch judgement concluded (pushes, failed grasps) counted apart; the time a judgement
-    takes [ms]."""
-    config = config or JudgementConfig()
-    groups: dict[str, dict[str, Tally]] = {"all": {}, "profile": {}, "split": {}, "cause": {}}
+def judge_corpus(tries: Iterable[RecordedTry], config: PrimitiveConfig | None = None) -> dict[str, Any]:
+    """The judgement on every recorded pinch and swing of ``tries``, offline (the settings of ``config``, default
+    the hand's): tallies overall, per profile, per split, per live cause, per motion; the tries no recorded
+    judgement concluded (closing pushes, top-ups, failed grasps) counted apart; the time a judgement takes [ms]."""
+    config = config or PrimitiveConfig()
+    groups: dict[str, dict[str, Tally]] = {"all": {}, "profile": {}, "split": {}, "cause": {}, "motion": {}}
     unjudged: dict[str, int] = {}
     seconds, count = 0.0, 0
     for t in tries:
@@ -140,12 +151,13 @@ def judge_corpus(tries: Iterable[RecordedTry], config: JudgementConfig | None = 
             unjudged[t.cause or t.outcome] = unjudged.get(t.cause or t.outcome, 0) + 1
             continue
         start = time.perf_counter()
-        judgement = judge_pinch(t.trace, config)
+        judgement = judge_recorded(t, config)
         seconds += time.perf_counter() - start
         count += 1
         same = judgement.outcome == t.outcome and (judgement.cause.value if judgement.cause else None) == t.cause
+        motion = "pinch" if isinstance(t.trace, PinchTrace) else "swing"
         keys = {"all": "all", "profile": t.context["profile"], "split": t.context["split"],
-                "cause": t.cause or "moved"}  # fmt: skip
+                "cause": t.cause or "moved", "motion": motion}  # fmt: skip
         for group, key in keys.items():
             groups[group].setdefault(key, Tally()).add(judgement.outcome, t.truly_moved, same)
     return {
@@ -155,26 +167,51 @@ def judge_corpus(tries: Iterable[RecordedTry], config: JudgementConfig | None = 
     }
 
 
-CAUSES_OF_A_PINCH = (None, Cause.LOCKED_NO_PROGRESS, Cause.HELD_PART_WAY, Cause.LOCKED_PULLED,
-                     Cause.LOCKED_SLIPPED_OFF, Cause.INCOMPLETE_TRAVEL, Cause.SLIPPED)  # fmt: skip
-"""What a pinch's judgement can conclude (None: moved)."""
+CAUSES_JUDGED = (
+    None, Cause.LOCKED_NO_PROGRESS, Cause.HELD_PART_WAY, Cause.LOCKED_PULLED, Cause.LOCKED_SLIPPED_OFF,
+    Cause.LOCKED_PUSHED, Cause.LOCKED_PAD_SLID, Cause.INCOMPLETE_TRAVEL, Cause.SLIPPED, Cause.JAMMED,
+)  # fmt: skip
+"""What a pinch's or a swing's judgement can conclude (None: moved)."""
+
+
+def judge_recorded(t: RecordedTry, config: PrimitiveConfig) -> Judgement:
+    """The judgement of a recorded pinch or swing, offline.
+
+    Raises:
+        ValueError: ``t`` has no readings (no recorded judgement concluded it)."""
+    if isinstance(t.trace, PinchTrace):
+        return judge_pinch(t.trace, config.judgement)
+    if isinstance(t.trace, SwingTrace):
+        return judge_swing(t.trace, config.judgement, config.push.judgement)
+    raise ValueError(f"try {t.context} has no readings to judge")
 
 
 def sample(tries: list[RecordedTry], per_cause: int = 4) -> list[RecordedTry]:
-    """Up to ``per_cause`` recorded pinches of each live cause (moved included), each from a different trial where
-    there are enough: the sample committed under ``tests/`` for the judgement's tests."""
+    """Up to ``per_cause`` recorded pinches and as many swings of each live cause (moved included), each from a
+    different trial where there are enough: the sample committed under ``tests/`` for the judgement's tests."""
     chosen: list[RecordedTry] = []
-    for cause in CAUSES_OF_A_PINCH:
-        value = cause.value if cause is not None else None
-        pool = [t for t in tries if t.trace is not None and t.cause == value]
-        seen: set[str] = set()
-        for t in pool:
-            if len([c for c in chosen if c.cause == value]) >= per_cause:
-                break
-            if t.context["key"] not in seen:
-                seen.add(t.context["key"])
-                chosen.append(t)
+    for motion in (PinchTrace, SwingTrace):
+        for cause in CAUSES_JUDGED:
+            value = cause.value if cause is not None else None
+            pool = [t for t in tries if isinstance(t.trace, motion) and t.cause == value]
+            seen: set[str] = set()
+            for t in pool:
+                if len(seen) >= per_cause:
+                    break
+                if t.context["key"] not in seen:
+                    seen.add(t.context["key"])
+                    chosen.append(t)
     return chosen
 
 
-__all__ = ["FORMAT", "RecordedTry", "Tally", "judge_corpus", "load_tries", "sample", "save_tries"]
+__all__ = [
+    "CAUSES_JUDGED",
+    "FORMAT",
+    "RecordedTry",
+    "Tally",
+    "judge_corpus",
+    "judge_recorded",
+    "load_tries",
+    "sample",
+    "save_tries",
+]

@@ -7,9 +7,17 @@ from pathlib import Path
 
 import pytest
 
-from puzzlebox.lab.try_corpus import CAUSES_OF_A_PINCH, RecordedTry, judge_corpus, load_tries, sample, save_tries
-from puzzlebox.skills.judgement import PinchLimits, PinchTrace, Reading, judge_pinch
-from puzzlebox.skills.settings import JudgementConfig
+from puzzlebox.lab.try_corpus import (
+    CAUSES_JUDGED,
+    RecordedTry,
+    judge_corpus,
+    judge_recorded,
+    load_tries,
+    sample,
+    save_tries,
+)
+from puzzlebox.skills.judgement import PinchLimits, PinchTrace, Reading
+from puzzlebox.skills.settings import PrimitiveConfig
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLE = ROOT / "tests/skills/data/tries_sample.npz"
@@ -47,7 +55,7 @@ def test_the_judgement_is_tallied_against_the_truth_with_a_confusion_matrix():
         made_up("blocked", "held_part_way", False, 25.0),  # live said otherwise than the judgement does now
         RecordedTry({"key": "t1"}, "failed", "grasp_empty", {"state_before": 0, "state_after": 0}, None),
     ]
-    summary = judge_corpus(tries, JudgementConfig())
+    summary = judge_corpus(tries, PrimitiveConfig())
     overall = summary["all"]["all"]
     assert (overall["pinches"], overall["same_as_live"], overall["evidence"]) == (4, 3, 4)
     assert overall["agreement"] == pytest.approx(3 / 4)
@@ -69,10 +77,9 @@ def test_every_recorded_pinch_of_the_sample_is_judged_as_the_hand_judged_it_live
     assert SAMPLE.stat().st_size <= 5_000_000
     causes = {t.cause for t in tries}
     assert {None, "locked_no_progress", "held_part_way"} <= causes  # moved, and the two ways a lock is felt
-    assert causes <= {c.value if c else None for c in CAUSES_OF_A_PINCH}
+    assert causes <= {c.value if c else None for c in CAUSES_JUDGED}
     for t in tries:
-        assert t.trace is not None
-        judgement = judge_pinch(t.trace, JudgementConfig())
+        judgement = judge_recorded(t, PrimitiveConfig())
         assert (judgement.outcome, judgement.cause.value if judgement.cause else None) == (t.outcome, t.cause), (
             t.context
         )
