@@ -18,6 +18,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from puzzlebox.lab.cli import write_json
 from puzzlebox.lab.hard_sets import FAMILY_NAMES, hard_box
 from puzzlebox.lab.reality_sweep import calibration_task
@@ -154,6 +156,7 @@ def run_tries(out: Path, config: TriesConfig, workers: int | None = None) -> dic
     write_json(out / "tries.json", summary)
     save_tries(out / "sample.npz", sample(tries))
     write_atomically(out / "tries.md", lambda tmp: tmp.write_text(markdown(summary)))
+    write_atomically(out / "tries.png", lambda tmp: plot(summary, tmp))
     return summary
 
 
@@ -181,4 +184,32 @@ def markdown(summary: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["TriesConfig", "record_task", "run_tries"]
+def plot(summary: dict[str, Any], path: Path) -> None:
+    """One confusion matrix per profile (rows: what the judgement concluded; columns: the truth), counts in the
+    cells, the agreement over the evidence in the title."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    profiles = list(summary["profile"])
+    fig, axes = plt.subplots(1, max(len(profiles), 1), figsize=(3.4 * max(len(profiles), 1), 3.2), squeeze=False)
+    judged, truth = ("moved", "blocked", "failed"), ("moved", "not moved")
+    for ax, name in zip(axes[0], profiles, strict=False):
+        tally = summary["profile"][name]
+        counts = np.array([[tally["confusion"][j][t] for t in truth] for j in judged], dtype=float)
+        shade = counts / max(counts.max(), 1.0)
+        ax.imshow(shade, cmap="Blues", vmin=0.0, vmax=1.0)
+        for (row, col), n in np.ndenumerate(counts):
+            colour = "white" if shade[row, col] > 0.5 else "black"
+            ax.text(col, row, f"{n:.0f}", ha="center", va="center", fontsize=10, color=colour)
+        ax.set_xticks(range(len(truth)), [f"truly {t}" for t in truth], fontsize=8)
+        ax.set_yticks(range(len(judged)), [f"judged {j}" for j in judged], fontsize=8)
+        agreement = "-" if tally["agreement"] is None else f"{100 * tally['agreement']:.2f} %"
+        ax.set_title(f"{name}: {tally['pinches']} tries, {agreement}", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, format="png")
+    plt.close(fig)
+
+
+__all__ = ["TriesConfig", "plot", "record_task", "run_tries"]
