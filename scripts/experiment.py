@@ -65,10 +65,10 @@ reports the nominal and the fitted twin's prediction errors of the wrench and th
 toggles: ``DIR/sysid.{json,md,png}``, every trial's log in ``DIR/logs/``; the same command resumes.
 
 ``tries`` (``puzzlebox/lab/tries_experiment.py``) records every try of twin trials (the paper test boxes under
-``ideal``, ``realistic`` and ``harsh``, runs with a misreported kind, hard boxes) with the readings the pinch's
+``ideal``, ``realistic`` and ``harsh``, runs with a misreported kind, hard boxes) with the readings the hand's
 judgement read and the simulator's truth, one file per trial in ``DIR/tries/``, then runs the judgement offline on
-every recorded pinch: ``DIR/tries.{json,md}`` (agreement with the truth per profile, split and cause, with confusion
-matrices; the time a judgement takes) and ``DIR/sample.npz`` (a few pinches of each cause); the same command resumes.
+every recorded pinch and door swing: ``DIR/tries.{json,md,png}`` (agreement with the truth per motion, profile, split
+and cause, with confusion matrices; the time a judgement takes) and ``DIR/sample.npz`` (a few of each cause); the same command resumes.
 
 ``disassembly`` (``learning/experiments/disassembly.py``) trains every agent on the measured ``lab-computer-a``
 and tests it on ``lab-computer-b`` and 10 variants of it (RAM sticks and GPU cables added or removed, every pose
