@@ -68,7 +68,8 @@ toggles: ``DIR/sysid.{json,md,png}``, every trial's log in ``DIR/logs/``; the sa
 ``ideal``, ``realistic`` and ``harsh``, runs with a misreported kind, hard boxes) with the readings the hand's
 judgement read and the simulator's truth, one file per trial in ``DIR/tries/``, then runs the judgement offline on
 every recorded pinch and door swing: ``DIR/tries.{json,md,png}`` (agreement with the truth per motion, profile, split
-and cause, with confusion matrices; the time a judgement takes) and ``DIR/sample.npz`` (a few of each cause); the same command resumes.
+and cause, with confusion matrices; the time a judgement takes) and ``DIR/sample.npz`` (a few of each cause); the
+same command resumes.
 
 ``disassembly`` (``learning/experiments/disassembly.py``) trains every agent on the measured ``lab-computer-a``
 and tests it on ``lab-computer-b`` and 10 variants of it (RAM sticks and GPU cables added or removed, every pose
