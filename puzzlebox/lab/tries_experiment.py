@@ -81,7 +81,8 @@ def record_task(settings: dict[str, Any], context: dict[str, Any]) -> dict[str, 
     start = time.perf_counter()
     spec, seed = spec_from_dict(settings["spec"]), settings["seed"]
     profile = RealityProfile.from_dict(settings["profile"])
-    calibration = CellCalibration.from_dict(settings["calibration"])
+    # None: the twin's nominal calibration, exact under ``ideal`` only
+    calibration = CellCalibration.from_dict(settings["calibration"]) if settings["calibration"] else None
     tries: list[RecordedTry] = []
     with TwinSession(spec, seed=seed, reality=profile) as session:
         told = wrong_kind(session.spec, seed) if settings["misreported"] else {}

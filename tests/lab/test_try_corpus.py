@@ -99,3 +99,22 @@ def test_the_tries_command_takes_only_its_flags(tmp_path):
     assert result.returncode == 2 and "--runs" in result.stderr, result.stderr
     assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_a_recorded_trial_is_judged_offline_as_it_was_live_and_agrees_with_the_truth(tmp_path):
+    """One oracle trial of a paper box under ``ideal`` recorded as ``experiment.py tries`` records it: every pinch and
+    swing judged again from its file gives what the hand concluded live, and moved / blocked match the truth."""
+    from puzzlebox.lab.tries_experiment import record_task
+    from puzzlebox.models.generator import paper_family
+    from puzzlebox.twin.reality import load_profile
+
+    spec = paper_family("test", seed=0)[0]
+    settings = {"key": "ideal-paper-test-0-s7000", "spec": spec.to_dict(), "seed": 7000,
+                "profile": load_profile("ideal").to_dict(), "profile_name": "ideal", "calibration": None,
+                "misreported": False, "split": "development", "agent": "dual", "max_actions": 6}  # fmt: skip
+    summary = record_task(settings, {"file": str(tmp_path / "t.npz")})
+    tries = load_tries(tmp_path / "t.npz")
+    assert summary["tries"] == len(tries) >= 5 and summary["judged"] >= 4
+    judged = judge_corpus(tries)["all"]["all"]
+    assert judged["same_as_live"] == judged["pinches"] == summary["judged"]
+    assert judged["agreement"] == 1.0 and judged["confusion"]["moved"]["moved"] >= 1
