@@ -218,22 +218,33 @@ class ClosingJudge:
         """How a closing push that ended at ``progress`` went."""
         return verdict(self.judgement, progress, self.forces, Cause.LOCKED_PUSHED)
 
+    def trace(self) -> ClosingTrace:
+        """What this judge has read."""
+        return ClosingTrace(self.limits, tuple(self.readings))
 
-def judge_closing(
-    limits: ClosingLimits, readings: tuple[ClosingReading, ...], judgement: JudgementConfig, push: DoorPushJudgement
-) -> Judgement:
-    """The judgement of a recorded closing push: its readings folded through :class:`ClosingJudge`."""
-    judge = ClosingJudge(judgement, push, limits)
-    for reading in readings:
+
+@dataclass(frozen=True)
+class ClosingTrace:
+    """A closing push as recorded: enough to judge it again offline (:func:`judge_closing`)."""
+
+    limits: ClosingLimits
+    readings: tuple[ClosingReading, ...]
+
+
+def judge_closing(trace: ClosingTrace, judgement: JudgementConfig, push: DoorPushJudgement) -> Judgement:
+    """The judgement of a recorded closing push: its readings folded through :class:`ClosingJudge` (a push that ran
+    its course is judged where its last reading stood)."""
+    judge = ClosingJudge(judgement, push, trace.limits)
+    for reading in trace.readings:
         ended = judge.read(reading)
         if isinstance(ended, Judgement):
             return ended
         if ended:
             break
-    return judge.verdict(readings[-1].progress if readings else 0.0)
+    return judge.verdict(trace.readings[-1].progress if trace.readings else 0.0)
 
 
 __all__ = [
-    "ClosingJudge", "ClosingLimits", "ClosingReading", "SwingJudge", "SwingLimits", "SwingReading", "SwingTrace",
-    "judge_closing", "judge_swing",
+    "ClosingJudge", "ClosingLimits", "ClosingReading", "ClosingTrace", "SwingJudge", "SwingLimits", "SwingReading",
+    "SwingTrace", "judge_closing", "judge_swing",
 ]  # fmt: skip

@@ -242,10 +242,10 @@ class DoorPusher:
                 # shut and was met on the lid at 15 mm/s loaded the wrist by 5-8 N per tick to 71 N.)
                 break
             if ended is not False:
-                result = Pinch.result_of(ended, judge.forces)
+                result = Pinch.result_of(ended, judge.forces, judge.trace())
                 break
         if result is None:
-            result = Pinch.result_of(judge.verdict(progress), judge.forces)
+            result = Pinch.result_of(judge.verdict(progress), judge.forces, judge.trace())
         return self._off_the_plate(door, progress, result)
 
     def _off_the_plate(self, door: DoorPush, progress: float, result: ToggleResult) -> ToggleResult:

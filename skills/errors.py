@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 from puzzlebox.models.try_outcome import Cause
 
 if TYPE_CHECKING:
-    from puzzlebox.skills.door_judgement import SwingTrace
+    from puzzlebox.skills.door_judgement import ClosingTrace, SwingTrace
     from puzzlebox.skills.judgement import PinchTrace
 
 
@@ -94,5 +94,5 @@ class SlipDetected(SkillError):
     """The handle left the grasp during the motion (the gripper closed past the handle's width)."""
 
     cause = Cause.SLIPPED
-    trace: PinchTrace | SwingTrace | None = None
+    trace: PinchTrace | SwingTrace | ClosingTrace | None = None
     """The readings of the pinch its judgement read the slip from (a :class:`skills.judgement.PinchTrace`), or None."""

@@ -17,7 +17,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from puzzlebox.models.try_outcome import Cause
-from puzzlebox.skills.door_judgement import SwingTrace
+from puzzlebox.skills.door_judgement import ClosingTrace, SwingTrace
 from puzzlebox.skills.errors import GraspFailure, SlipDetected
 from puzzlebox.skills.joint_model import JointModel
 from puzzlebox.skills.judgement import Decision, Judgement, PinchJudge, PinchLimits, PinchTrace, Reading, verdict
@@ -335,7 +335,7 @@ class Pinch:
 
     @staticmethod
     def result_of(
-        judgement: Judgement, forces: list[float], trace: PinchTrace | SwingTrace | None = None
+        judgement: Judgement, forces: list[float], trace: PinchTrace | SwingTrace | ClosingTrace | None = None
     ) -> ToggleResult:
         """The toggle's result of a judgement, its reason rendered from its cause; a slip raises
         :class:`SlipDetected` (no evidence: the toggle's retries decide what follows)."""

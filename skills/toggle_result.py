@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 from puzzlebox.models.try_outcome import Cause, Outcome
 
 if TYPE_CHECKING:
-    from puzzlebox.skills.door_judgement import SwingTrace
+    from puzzlebox.skills.door_judgement import ClosingTrace, SwingTrace
     from puzzlebox.skills.judgement import PinchTrace
 
 LATCHED: dict[Cause, str] = {
@@ -58,7 +58,7 @@ class ToggleResult:
     still while the pad slid along it)."""
     not_pushed: bool = False
     """A door the pads lost stands part-way where no look sees it: it was not pushed."""
-    trace: PinchTrace | SwingTrace | None = None
+    trace: PinchTrace | SwingTrace | ClosingTrace | None = None
     """The readings the judgement read this result from, a pinch's (:func:`skills.judgement.judge_pinch`) or a
     door's opening swing's (:func:`skills.door_judgement.judge_swing`), to judge them again offline; None for a
     result no recorded judgement gave (a closing push, a top-up, an error)."""

@@ -27,7 +27,16 @@ import numpy as np
 
 from puzzlebox.models.npz_file import load_header, save_npz
 from puzzlebox.models.try_outcome import Cause
-from puzzlebox.skills.door_judgement import SwingLimits, SwingReading, SwingTrace, judge_swing
+from puzzlebox.skills.door_judgement import (
+    ClosingLimits,
+    ClosingReading,
+    ClosingTrace,
+    SwingLimits,
+    SwingReading,
+    SwingTrace,
+    judge_closing,
+    judge_swing,
+)
 from puzzlebox.skills.judgement import Judgement, PinchLimits, PinchTrace, Reading, judge_pinch
 from puzzlebox.skills.settings import PrimitiveConfig
 
@@ -36,6 +45,8 @@ READING_COLUMNS = ("commanded", "opposing", "magnitude", "progress", "closure")
 """The columns of a pinch's ``actuation`` array, one row per :class:`Reading`."""
 SWING_COLUMNS = ("progress", "face", "normal", "opposing", "magnitude")
 """The columns of a door swing's ``actuation`` array, one row per :class:`SwingReading`."""
+CLOSING_COLUMNS = ("progress", "opposing", "magnitude")
+"""The columns of a door's closing push's ``actuation`` array, one row per :class:`ClosingReading`."""
 
 
 @dataclass(frozen=True)
@@ -50,7 +61,7 @@ class RecordedTry:
     """Its cause (a :class:`models.try_outcome.Cause` value), None for moved."""
     truth: dict[str, Any]
     """Evaluation only: ``state_before``, ``state_after`` (0/1), ``fraction_before``, ``fraction_after`` [-]."""
-    trace: PinchTrace | SwingTrace | None
+    trace: PinchTrace | SwingTrace | ClosingTrace | None
     """The readings its judgement read, a pinch's or a door's opening swing's, or None: the toggle's result came from
     no recorded judgement (a closing push, a top-up, a failed grasp)."""
 
@@ -74,6 +85,10 @@ def save_tries(path: str | Path, tries: Iterable[RecordedTry]) -> Path:
             h["trace"] = {"kind": "swing", "limits": dataclasses.asdict(t.trace.limits), "ended_at": t.trace.ended_at}
             rows = [[getattr(r, c) for c in SWING_COLUMNS] for r in t.trace.readings]
             arrays[f"{i}.actuation"] = np.array(rows, dtype=np.float64).reshape(-1, len(SWING_COLUMNS))
+        elif isinstance(t.trace, ClosingTrace):
+            h["trace"] = {"kind": "closing", "limits": dataclasses.asdict(t.trace.limits)}
+            rows = [[getattr(r, c) for c in CLOSING_COLUMNS] for r in t.trace.readings]
+            arrays[f"{i}.actuation"] = np.array(rows, dtype=np.float64).reshape(-1, len(CLOSING_COLUMNS))
         header.append(h)
     return save_npz(path, {"format": FORMAT, "tries": header}, arrays)
 
@@ -88,15 +103,18 @@ def load_tries(path: str | Path) -> list[RecordedTry]:
         header = load_header(data, path, FORMAT, "a file of tries")
         tries = []
         for i, h in enumerate(header["tries"]):
-            trace: PinchTrace | SwingTrace | None = None
+            trace: PinchTrace | SwingTrace | ClosingTrace | None = None
             if h["trace"] is not None and h["trace"]["kind"] == "pinch":
                 readings = tuple(Reading(*map(float, row)) for row in data[f"{i}.actuation"])
                 settling = tuple((float(p), float(c)) for p, c in data[f"{i}.settling"])
                 limits = PinchLimits(**h["trace"]["limits"])
                 trace = PinchTrace(limits, readings, settling, h["trace"]["reached"])
-            elif h["trace"] is not None:
+            elif h["trace"] is not None and h["trace"]["kind"] == "swing":
                 swings = tuple(SwingReading(*map(float, row)) for row in data[f"{i}.actuation"])
                 trace = SwingTrace(SwingLimits(**h["trace"]["limits"]), swings, h["trace"]["ended_at"])
+            elif h["trace"] is not None:
+                closing = tuple(ClosingReading(*map(float, row)) for row in data[f"{i}.actuation"])
+                trace = ClosingTrace(ClosingLimits(**h["trace"]["limits"]), closing)
             tries.append(RecordedTry(h["context"], h["outcome"], h["cause"], h["truth"], trace))
     return tries
 
@@ -155,7 +173,7 @@ def judge_corpus(tries: Iterable[RecordedTry], config: PrimitiveConfig | None = 
         seconds += time.perf_counter() - start
         count += 1
         same = judgement.outcome == t.outcome and (judgement.cause.value if judgement.cause else None) == t.cause
-        motion = "pinch" if isinstance(t.trace, PinchTrace) else "swing"
+        motion = {PinchTrace: "pinch", SwingTrace: "swing", ClosingTrace: "closing"}[type(t.trace)]
         keys = {"all": "all", "profile": t.context["profile"], "split": t.context["split"],
                 "cause": t.cause or "moved", "motion": motion}  # fmt: skip
         for group, key in keys.items():
@@ -183,6 +201,8 @@ def judge_recorded(t: RecordedTry, config: PrimitiveConfig) -> Judgement:
         return judge_pinch(t.trace, config.judgement)
     if isinstance(t.trace, SwingTrace):
         return judge_swing(t.trace, config.judgement, config.push.judgement)
+    if isinstance(t.trace, ClosingTrace):
+        return judge_closing(t.trace, config.judgement, config.push.judgement)
     raise ValueError(f"try {t.context} has no readings to judge")
 
 
@@ -190,7 +210,7 @@ def sample(tries: list[RecordedTry], per_cause: int = 4) -> list[RecordedTry]:
     """Up to ``per_cause`` recorded pinches and as many swings of each live cause (moved included), each from a
     different trial where there are enough: the sample committed under ``tests/`` for the judgement's tests."""
     chosen: list[RecordedTry] = []
-    for motion in (PinchTrace, SwingTrace):
+    for motion in (PinchTrace, SwingTrace, ClosingTrace):
         for cause in CAUSES_JUDGED:
             value = cause.value if cause is not None else None
             pool = [t for t in tries if isinstance(t.trace, motion) and t.cause == value]

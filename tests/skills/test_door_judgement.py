@@ -8,6 +8,7 @@ from puzzlebox.models.try_outcome import Cause
 from puzzlebox.skills.door_judgement import (
     ClosingLimits,
     ClosingReading,
+    ClosingTrace,
     SwingLimits,
     SwingReading,
     SwingTrace,
@@ -71,7 +72,7 @@ def test_a_pad_that_lost_the_face_early_is_judged_by_how_far_the_face_turned_whi
 def test_a_closing_push_ends_on_the_lid_and_a_plate_that_does_not_give_is_a_latch():
     closing = ClosingLimits(start=0.0, contact=3.0)
     down = tuple(ClosingReading(k / 10, 4.0, 4.0) for k in range(10)) + (ClosingReading(0.98, 25.0, 25.0),)
-    assert judge_closing(closing, down, JUDGEMENT, PUSH).outcome == "moved"
+    assert judge_closing(ClosingTrace(closing, down), JUDGEMENT, PUSH).outcome == "moved"
     held = (ClosingReading(0.0, 4.0, 4.0), ClosingReading(0.02, 21.0, 21.0))
-    judgement = judge_closing(closing, held, JUDGEMENT, PUSH)
+    judgement = judge_closing(ClosingTrace(closing, held), JUDGEMENT, PUSH)
     assert (judgement.outcome, judgement.cause) == ("blocked", Cause.LOCKED_PUSHED)
