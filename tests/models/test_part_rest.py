@@ -30,4 +30,5 @@ def test_parts_left_open_stay_open_under_gravity():
         drift = np.array([data.qpos[j.qposadr[0]] for j in joints]) - start
         travel = np.array([j.range[1] for j in joints])
         # the default impedance (d = 0.9) let a door at 98 % sink 3 % of its travel in 30 s, and on out of its band
-        assert np.all(np.abs(drift) / travel < 0.005), dict(zip([c.name for c in spec.components], drift / travel))
+        names = [c.name for c in spec.components]
+        assert np.all(np.abs(drift) / travel < 0.005), dict(zip(names, drift / travel, strict=True))
