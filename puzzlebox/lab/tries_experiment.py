@@ -2,8 +2,9 @@
 judgement on it offline (:mod:`puzzlebox.lab.try_corpus`).
 
 The trials: the paper's three test boxes under each profile (``ideal``, ``realistic``, ``harsh``, each with its
-cell's calibration), runs with one kind misreported (``realistic``), and hard boxes of each family (``realistic``),
-each solved by the dual agent from an empty memory. The split: the paper boxes are the ``development`` part (the
+cell's calibration) and under ``realistic`` without a calibration file (``realistic-uncalibrated``), runs with one
+kind misreported (``realistic``), and hard boxes of each family (``realistic``), each solved by the dual agent from an
+empty memory. The split: the paper boxes are the ``development`` part (the
 judgement's thresholds were set over the project's history on them, at other seeds); the hard boxes, drawn from a
 seed range used nowhere else, and the misreported runs are ``held-out``.
 """
@@ -40,8 +41,11 @@ class TriesConfig:
     """What ``experiment.py tries`` records."""
 
     profiles: tuple[str, ...] = ("ideal", "realistic", "harsh")
+    uncalibrated: tuple[str, ...] = ("realistic",)
+    """Profiles whose paper-box trials are also recorded without a calibration file (the twin's nominal, datasheet
+    calibration; reported as ``<profile>-uncalibrated``)."""
     paper_seeds: tuple[int, ...] = (7000, 7001, 7002, 7003)
-    """Trial seeds (placements) of each paper test box under each profile."""
+    """Trial seeds (placements) of each paper test box in each cell."""
     misreported: int = 12
     """Runs with one kind misreported (``realistic``; box ``i % 3``, seed ``7100 + i``)."""
     hard_boxes: int = 2
@@ -55,19 +59,22 @@ class TriesConfig:
         return dataclasses.replace(self, paper_seeds=(7000,), misreported=2, hard_boxes=1)
 
 
-def _trials(config: TriesConfig) -> Iterator[tuple[str, PuzzleSpec, int, str, bool, str]]:
-    """(key, spec, seed, profile, one kind misreported, split) of every trial."""
+def _trials(config: TriesConfig) -> Iterator[tuple[str, PuzzleSpec, int, str, bool, bool, str]]:
+    """(key, spec, seed, profile, calibrated, one kind misreported, split) of every trial."""
     paper = paper_family("test", seed=0)
-    for profile in config.profiles:
+    cells = [(p, True) for p in config.profiles] + [(p, False) for p in config.uncalibrated]
+    for profile, calibrated in cells:
+        cell = profile if calibrated else f"{profile}-uncalibrated"
         for spec in paper:
             for seed in config.paper_seeds:
-                yield f"{profile}-{spec.name}-s{seed}", spec, seed, profile, False, "development"
+                yield f"{cell}-{spec.name}-s{seed}", spec, seed, profile, calibrated, False, "development"
     for i in range(config.misreported):
-        yield f"misreported-{paper[i % 3].name}-s{7100 + i}", paper[i % 3], 7100 + i, "realistic", True, "held-out"
+        box = paper[i % 3]
+        yield f"misreported-{box.name}-s{7100 + i}", box, 7100 + i, "realistic", True, True, "held-out"
     for family in FAMILY_NAMES:
         for b in range(config.hard_boxes):
             spec = hard_box(family, config.hard_seed + b)
-            yield f"hard-{spec.name}", spec, config.hard_seed + b, "realistic", False, "held-out"
+            yield f"hard-{spec.name}", spec, config.hard_seed + b, "realistic", True, False, "held-out"
 
 
 def record_task(settings: dict[str, Any], context: dict[str, Any]) -> dict[str, Any]:
@@ -131,7 +138,7 @@ def run_tries(out: Path, config: TriesConfig, workers: int | None = None) -> dic
     to ``out/tries.json`` (and ``out/tries.md``)."""
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
-    profiles = {name: load_profile(name) for name in config.profiles}
+    profiles = {name: load_profile(name) for name in (*config.profiles, *config.uncalibrated)}
     records = out / "records"
     with make_executor(workers, None) as executor:
         spec0 = paper_family("test", seed=0)[0]
@@ -142,11 +149,12 @@ def run_tries(out: Path, config: TriesConfig, workers: int | None = None) -> dic
         cal = {name: done.records[f"calibration-{name}"]["calibration"] for name in profiles}
         tasks = [
             Task(key, record_task, {"key": key, "spec": spec.to_dict(), "seed": seed,
-                                    "profile": profiles[profile].to_dict(), "profile_name": profile,
-                                    "calibration": cal[profile], "misreported": misreported, "split": split,
-                                    "agent": config.agent, "max_actions": config.max_actions},
+                                    "profile": profiles[profile].to_dict(),
+                                    "profile_name": profile if calibrated else f"{profile}-uncalibrated",
+                                    "calibration": cal[profile] if calibrated else None, "misreported": misreported,
+                                    "split": split, "agent": config.agent, "max_actions": config.max_actions},
                  context={"file": str(out / "tries" / f"{key}.npz")})
-            for key, spec, seed, profile, misreported, split in _trials(config)
+            for key, spec, seed, profile, calibrated, misreported, split in _trials(config)
         ]  # fmt: skip
         report = run_tasks(tasks, RecordStore(records / "trials"), executor, desc="recorded trials",
                            postfix=lambda r: f"tries {sum(x['tries'] for x in r.values())}")  # fmt: skip
