@@ -76,3 +76,13 @@ def test_a_closing_push_ends_on_the_lid_and_a_plate_that_does_not_give_is_a_latc
     held = (ClosingReading(0.0, 4.0, 4.0), ClosingReading(0.02, 21.0, 21.0))
     judgement = judge_closing(ClosingTrace(closing, held), JUDGEMENT, PUSH)
     assert (judgement.outcome, judgement.cause) == ("blocked", Cause.LOCKED_PUSHED)
+
+
+def test_a_door_that_stood_part_way_and_will_not_go_on_under_a_hard_push_is_stuck():
+    """Pushed on from 27 %, a door that does not turn further under 31 N on its face is stuck there (no evidence):
+    the push stops, rather than pressing on until the pad slips off the handle (48-55 N without a calibration
+    file)."""
+    judgement = swing([SwingReading(0.28, 0.27, 6.0, 4.0, 6.0), SwingReading(0.29, 0.27, 31.0, 20.0, 31.0)], start=0.27)
+    assert (judgement.outcome, judgement.cause, judgement.held_at) == ("failed", Cause.JAMMED, 0.27)
+    free = swing(pressed([0.27 + k / 20 for k in range(16)], [0.27 + k / 20 for k in range(16)]), 0.27, 1.02)
+    assert free.outcome == "moved"  # a light push that turns the door carries it on
