@@ -102,7 +102,7 @@ class SwingJudge:
         if pressed_hard and lim.start >= c.blocked_progress and r.progress - lim.start < c.blocked_progress:
             # a door that stood part-way and will not go on: stuck, or its lock's rod at its wall. Judged only where
             # it stood (as the slide test judges it) the push went on, and without a calibration file it pressed a
-            # door held at 27 % with 48-55 N until the pad slipped off (16 of 207 recorded swings, 40-60 N)
+            # door held at 27 % with 48-55 N until the pad slipped off (24 of 251 recorded swings, 40-60 N)
             return Judgement("failed", Cause.JAMMED, r.progress, peak, held_at=lim.start)
         return None
 
