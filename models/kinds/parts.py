@@ -31,11 +31,6 @@ def handle_geom_defaults() -> dict[str, object]:
     return {"priority": 2, "friction": [1.0, 0.002, 0.0001], "condim": 4, "rgba": HANDLE_COLOUR}
 
 
-FRICTION_SOLIMP = (0.999, 0.9999, 0.001, 0.5, 2.0)
-"""Impedance of a component joint's dry friction (MuJoCo ``solimpfriction``): stiff enough that a part left
-where it stands does not creep under gravity (see :func:`add_joint`)."""
-
-
 def add_joint(body: mjcf.Element, name: str, template: KindTemplate, dynamics: JointDynamics) -> mjcf.Element:
     """The joint ``<name>:joint`` of the template, at mid-plate height, range ``[0, travel]``."""
     return body.add(
@@ -50,12 +45,7 @@ def add_joint(body: mjcf.Element, name: str, template: KindTemplate, dynamics: J
         frictionloss=dynamics.frictionloss,
         armature=dynamics.armature,
         solreflimit=[0.004, 1.0],  # stiffer end stops: a door resting on its limit sags < 0.1 deg
-        solreffriction=[0.002, 1.0],
-        # MuJoCo's dry friction is a soft constraint: under a steady load below ``frictionloss`` the joint still
-        # creeps, at a speed proportional to (1 - d) / d of the impedance d. With the default d = 0.9 an open door
-        # (gravity ~0.001-0.007 N·m about its pin at 98 % of its travel) sank ~0.05 deg/s, from open to below the
-        # open band within one trial; d = 0.999 creeps 100x slower (~0.3 deg in 10 minutes).
-        solimpfriction=list(FRICTION_SOLIMP),
+        solreffriction=[0.002, 1.0],  # stiff dry friction: an open door stays open (default 0.02 creeps)
     )
 
 
