@@ -3,13 +3,8 @@
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import TYPE_CHECKING
 
 from puzzlebox.models.try_outcome import Cause
-
-if TYPE_CHECKING:
-    from puzzlebox.skills.door_judgement import ClosingTrace, SwingTrace
-    from puzzlebox.skills.judgement import PinchTrace
 
 
 class SkillError(Exception):
@@ -94,5 +89,3 @@ class SlipDetected(SkillError):
     """The handle left the grasp during the motion (the gripper closed past the handle's width)."""
 
     cause = Cause.SLIPPED
-    trace: PinchTrace | SwingTrace | ClosingTrace | None = None
-    """The readings of the pinch its judgement read the slip from (a :class:`skills.judgement.PinchTrace`), or None."""

@@ -340,10 +340,8 @@ class Pinch:
         """The toggle's result of a judgement, its reason rendered from its cause; a slip raises
         :class:`SlipDetected` (no evidence: the toggle's retries decide what follows)."""
         cause, progress = judgement.cause, judgement.progress
-        if cause is Cause.SLIPPED:
-            slip = SlipDetected(f"the handle slipped out of the grasp after {progress:.0%} of the travel")
-            slip.trace = trace
-            raise slip
+        if cause is Cause.SLIPPED:  # (the readings stay with the pinch's judge: Toggler keeps them with the failure)
+            raise SlipDetected(f"the handle slipped out of the grasp after {progress:.0%} of the travel")
         if cause is None:
             reason = ""
         elif cause is Cause.HELD_PART_WAY:

@@ -263,7 +263,7 @@ class Toggler:
             result = ToggleResult(
                 "failed", reason=f"{type(err).__name__}: {err}", progress=self.pinch.progress, cause=err.cause,
                 stopped_while=err.phase if isinstance(err, ForceLimitExceeded) else "",
-                trace=err.trace if isinstance(err, SlipDetected) else None,
+                trace=self.pinch.judge.trace() if isinstance(err, SlipDetected) and self.pinch.judge else None,
             )  # fmt: skip
             self.retreat.withdraw()
             return result
