@@ -88,8 +88,6 @@ class Judgement:
     """The part was felt in its end stop (a door's over-travel)."""
     held_at: float | None = None
     """Where a part held part-way stopped [fraction of the travel]."""
-    decision: Decision | None = None
-    """The tick's decision that ended the actuation early, if one did."""
 
 
 class PinchJudge:
@@ -165,14 +163,14 @@ class PinchJudge:
             raise ValueError(f"{decision} does not end a try; the verdict judges it")
         peak, progress = self.peak, self.progress
         if decision is Decision.HELD_EARLY:
-            return Judgement("blocked", Cause.LOCKED_NO_PROGRESS, progress, peak, decision=decision)
+            return Judgement("blocked", Cause.LOCKED_NO_PROGRESS, progress, peak)
         if decision is Decision.HELD_PART_WAY:
-            return Judgement("blocked", Cause.HELD_PART_WAY, progress, peak, held_at=progress, decision=decision)
+            return Judgement("blocked", Cause.HELD_PART_WAY, progress, peak, held_at=progress)
         if decision is Decision.SLIPPED_OFF_LOCKED:
-            return Judgement("blocked", Cause.LOCKED_SLIPPED_OFF, progress, peak, decision=decision)
+            return Judgement("blocked", Cause.LOCKED_SLIPPED_OFF, progress, peak)
         if decision is Decision.SLIPPED_AT_END_STOP:
-            return Judgement("moved", None, progress, peak, end_stop_felt=True, decision=decision)
-        return Judgement("failed", Cause.SLIPPED, progress, peak, decision=decision)
+            return Judgement("moved", None, progress, peak, end_stop_felt=True)
+        return Judgement("failed", Cause.SLIPPED, progress, peak)
 
     def verdict(self, reached: float, latched: Cause | None = Cause.LOCKED_PULLED) -> Judgement:
         """How a motion that ran its course ended, the part ``reached`` [fraction of the travel, head start counted]:

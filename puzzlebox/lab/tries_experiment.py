@@ -1,4 +1,4 @@
-"""``experiment.py tries``: record every try of a set of twin trials into a corpus, then measure the pinch's
+"""``experiment.py tries``: record every try of a set of twin trials into a corpus, then measure the hand's
 judgement on it offline (:mod:`puzzlebox.lab.try_corpus`).
 
 The trials: the paper's three test boxes under each profile (``ideal``, ``realistic``, ``harsh``, each with its
@@ -55,7 +55,7 @@ class TriesConfig:
     max_actions: int = 20
 
     def quick(self) -> TriesConfig:
-        """CI size: one placement per profile, two misreported runs, one hard box of one family."""
+        """A quick look: one placement per cell, two misreported runs, one hard box of each family (17 trials)."""
         return dataclasses.replace(self, paper_seeds=(7000,), misreported=2, hard_boxes=1)
 
 
