@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from puzzlebox.learning.agents.base import Agent
 from puzzlebox.models import World
-from puzzlebox.models.try_outcome import Cause
+from puzzlebox.models.try_outcome import Cause, ReadsItsResult, TryResult
 
 MAX_FAILURES_IN_A_ROW = 3
 """A run ends when one component fails this many tries in a row (each already retried by the world), or when every
@@ -20,16 +20,32 @@ to weigh (the dual agents try something else), and the run goes on while anythin
 
 
 @dataclass(frozen=True)
-class ActionRecord:
-    """One try: which component (its ground-truth name when the world gives one), and its outcome."""
+class ActionRecord(ReadsItsResult):
+    """One try: which component (its ground-truth name when the world gives one), and the world's result as it
+    was returned (the same frozen :class:`models.TryResult`, not a copy of its fields)."""
 
     component: str
-    moved: bool
-    outcome: str = "moved"
-    """``moved``, ``blocked`` or ``failed`` (see :class:`models.TryResult`)."""
-    reason: str = ""
-    cause: Cause | None = None
-    """Why it was ``blocked`` or ``failed``, as a type (None for ``moved`` and for worlds that do not say)."""
+    result: TryResult
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``actions[]`` entry of a run record (``give_up`` is the world's word to the agent, not recorded)."""
+        return {"component": self.component, "moved": self.moved, "outcome": self.outcome, "reason": self.reason,
+                "cause": self.cause}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, entry: dict[str, Any]) -> ActionRecord:
+        """An ``actions[]`` entry (:meth:`to_dict`'s layout). One written before outcomes were kept is ``moved`` or
+        ``blocked`` as it moved; one written before causes were kept gets the cause its reason text names, if that
+        cause fits its outcome."""
+        outcome = entry.get("outcome", "moved" if entry["moved"] else "blocked")
+        reason = entry.get("reason", "")
+        if "cause" in entry:
+            cause = None if entry["cause"] is None else Cause(entry["cause"])
+        else:
+            cause = Cause.from_legacy(reason)
+            if cause is not None and (outcome == "moved" or (outcome == "blocked") != (cause.family == "locked")):
+                cause = None
+        return cls(entry["component"], TryResult(outcome, reason, cause=cause))
 
 
 @dataclass(frozen=True)
@@ -46,7 +62,10 @@ class RunResult:
     """Why an unsolved run stopped early (a component the world gave up on), else empty."""
 
     def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
+        """The ``runs[]`` entry of ``results.json``."""
+        return {"spec": self.spec, "seed": self.seed, "solved": self.solved, "num_actions": self.num_actions,
+                "wall_time_s": self.wall_time_s, "actions": [a.to_dict() for a in self.actions],
+                "ended": self.ended}  # fmt: skip
 
 
 def run_episode(
@@ -80,7 +99,7 @@ def run_episode(
             failed_here = set()
         agent.record(index, result, observation)
         name = name_of(index) if name_of else str(index)
-        actions.append(ActionRecord(name, result.moved, result.outcome, result.reason, result.cause))
+        actions.append(ActionRecord(name, result))
         if on_action is not None:
             on_action(actions[-1])
         repeated = len(actions) > 1 and actions[-2].component == name and actions[-2].outcome == "failed"

@@ -173,4 +173,30 @@ class TryResult:
         return cls("moved") if moved else cls("blocked")
 
 
-__all__ = ["OUTCOMES", "Cause", "Outcome", "TryResult"]
+class ReadsItsResult:
+    """A record of one try that holds the world's :class:`TryResult` as it was returned (``result``) and reads its
+    outcome through it, copying none of its fields (the run's ``learning.ActionRecord``, the world's
+    ``skills.robot_world.ActionLog``)."""
+
+    result: TryResult
+
+    @property
+    def moved(self) -> bool:
+        return self.result.moved
+
+    @property
+    def outcome(self) -> Outcome:
+        """``moved``, ``blocked`` or ``failed``."""
+        return self.result.outcome
+
+    @property
+    def reason(self) -> str:
+        return self.result.reason
+
+    @property
+    def cause(self) -> Cause | None:
+        """Why it was ``blocked`` or ``failed``, as a type (None for ``moved`` and for worlds that do not say)."""
+        return self.result.cause
+
+
+__all__ = ["OUTCOMES", "Cause", "Outcome", "ReadsItsResult", "TryResult"]

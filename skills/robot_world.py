@@ -47,6 +47,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -55,7 +56,7 @@ from puzzlebox.models.calibration import CellCalibration
 from puzzlebox.models.geometry import wrap_angle
 from puzzlebox.models.kinds import get_kind
 from puzzlebox.models.robot import Robot
-from puzzlebox.models.try_outcome import Cause
+from puzzlebox.models.try_outcome import Cause, ReadsItsResult
 from puzzlebox.skills.door_clearance import lean_away, near_open_door
 from puzzlebox.skills.joint_model import JointModel, joint_model
 from puzzlebox.skills.other_kinds import OtherKinds
@@ -148,15 +149,14 @@ class WorldConfig:
 
 
 @dataclass
-class ActionLog:
-    """One try as the robot sensed it (and, for evaluation, the truth)."""
+class ActionLog(ReadsItsResult):
+    """One try as the robot sensed it (and, for evaluation, the truth): the world's result as it returned it (the
+    same frozen :class:`models.TryResult`) with what the try cost."""
 
     index: int
     marker: int
     kind: str
-    outcome: str
-    reason: str
-    moved: bool
+    result: TryResult
     progress: float
     peak_force: float
     """Largest filtered wrist force over the try, including retries [N]."""
@@ -166,8 +166,15 @@ class ActionLog:
     true_moved: bool | None = None
     tried_kinds: tuple[str, ...] = ()
     """The other kinds the part was tried as in this try, in order (``kind`` is the one in use after it)."""
-    cause: Cause | None = None
-    """Why it was ``blocked`` or ``failed`` (None for ``moved``): :attr:`reason` is its text."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """The try as a record's ``timeline`` entry."""
+        return {
+            "index": self.index, "marker": self.marker, "kind": self.kind, "outcome": self.outcome,
+            "reason": self.reason, "moved": self.moved, "progress": self.progress, "peak_force": self.peak_force,
+            "attempts": self.attempts, "sim_time": self.sim_time, "wall_time": self.wall_time,
+            "true_moved": self.true_moved, "tried_kinds": self.tried_kinds, "cause": self.cause,
+        }  # fmt: skip
 
 
 @dataclass
@@ -280,9 +287,8 @@ class RobotWorld:
         after = self.ground_truth(marker) if self.ground_truth else None
         self.log.append(
             ActionLog(
-                index, marker, kind_of(self.kinds, marker), outcome.outcome, outcome.reason, outcome.moved,
-                result.progress, effort.peak, effort.attempts, effort.sim_time, effort.wall_time,
-                None if before is None else bool(before != after), tried, outcome.cause,
+                index, marker, kind_of(self.kinds, marker), outcome, result.progress, effort.peak, effort.attempts,
+                effort.sim_time, effort.wall_time, None if before is None else bool(before != after), tried,
             )
         )  # fmt: skip
         return outcome

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -71,7 +71,7 @@ def _entry(
     entry["perceived_closed_poses"] = (
         {by_marker[m]: [float(v) for v in pose] for m, pose in world.closed_poses.items()} if world else {}
     )
-    entry["timeline"] = [{**asdict(a), "component": by_marker[a.marker]} for a in (world.log if world else [])]
+    entry["timeline"] = [{**a.to_dict(), "component": by_marker[a.marker]} for a in (world.log if world else [])]
     for action in entry["timeline"]:
         del action["true_moved"]  # no ground truth on a real cell
     return entry
@@ -161,7 +161,7 @@ def _unfinished(spec: PuzzleSpec, seed: int, world: RobotWorld | None, wall: flo
     log = world.log if world else []
     names = world.names if world else {}
     assert names is not None  # run_real_trial's world is made with the spec's names
-    actions = [ActionRecord(names[a.marker], a.moved, a.outcome, a.reason, a.cause) for a in log]
+    actions = [ActionRecord(names[a.marker], a.result) for a in log]
     solved = bool(world is not None and world.observe().solved)
     return RunResult(spec.name, seed, solved, len(log), time.perf_counter() - wall, actions, ended=why)
 

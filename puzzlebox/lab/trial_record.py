@@ -3,11 +3,10 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from typing import Any
 
 from puzzlebox.learning import ActionRecord, RunResult
-from puzzlebox.models.try_outcome import Cause
 
 __all__ = ["TrialRecord"]
 
@@ -16,16 +15,6 @@ _OPTIONAL = (
     "peak_true_wrist_force_during", "sensed_sha256", "told_kinds", "found_kinds", "timeline", "robot_time_s", "stopped",
     "perceived_closed_poses",
 )  # fmt: skip
-
-
-def _action(entry: dict[str, Any], known: set[str]) -> ActionRecord:
-    """One ``actions[]`` entry; one written before causes were kept gets the cause its reason text names."""
-    values = {k: v for k, v in entry.items() if k in known}
-    if "cause" not in entry:
-        values["cause"] = Cause.from_legacy(entry.get("reason", ""))
-    elif entry["cause"] is not None:
-        values["cause"] = Cause(entry["cause"])
-    return ActionRecord(**values)
 
 
 @dataclass(frozen=True)
@@ -89,8 +78,7 @@ class TrialRecord:
     def from_dict(cls, entry: dict[str, Any]) -> TrialRecord:
         """The record of a run entry (:meth:`to_dict`'s layout: a ``results.json`` ``runs[]`` entry or a
         ``DIR/runs/<key>.json`` record) of a symbolic, twin or real trial; ``from_dict(r.to_dict()) == r``."""
-        known = {f.name for f in fields(ActionRecord)}
-        actions = tuple(_action(a, known) for a in entry.get("actions", ()))
+        actions = tuple(ActionRecord.from_dict(a) for a in entry.get("actions", ()))
         extra = {k: entry[k] for k in _OPTIONAL if k in entry}
         if "box_pose" in extra:
             extra["box_pose"] = tuple(extra["box_pose"])
@@ -111,8 +99,7 @@ class TrialRecord:
         out: dict[str, Any] = {
             "spec": self.spec, "seed": self.seed, "solved": self.solved, "num_actions": self.num_actions,
             "wall_time_s": self.wall_time_s,
-            "actions": [{"component": a.component, "moved": a.moved, "outcome": a.outcome, "reason": a.reason,
-                         "cause": a.cause} for a in self.actions],
+            "actions": [a.to_dict() for a in self.actions],
             "ended": self.ended,
         }  # fmt: skip
         if self.robot_time_s is not None:  # a real cell: what was sensed, no simulator

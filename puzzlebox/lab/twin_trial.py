@@ -6,7 +6,6 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
-from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -171,7 +170,7 @@ def run_twin_trial(
     by_marker = {c.marker: i for i, c in enumerate(spec.components)}
     found = {spec.components[by_marker[m]].name: kind for m, kind in (world.found_kinds if world else {}).items()}
     timeline = tuple(
-        {**asdict(a), "component": spec.components[by_marker[a.marker]].name,
+        {**a.to_dict(), "component": spec.components[by_marker[a.marker]].name,
          "pose_error_m": pose_errors.get(spec.components[by_marker[a.marker]].name)}
         for a in (world.log if world else [])
     )  # fmt: skip

@@ -63,3 +63,37 @@ def test_a_record_keeps_its_causes_and_an_old_one_loads_with_the_cause_its_text_
     assert symbolic.actions[0].cause is None
     with pytest.raises(ValueError):
         TrialRecord.from_dict(_entry(reason="", cause="on_fire"))
+
+
+def test_the_worlds_result_is_carried_to_the_record_as_it_was_returned():
+    # the result changes type once between the world and the record's dict: the run's action holds the very object
+    from puzzlebox.learning import DualAgent, SymbolicWorld, run_episode
+    from puzzlebox.models.generator import paper_family
+
+    spec = paper_family("test")[0]
+    returned: list[TryResult] = []
+
+    class Recording(SymbolicWorld):
+        def try_toggle(self, index: int) -> TryResult:
+            returned.append(super().try_toggle(index))
+            return returned[-1]
+
+    run = run_episode(DualAgent(), Recording(spec, 0), spec.name, 0, max_actions=30)
+    assert run.solved and [a.result for a in run.actions] == returned
+    assert all(a.result is r for a, r in zip(run.actions, returned, strict=True))
+
+
+@pytest.mark.parametrize("cause", list(Cause))
+def test_every_result_round_trips_through_the_record(cause):
+    result = TryResult("blocked" if cause.family == "locked" else "failed", f"text of {cause.value}", cause=cause)
+    record = TrialRecord.from_dict(_entry(reason=result.reason, cause=cause.value, outcome=result.outcome))
+    assert record.actions[0].result == result
+    assert TrialRecord.from_dict(record.to_dict()) == record
+
+
+def test_an_old_record_without_outcomes_loads_as_it_moved_and_a_cause_that_does_not_fit_is_dropped():
+    old = _entry(reason="latched: force rose without progress")
+    del old["actions"][0]["outcome"]  # (moved: False)
+    assert TrialRecord.from_dict(old).actions[0].outcome == "blocked"
+    failed = _entry(reason="latched: held part-way (33% of the travel)", outcome="failed")
+    assert TrialRecord.from_dict(failed).actions[0].cause is None  # (a lock's text on a failed try: no cause)
