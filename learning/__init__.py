@@ -13,7 +13,7 @@ from puzzlebox.learning.agents import (
     RandomAgent,
     make_agent,
 )
-from puzzlebox.learning.errors import ConfigError, InvalidAction, LearningError, UnknownAgent
+from puzzlebox.learning.errors import AgentError, ConfigError, InvalidAction, LearningError, UnknownAgent
 from puzzlebox.learning.puzzle_env import FaultConfig, PuzzleEnv, PuzzleEnvConfig
 from puzzlebox.learning.symbolic_world import SymbolicWorld
 from puzzlebox.learning.trial import ActionRecord, RunResult, run_episode, summarise
@@ -25,6 +25,7 @@ __all__ = [
     "AGENT_NAMES",
     "DEEP_AGENT_NAMES",
     "ActionRecord",
+    "AgentError",
     "Agent",
     "ConfigError",
     "DualAgent",

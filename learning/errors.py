@@ -11,6 +11,11 @@ class InvalidAction(LearningError, ValueError):
     """An action outside ``0..N-1`` (the message gives the valid range)."""
 
 
+class AgentError(LearningError):
+    """An agent broke the trial loop's seam: it chose something that is not one of the observation's parts, or it
+    raised (``SystemExit`` included). The message names the agent; the tries before it stand."""
+
+
 class UnknownAgent(LearningError, KeyError):
     """An agent name no factory knows; the message lists the known agents."""
 

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from puzzlebox.learning.agents.base import Agent
+from puzzlebox.learning.errors import AgentError
 from puzzlebox.models import World
 from puzzlebox.models.try_outcome import Cause, ReadsItsResult, TryResult
 
@@ -84,20 +85,20 @@ def run_episode(
     """
     start = time.perf_counter()
     observation = world.observe()
-    agent.begin_episode(observation, np.random.default_rng(seed))
+    _from(agent, "begin_episode", agent.begin_episode, observation, np.random.default_rng(seed))
     name_of = getattr(world, "ground_truth_name", None)
     actions: list[ActionRecord] = []
     ended = ""
     failures_in_a_row = 0  # of the component tried last
     failed_here: set[str] = set()  # components whose last try failed since the joint state last changed
     while not observation.solved and len(actions) < max_actions:
-        index = agent.choose(observation)
+        index = _part_chosen(agent, _from(agent, "choose", agent.choose, observation), len(observation.states))
         before = observation.states
         result = world.try_toggle(index)
         observation = world.observe()
         if not np.array_equal(before, observation.states):
             failed_here = set()
-        agent.record(index, result, observation)
+        _from(agent, "record", agent.record, index, result, observation)
         name = name_of(index) if name_of else str(index)
         actions.append(ActionRecord(name, result))
         if on_action is not None:
@@ -109,7 +110,7 @@ def run_episode(
         if failures_in_a_row >= MAX_FAILURES_IN_A_ROW or len(failed_here) == len(observation.states):
             ended = f"could not try {name}: {result.reason}"
             break
-    agent.end_episode(observation.solved)
+    _from(agent, "end_episode", agent.end_episode, observation.solved)
     return RunResult(
         spec=spec_name,
         seed=seed,
@@ -119,6 +120,28 @@ def run_episode(
         actions=actions,
         ended=ended,
     )
+
+
+def _agent_name(agent: Agent) -> str:
+    return str(getattr(agent, "name", "") or type(agent).__name__)
+
+
+def _from(agent: Agent, method: str, call: Callable[..., Any], *args: Any) -> Any:
+    """``call(*args)``, one of ``agent``'s methods: anything it raises but a Ctrl-C (``SystemExit`` too: a user's
+    agent must not end the command silently) is the agent's :class:`AgentError`, naming it."""
+    try:
+        return call(*args)
+    except KeyboardInterrupt:
+        raise
+    except BaseException as err:  # noqa: BLE001 - the seam: whatever an agent raises is reported as the agent's
+        raise AgentError(f"agent {_agent_name(agent)!r} raised {type(err).__name__} in {method}(): {err}") from err
+
+
+def _part_chosen(agent: Agent, index: Any, parts: int) -> int:
+    """``index`` if it names one of the ``parts`` parts; else the agent's :class:`AgentError`, before any arm moves."""
+    if isinstance(index, bool) or not isinstance(index, int | np.integer) or not 0 <= index < parts:
+        raise AgentError(f"agent {_agent_name(agent)!r} chose {index!r}: the box's parts are 0..{parts - 1}")
+    return int(index)
 
 
 def summarise(runs: list[RunResult | dict[str, Any]], max_actions: int) -> dict[str, Any]:

@@ -4,8 +4,9 @@ a failed try the agent weighs (it tries something else first), not the end of th
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
-from puzzlebox.learning import DualAgent, SymbolicWorld, run_episode
+from puzzlebox.learning import AgentError, DualAgent, SymbolicWorld, run_episode
 from puzzlebox.learning.trial import MAX_FAILURES_IN_A_ROW
 from puzzlebox.models import TryResult
 from puzzlebox.models.generator import paper_family
@@ -113,3 +114,56 @@ def test_an_agent_that_insists_on_a_part_that_cannot_be_tried_is_stopped_with_th
     assert not result.solved
     assert world.tries == MAX_FAILURES_IN_A_ROW == result.num_actions
     assert "closed on nothing" in result.ended
+
+
+class _Choosing:
+    """A user's agent that chooses ``choice`` every time (or raises it, if it is an exception)."""
+
+    name = "choosing"
+
+    def __init__(self, choice) -> None:
+        self.choice = choice
+
+    def begin_episode(self, observation, rng):
+        pass
+
+    def choose(self, observation):
+        if isinstance(self.choice, BaseException):
+            raise self.choice
+        return self.choice
+
+    def record(self, index, result, observation):
+        pass
+
+    def end_episode(self, solved):
+        pass
+
+
+class _Counting(SymbolicWorld):
+    def __init__(self, spec, seed) -> None:
+        super().__init__(spec, seed)
+        self.tries = 0
+
+    def try_toggle(self, index: int) -> TryResult:
+        self.tries += 1
+        return super().try_toggle(index)
+
+
+@pytest.mark.parametrize("choice", [-1, 5, 999, True, 1.0, "0", None])
+def test_a_choice_that_is_not_a_part_is_the_agents_error_before_anything_is_tried(choice):
+    spec = _spec()  # 5 parts
+    world = _Counting(spec, 3)
+    with pytest.raises(AgentError, match=r"agent 'choosing' chose .*: the box's parts are 0\.\.4"):
+        run_episode(_Choosing(choice), world, spec.name, 3, max_actions=30)
+    assert world.tries == 0
+
+
+def test_an_agent_that_raises_is_named_and_a_ctrl_c_still_stops_the_run():
+    spec = _spec()
+    for raised in (SystemExit(0), RuntimeError("boom")):
+        with pytest.raises(AgentError, match=f"agent 'choosing' raised {type(raised).__name__} in choose"):
+            run_episode(_Choosing(raised), SymbolicWorld(spec, 3), spec.name, 3, max_actions=30)
+    with pytest.raises(KeyboardInterrupt):
+        run_episode(_Choosing(KeyboardInterrupt()), SymbolicWorld(spec, 3), spec.name, 3, max_actions=30)
+    run = run_episode(_Choosing(np.int64(0)), SymbolicWorld(spec, 3), spec.name, 3, max_actions=2)
+    assert run.num_actions == 2  # a numpy integer is a part

@@ -20,6 +20,20 @@ AGENTS = (
 class Chooser:
     def choose(self, observation):
         return 0
+
+
+class OffTheBox(TryInTurn):
+    name = "off-the-box"
+
+    def choose(self, observation):
+        return -1
+
+
+class Quitter(TryInTurn):
+    name = "quitter"
+
+    def choose(self, observation):
+        raise SystemExit(0)
 """
 )
 
@@ -57,7 +71,7 @@ def test_a_users_agent_class_runs_in_either_sim(folder, sim, extra):
     ("agent", "says"),
     [
         ("no_such_module:Agent", "cannot import module 'no_such_module'"),
-        ("my_agents:Nobody", "has no 'Nobody'; its classes: ['Chooser', 'TryInTurn']"),
+        ("my_agents:Nobody", "has no 'Nobody'; its classes: ['Chooser', 'OffTheBox', 'Quitter', 'TryInTurn']"),
         ("my_agents:Chooser", "does not satisfy the Agent protocol: no method begin_episode, record, end_episode"),
     ],
 )
@@ -68,3 +82,17 @@ def test_an_agent_class_that_cannot_run_is_one_line_and_exit_2(folder, agent, sa
     assert (
         result.stderr.strip().startswith("error: ") and says in result.stderr and len(result.stderr.splitlines()) == 1
     )
+
+
+@pytest.mark.parametrize(
+    ("sim", "agent", "says"),
+    [
+        ("symbolic", "my_agents:Quitter", "agent 'quitter' raised SystemExit in choose()"),
+        ("twin", "my_agents:OffTheBox", "agent 'off-the-box' chose -1: the box's parts are 0..4"),
+    ],
+)
+def test_an_agent_that_misbehaves_fails_its_run_naming_it_before_the_arm_moves(folder, sim, agent, says):
+    # before: -1 had the twin's arm try the last part, and SystemExit ended trial.py with exit 0 and no results
+    result = trial(folder, "--sim", sim, "--agent", agent, "--runs", "1", "--max-actions", "3", "--out", folder / "o")
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    assert says in result.stderr and "--resume retries the failed ones" in result.stderr
