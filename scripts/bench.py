@@ -47,7 +47,7 @@ from puzzlebox.lab.bench_figures import (  # noqa: E402
     scale_figures,
 )
 from puzzlebox.lab.bench_soak import SoakConfig, SoakPoint, soak_points, soak_verdict  # noqa: E402
-from puzzlebox.lab.cli import OneLineParser, fail, one_line, write_json  # noqa: E402
+from puzzlebox.lab.cli import OneLineParser, fail, one_line, run_script, write_json  # noqa: E402
 from puzzlebox.lab.errors import RunStoreError  # noqa: E402
 from puzzlebox.lab.out_lock import OutputLock  # noqa: E402
 
@@ -117,4 +117,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    run_script(main)

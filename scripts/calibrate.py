@@ -29,7 +29,7 @@ import dataclasses
 import time
 from pathlib import Path
 
-from puzzlebox.lab.cli import OneLineParser, fail, one_line, versions, write_json
+from puzzlebox.lab.cli import OneLineParser, fail, one_line, run_script, versions, write_json
 from puzzlebox.lab.errors import RunStoreError
 from puzzlebox.lab.inputs import MAX_SEED, MAX_VIEWS
 from puzzlebox.lab.out_lock import OutputLock
@@ -119,4 +119,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    run_script(main)

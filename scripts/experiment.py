@@ -101,7 +101,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from puzzlebox.lab.cli import OneLineParser, fail
+from puzzlebox.lab.cli import OneLineParser, fail, run_script
 from puzzlebox.lab.errors import ExperimentStepFailed, LabError
 from puzzlebox.lab.experiment_flags import AGENTS, PROTOCOL_NAMES, ExperimentFlags
 from puzzlebox.lab.experiment_protocols import run_experiment
@@ -174,4 +174,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    run_script(main)

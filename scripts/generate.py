@@ -54,7 +54,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from puzzlebox.lab.box_exports import export_box_meshes, export_mjcf
-from puzzlebox.lab.cli import OneLineParser, fail, write_json
+from puzzlebox.lab.cli import OneLineParser, fail, run_script, write_json
 from puzzlebox.lab.errors import LabError, SpecFilesInvalid
 from puzzlebox.lab.inputs import check_seed
 from puzzlebox.lab.spec_files import load_box_specs, validation_lines, write_spec_file
@@ -205,4 +205,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    run_script(main)

@@ -16,7 +16,7 @@ import argparse
 import json
 import sys
 
-from puzzlebox.lab.cli import OneLineParser, fail
+from puzzlebox.lab.cli import OneLineParser, fail, run_script
 from puzzlebox.learning.errors import MemoryFileError
 from puzzlebox.learning.memory import MemoryStore
 
@@ -68,4 +68,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    run_script(main)

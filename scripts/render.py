@@ -19,7 +19,7 @@ from pathlib import Path
 
 import imageio.v3 as iio
 
-from puzzlebox.lab.cli import OneLineParser, fail, one_line, versions, write_json
+from puzzlebox.lab.cli import OneLineParser, fail, one_line, run_script, versions, write_json
 from puzzlebox.lab.errors import RunStoreError
 from puzzlebox.lab.inputs import MAX_IMAGE_SIDE, MAX_VIEWS, check_count, check_seed
 from puzzlebox.lab.out_lock import OutputLock
@@ -112,4 +112,4 @@ def _gallery(spec, out: Path, config: RenderConfig, args: argparse.Namespace, lo
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    run_script(main)

@@ -28,7 +28,7 @@ import sys
 import time
 from pathlib import Path
 
-from puzzlebox.lab.cli import OneLineParser, fail, one_line
+from puzzlebox.lab.cli import OneLineParser, fail, one_line, run_script
 from puzzlebox.lab.report_gallery import write_top_views
 from puzzlebox.lab.report_html import ReportError, build_page, load_results_dir
 from puzzlebox.models.atomic import write_text_atomically
@@ -86,4 +86,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    run_script(main)

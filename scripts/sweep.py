@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from puzzlebox.lab.cell_bars import cell_bars
-from puzzlebox.lab.cli import OneLineParser, fail, one_line
+from puzzlebox.lab.cli import OneLineParser, fail, one_line, run_script
 from puzzlebox.lab.errors import RunStoreError
 from puzzlebox.lab.inputs import MAX_WORKERS
 from puzzlebox.lab.interrupt import StopRequests
@@ -149,4 +149,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    run_script(main)

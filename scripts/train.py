@@ -36,7 +36,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from puzzlebox.lab.cli import OneLineParser, fail, versions
+from puzzlebox.lab.cli import OneLineParser, fail, run_script, versions
 from puzzlebox.lab.deep_training import train_deep
 from puzzlebox.lab.errors import LabError
 from puzzlebox.lab.inputs import MAX_ACTIONS, MAX_EPISODES, check_count, check_seed
@@ -121,4 +121,4 @@ def _train(args: argparse.Namespace) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    run_script(main)

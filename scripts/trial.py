@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from puzzlebox.lab.agent_class import check_agent
-from puzzlebox.lab.cli import OneLineParser, fail, one_line
+from puzzlebox.lab.cli import OneLineParser, fail, one_line, run_script
 from puzzlebox.lab.errors import AgentClassError, ArmTrialFailed, ArmTrialRefused, RunStoreError, TrialConfigError
 from puzzlebox.lab.run_store import RunStore
 from puzzlebox.lab.runner import RunnerError, make_executor
@@ -199,4 +199,4 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    run_script(main)

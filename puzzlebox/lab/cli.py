@@ -5,8 +5,10 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import json
+import os
 import platform
 import sys
+from collections.abc import Callable
 from importlib import metadata
 from pathlib import Path
 from typing import Any, NoReturn
@@ -22,6 +24,18 @@ class OneLineParser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"error: {message} (see {self.prog} --help)\n")
+
+    def parse_known_args(self, args: Any = None, namespace: Any = None) -> Any:
+        """As argparse's, and an empty argument is refused: ``--out ""`` (an unset shell variable) wrote into the
+        current folder, ``--specs ""`` read the folder as a spec."""
+        given = list(sys.argv[1:] if args is None else args)
+        for at, arg in enumerate(given):
+            value = arg.split("=", 1)[1] if arg.startswith("--") and "=" in arg else arg
+            if isinstance(value, str) and not value.strip():
+                after = given[at - 1] if at and str(given[at - 1]).startswith("-") else ""
+                self.error(f"{arg.split('=')[0] if arg.startswith('--') else after or 'an argument'} is empty "
+                           "(an unset shell variable?)")  # fmt: skip
+        return super().parse_known_args(given, namespace)
 
 
 def versions() -> dict[str, str]:
@@ -43,6 +57,40 @@ def write_json(path: Path, data: Any) -> Path:
 def one_line(err: Exception) -> str:
     """An error's message on one line (for ``fail`` and logs)."""
     return " ".join(line.strip() for line in str(err).splitlines())
+
+
+class _StdoutThatMayClose:
+    """``sys.stdout`` for a script whose reader may go away (``| head -1``): once the pipe is closed, the rest of
+    what the script prints is dropped (the descriptor is pointed at ``os.devnull``) and the script goes on."""
+
+    def __init__(self, stream: Any) -> None:
+        self._stream = stream
+
+    def _guarded(self, call: Callable[[], Any]) -> Any:
+        try:
+            return call()
+        except BrokenPipeError:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, self._stream.fileno())  # (what is still buffered goes there too, at exit)
+            os.close(devnull)
+            return None
+
+    def write(self, text: str) -> int:
+        self._guarded(lambda: self._stream.write(text))
+        return len(text)
+
+    def flush(self) -> None:
+        self._guarded(self._stream.flush)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
+
+
+def run_script(main: Callable[[], int | None]) -> NoReturn:
+    """Run a script's ``main`` and exit with its code. A reader that closes stdout early (``... | head -1``) ends
+    nothing: the script finishes its work and writes every file, and what it would still print is dropped."""
+    sys.stdout = _StdoutThatMayClose(sys.stdout)
+    raise SystemExit(main())
 
 
 def fail(message: str, code: int = 2) -> NoReturn:

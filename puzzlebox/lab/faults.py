@@ -342,6 +342,7 @@ def cli_mistakes(out: Path) -> FaultRow:
                                     "--reality", "stormy", "--out", out / "cli" / "o6"],
         "random box too large to reach": [SCRIPTS / "generate.py", "random", "--components", 40, "--seed", 0,
                                           "--out", out / "cli" / "r.json"],
+        "--out empty (an unset variable)": [*trial, "--seed", 0, "--agent", "dual", "--out", ""],
     }  # fmt: skip
     failed = []
     for name, args in cases.items():

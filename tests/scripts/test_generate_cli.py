@@ -289,3 +289,24 @@ def test_check_locks_names_an_invalid_spec_in_one_line_and_exits_2(tmp_path, pap
     (tmp_path / "bad.json").write_text('{"name": 1}')
     result = generate("check-locks", paper_box, tmp_path / "bad.json")
     assert_one_line_failure(result, "bad.json", "invalid puzzle spec")
+
+
+@pytest.mark.parametrize("script", ["generate", "trial"])
+def test_a_reader_that_closes_stdout_early_ends_nothing(tmp_path, script):
+    # (`generate.py paper | head -1` wrote 2 of 12 specs, trial.py ended in a BrokenPipeError traceback)
+    specs = tmp_path / "specs"
+    args = ["paper", "--split", "all", "--out", specs]
+    if script == "trial":
+        assert generate("paper", "--split", "test", "--out", specs).returncode == 0
+        args = ["--specs", *sorted(specs.glob("*.json")), "--sim", "symbolic", "--agent", "dual", "--runs", 4,
+                "--seed", 0, "--max-actions", 30, "--out", tmp_path / "out"]  # fmt: skip
+    reader_gone = subprocess.Popen([sys.executable, ROOT / "scripts" / f"{script}.py", *map(str, args)],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+    assert reader_gone.stdout is not None
+    reader_gone.stdout.close()  # before the script prints anything
+    _, err = reader_gone.communicate(timeout=300)
+    assert reader_gone.returncode == 0 and "Traceback" not in err and "Broken pipe" not in err, err
+    if script == "generate":
+        assert len(list(specs.glob("*.json"))) == 12
+    else:
+        assert len(json.loads((tmp_path / "out" / "results.json").read_text())["runs"]) == 12

@@ -366,3 +366,27 @@ def test_a_real_full_disk_is_one_line_and_the_runs_written_are_whole(tmp_path, s
 def test_an_argument_the_parser_refuses_is_one_line_without_the_usage(capsys, script, argv, says):
     line = one_line_exit_2(capsys, script, *argv)
     assert says in line and "usage:" not in line, line
+
+
+# -- empty arguments ------------------------------------------------------------------------------------------
+
+TRIAL = ["--sim", "symbolic", "--runs", "1", "--seed", "0", "--max-actions", "3"]
+EMPTY_CASES = [
+    ("trial", ["--specs", "{spec}", *TRIAL, "--out", ""], "--out is empty"),
+    ("trial", ["--specs", "", *TRIAL, "--out", "x"], "--specs is empty"),
+    ("sweep", ["{spec}", "--out="], "--out is empty"),
+    ("render", ["--spec", "{spec}", "--out", " "], "--out is empty"),
+    ("generate", ["paper", "--split", "test", "--out", ""], "--out is empty"),
+    ("calibrate", ["--out", ""], "--out is empty"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("script", "argv", "says"), EMPTY_CASES, ids=[f"{c[0]}-{c[2]}" for c in EMPTY_CASES])
+def test_an_empty_argument_is_refused_before_anything_is_written(
+    capsys, tmp_path, monkeypatch, spec, script, argv, says
+):
+    # an unset shell variable (--out "$OUT") wrote into the current folder
+    monkeypatch.chdir(tmp_path)
+    line = one_line_exit_2(capsys, script, *(a.replace("{spec}", str(spec)) for a in argv))
+    assert says in line
+    assert not any(tmp_path.iterdir())
