@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+import stat
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -86,14 +87,21 @@ def read_json(path: str | Path, **options: Any) -> Any:
 
 
 def read_input_text(path: str | Path) -> str:
-    """The text of the input file ``path``; :class:`JsonInputError` if it cannot be read, is larger than
-    :data:`MAX_FILE_BYTES` or is not UTF-8."""
+    """The text of the input file ``path``; :class:`JsonInputError` if it is not a regular file (a device, a FIFO,
+    a socket: ``/dev/zero`` was read until the kernel stopped it, a FIFO blocked for ever), cannot be read, is larger
+    than :data:`MAX_FILE_BYTES` or is not UTF-8. At most that many bytes are read, whatever the file claims."""
     path = Path(path)
     try:
-        size = path.stat().st_size
-        if size > MAX_FILE_BYTES:
-            raise JsonInputError(f"too large ({size} bytes; at most {MAX_FILE_BYTES})")
-        text = path.read_text(encoding="utf-8")
+        mode = path.stat().st_mode  # (follows a link: a link to a device is a device)
+        if stat.S_ISDIR(mode):
+            raise IsADirectoryError
+        if not stat.S_ISREG(mode):
+            raise JsonInputError("not a regular file (a device, a FIFO or a socket)")
+        with path.open("rb") as file:
+            data = file.read(MAX_FILE_BYTES + 1)
+        if len(data) > MAX_FILE_BYTES:
+            raise JsonInputError(f"too large (over {MAX_FILE_BYTES} bytes)")
+        text = data.decode("utf-8")
     except FileNotFoundError:
         raise JsonInputError("no such file") from None
     except IsADirectoryError:

@@ -13,6 +13,7 @@ import errno
 import importlib
 import json
 import math
+import os
 import sqlite3
 import subprocess
 import sys
@@ -390,3 +391,32 @@ def test_an_empty_argument_is_refused_before_anything_is_written(
     line = one_line_exit_2(capsys, script, *(a.replace("{spec}", str(spec)) for a in argv))
     assert says in line
     assert not any(tmp_path.iterdir())
+
+
+# -- inputs that are not regular files -------------------------------------------------------------------------
+
+
+@pytest.fixture
+def fifo(tmp_path) -> Path:
+    path = tmp_path / "a-fifo.json"
+    os.mkfifo(path)
+    return path
+
+
+def test_a_device_or_a_fifo_as_an_input_is_refused_without_reading_it(capsys, tmp_path, fifo):
+    # /dev/zero was read until the kernel killed the process (23.7 GB), a FIFO blocked for ever
+    for source in ("/dev/zero", "/dev/urandom", fifo):
+        line = one_line_exit_2(capsys, "trial", "--specs", source, *TRIAL, "--agent", "dual", "--out", tmp_path / "o")
+        assert "not a regular file" in line
+        assert "not a regular file" in one_line_exit_2(capsys, "sweep", source, "--out", tmp_path / "s")
+    assert not (tmp_path / "o").exists() and not (tmp_path / "s").exists()
+
+
+def test_an_input_read_is_bounded_whatever_the_file_claims(tmp_path, monkeypatch):
+    from puzzlebox.models import json_input
+
+    path = tmp_path / "big.json"
+    path.write_text("[" + "0," * 600 + "0]")
+    monkeypatch.setattr(json_input, "MAX_FILE_BYTES", 1000)
+    with pytest.raises(json_input.JsonInputError, match="too large"):
+        json_input.read_input_text(path)
