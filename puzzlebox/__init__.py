@@ -11,6 +11,30 @@ the symbolic ``puzzlebox/Puzzle-v0`` is registered by :mod:`puzzlebox.learning`.
 
 __version__ = "0.1.0"
 
+_MUJOCO_GL_VALUES = ("egl", "osmesa", "glfw", "glx", "", "enable", "enabled", "on", "true", "1", "disable",
+                     "disabled", "off", "false", "0")  # fmt: skip
+"""The values of ``MUJOCO_GL`` MuJoCo accepts on Linux (``mujoco.rendering.classic.gl_context``)."""
+
+
+def _refuse_a_script_an_unknown_mujoco_gl() -> None:
+    """A command-line script (``scripts/*.py``) started with a ``MUJOCO_GL`` MuJoCo does not know says so in one line
+    (exit 2): MuJoCo refuses it with a 20-line traceback at its first import, before the script's own checks run, and
+    every script imports ``puzzlebox`` before anything of MuJoCo. A library user meets MuJoCo's own error."""
+    import os
+    import sys
+    from importlib.util import find_spec
+    from pathlib import Path
+
+    gl = os.environ.get("MUJOCO_GL")
+    if gl is None or gl.strip().lower() in _MUJOCO_GL_VALUES or not sys.argv or not sys.argv[0]:
+        return
+    scripts = find_spec("puzzlebox.scripts")
+    folders = [Path(f).resolve() for f in (scripts.submodule_search_locations or [])] if scripts else []
+    if Path(sys.argv[0]).resolve().parent in folders:
+        sys.stderr.write(f"error: MUJOCO_GL={gl!r} is not a value MuJoCo knows: egl (headless), osmesa, glfw or glx, "
+                         "or unset\n")  # fmt: skip
+        raise SystemExit(2)
+
 
 def _register_environments() -> None:
     """``gymnasium.make("puzzlebox/TwinPuzzle-v0", spec=..., config=...)`` and
@@ -26,4 +50,5 @@ def _register_environments() -> None:
         )
 
 
+_refuse_a_script_an_unknown_mujoco_gl()
 _register_environments()

@@ -420,3 +420,14 @@ def test_an_input_read_is_bounded_whatever_the_file_claims(tmp_path, monkeypatch
     monkeypatch.setattr(json_input, "MAX_FILE_BYTES", 1000)
     with pytest.raises(json_input.JsonInputError, match="too large"):
         json_input.read_input_text(path)
+
+
+@pytest.mark.parametrize("script", ["trial", "generate", "render"])
+def test_a_mujoco_gl_typo_is_one_line(script):
+    # MuJoCo refuses it at its first import, before a script's own checks: a 16-22-line traceback
+    env = {**os.environ, "MUJOCO_GL": "eglx"}
+    result = subprocess.run([sys.executable, ROOT / "scripts" / f"{script}.py", "--help"], env=env,
+                            capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert result.stderr.strip() == ("error: MUJOCO_GL='eglx' is not a value MuJoCo knows: egl (headless), osmesa, "
+                                     "glfw or glx, or unset")  # fmt: skip
