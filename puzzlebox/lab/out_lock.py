@@ -80,7 +80,10 @@ class OutputLock:
         if not directory and self.out.is_dir():
             raise OutputNotADirectory(f"{what} {self.out} is a directory; give a file name")
         self.path = lock_path(self.out, directory)
-        self._key = str(self.path.resolve())
+        try:
+            self._key = str(self.path.resolve())
+        except RuntimeError as err:  # (Python 3.11 raises this for a loop of symbolic links)
+            raise OutputNotWritable(f"{what} {self.out}: a loop of symbolic links") from err
         self._released = False
         held = _HELD.get(self._key)
         if held is not None and held.pid == os.getpid():

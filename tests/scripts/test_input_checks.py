@@ -431,3 +431,10 @@ def test_a_mujoco_gl_typo_is_one_line(script):
     assert result.returncode == 2 and "Traceback" not in result.stderr
     assert result.stderr.strip() == ("error: MUJOCO_GL='eglx' is not a value MuJoCo knows: egl (headless), osmesa, "
                                      "glfw or glx, or unset")  # fmt: skip
+
+
+def test_an_out_that_is_a_loop_of_links_is_one_line(capsys, tmp_path, spec):
+    (tmp_path / "a").symlink_to(tmp_path / "b")
+    (tmp_path / "b").symlink_to(tmp_path / "a")
+    line = one_line_exit_2(capsys, "trial", "--specs", spec, *TRIAL, "--agent", "dual", "--out", tmp_path / "a")
+    assert "a loop of symbolic links" in line
