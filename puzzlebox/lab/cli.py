@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import io
 import json
 import os
 import platform
@@ -88,7 +89,11 @@ class _StdoutThatMayClose:
 
 def run_script(main: Callable[[], int | None]) -> NoReturn:
     """Run a script's ``main`` and exit with its code. A reader that closes stdout early (``... | head -1``) ends
-    nothing: the script finishes its work and writes every file, and what it would still print is dropped."""
+    nothing: the script finishes its work and writes every file, and what it would still print is dropped. A path
+    that is not UTF-8 (a byte the shell passed as is) is printed escaped, never a ``UnicodeEncodeError``."""
+    for stream in (sys.stdout, sys.stderr):
+        if isinstance(stream, io.TextIOWrapper):
+            stream.reconfigure(errors="backslashreplace")
     sys.stdout = _StdoutThatMayClose(sys.stdout)
     raise SystemExit(main())
 

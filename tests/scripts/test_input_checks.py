@@ -438,3 +438,13 @@ def test_an_out_that_is_a_loop_of_links_is_one_line(capsys, tmp_path, spec):
     (tmp_path / "b").symlink_to(tmp_path / "a")
     line = one_line_exit_2(capsys, "trial", "--specs", spec, *TRIAL, "--agent", "dual", "--out", tmp_path / "a")
     assert "a loop of symbolic links" in line
+
+
+def test_a_path_that_is_not_utf8_is_printed_escaped(tmp_path, spec):
+    # a byte the shell passes as is (0xff): UnicodeEncodeError tracebacks under a strict UTF-8 stdout
+    out = os.fsencode(tmp_path) + b"/out\xff"
+    env = {**os.environ, "PYTHONIOENCODING": "utf-8:strict"}
+    argv = [sys.executable, str(ROOT / "scripts/trial.py"), "--specs", str(spec), *TRIAL, "--agent", "dual", "--out"]
+    result = subprocess.run([*map(os.fsencode, argv), out], env=env, capture_output=True, timeout=300)
+    assert result.returncode == 0 and b"Traceback" not in result.stderr, result.stderr
+    assert b"out\\udcff" in result.stdout and os.path.exists(out + b"/results.json")
