@@ -6,7 +6,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
+import numpy as np
+
 from puzzlebox.lab.errors import TrialConfigError
+from puzzlebox.lab.inputs import MAX_ACTIONS, InputError, check_count, check_seed
+from puzzlebox.learning.dual_controller import MAX_LOCKERS
 from puzzlebox.models.calibration import CellCalibration
 from puzzlebox.models.mechanism_mjcf import LOCK_MODES
 from puzzlebox.twin.reality import RealityProfile
@@ -57,10 +61,23 @@ class TrialConfig:
         problems = []
         if self.sim not in SIMS:
             problems.append(f"sim must be one of {list(SIMS)}, got {self.sim!r}")
-        if self.max_actions < 1:
-            problems.append(f"max_actions must be at least 1, got {self.max_actions}")
-        if self.max_lockers is not None and self.max_lockers < 1:
-            problems.append(f"max_lockers must be at least 1, got {self.max_lockers}")
+        if not isinstance(self.agent, str):
+            problems.append(f"agent must be an agent's name (give an agent object to run_trial), got {self.agent!r}")
+        checks = [(check_seed, self.seed, "seed", ()), (check_count, self.max_actions, "max_actions", (MAX_ACTIONS,))]
+        if self.max_lockers is not None:
+            checks.append((check_count, self.max_lockers, "max_lockers", (MAX_LOCKERS,)))
+        for check, value, name, bounds in checks:
+            try:
+                check(int(value) if isinstance(value, np.integer) else value, name, *bounds)
+            except InputError as err:
+                problems.append(str(err))
+        if not isinstance(self.reality, str | Path | RealityProfile):
+            problems.append(f"reality must be a profile's name, a file or a RealityProfile, got {self.reality!r}")
+        if self.calibration is not None and not isinstance(self.calibration, CellCalibration):
+            problems.append(f"calibration must be a CellCalibration (load_calibration), got {self.calibration!r}")
+        for name in ("memory", "checkpoint"):
+            if getattr(self, name) is not None and not isinstance(getattr(self, name), str | Path):
+                problems.append(f"{name} must be a path, got {getattr(self, name)!r}")
         if self.locks not in LOCK_MODES:
             problems.append(f"locks must be one of {list(LOCK_MODES)}, got {self.locks!r}")
         if self.sim == "symbolic" and self.misreport_kind:

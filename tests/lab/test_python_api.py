@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 from user_agents import TryInTurn
 
@@ -99,6 +100,12 @@ def test_a_users_loop_drives_the_twin_through_open_world():
 def test_a_config_that_cannot_run_is_refused_with_every_problem():
     with pytest.raises(TrialConfigError, match="max_actions.*locks"):
         TrialConfig(max_actions=0, locks="glue")
+    # absurd values and wrong types: each named, none a raw TypeError later
+    with pytest.raises(TrialConfigError, match=r"seed must be <= 4294967295.*max_actions must be an integer, got 2.5"):
+        TrialConfig(seed=2**70, max_actions=2.5)  # type: ignore[arg-type]
+    with pytest.raises(TrialConfigError, match="agent must be an agent's name.*reality must be.*memory must be a path"):
+        TrialConfig(agent=TryInTurn(), reality=3.0, memory=5)  # type: ignore[arg-type]
+    assert TrialConfig(seed=np.int64(7)).seed == 7  # a numpy integer is a seed
     with pytest.raises(TrialConfigError, match="twin"):
         run_trial(SPEC, TrialConfig(sim="symbolic"), video="out.mp4")
     arm = RealCell(robot=None, config=None, calibration=None)  # type: ignore[arg-type]  # refused before use
