@@ -65,6 +65,7 @@ from puzzlebox.learning.memory.keys import (
 )
 from puzzlebox.models.atomic import apply_umask
 from puzzlebox.models.disassembly_kinds import kind_family
+from puzzlebox.models.errors import UnknownKindError
 
 MEMORY_FORMAT = "puzzlebox-memory"
 PAIR_VALUE_SIZE = 6
@@ -337,6 +338,7 @@ class MemoryStore:
                 except ValueError as err:
                     raise MemoryFileError(f"{path} has a malformed pair key ({kind_i} -> {kind_j}): {err}") from None
             _check_probabilities(value_arr, f"{path} has a pair entry ({kind_i} -> {kind_j})")
+            _check_kinds(path, "a pair entry", kind_i, kind_j)
             self._pairs[(kind_i, kind_j)].append((key_arr, value_arr, episode))
             by_episode[episode].append(value_arr)
             offsets[episode].append(key_arr[:3])
@@ -349,7 +351,14 @@ class MemoryStore:
             if value_arr.size != 2:
                 raise MemoryFileError(f"{path} has a malformed independence entry")
             _check_probabilities(value_arr, f"{path} has an independence entry ({kind})")
+            _check_kinds(path, "an independence entry", kind)
             self._independence[kind].append(value_arr)
+        if self._schema != "1":  # (the training log: every run's config is JSON, read by training_log)
+            for run_id, config in conn.execute("SELECT id, config FROM training_runs"):
+                try:
+                    json.loads(config)
+                except (TypeError, ValueError):
+                    raise MemoryFileError(f"{path} has a training run ({run_id}) whose config is not JSON") from None
 
     def _write_transaction(self) -> None:
         """Begin a write transaction (holding the file's write lock) and check, inside it, that the file is still
@@ -682,6 +691,22 @@ def _meta_number(meta: dict[str, str], name: str, path: Path, rule: str, positiv
     if not (math.isfinite(value) and (value > 0.0 if positive else value >= 0.0)):
         raise MemoryFileError(f"{path} has a {name} that is not {rule}: {value}")
     return value
+
+
+def _check_kinds(path: Path, entry: str, *kinds: object) -> None:
+    """:class:`MemoryFileError` unless every one of ``kinds`` is a kind some family knows (a memory of an unknown kind
+    failed every trial of the memory agent, and ``train.py`` wrote to it before failing)."""
+    for kind in kinds:
+        if kind not in _KNOWN_KINDS:
+            try:
+                kind_family(str(kind))
+            except UnknownKindError as err:
+                raise MemoryFileError(f"{path} has {entry} of an unknown kind: {err}") from None
+            _KNOWN_KINDS.add(str(kind))
+
+
+_KNOWN_KINDS: set[str] = set()
+"""Kinds :func:`_check_kinds` found known (a memory holds thousands of entries of a few kinds)."""
 
 
 def _check_probabilities(values: np.ndarray, where: str) -> None:

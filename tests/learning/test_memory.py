@@ -340,6 +340,30 @@ def test_a_memory_with_a_malformed_entry_is_a_memory_file_error(trained_memory_f
     assert_not_a_memory(path)
 
 
+@pytest.mark.parametrize(
+    ("change", "says"),
+    [
+        ("UPDATE pair_entries SET kind_i = 'trapdoor' WHERE rowid = 1", "a pair entry of an unknown kind"),
+        ("UPDATE independence_entries SET kind = 'trapdoor' WHERE rowid = 1", "an independence entry of an unknown"),
+        ("INSERT INTO training_runs (started, config) VALUES (0, '{not json')", "whose config is not JSON"),
+    ],
+)
+def test_a_memory_whose_contents_are_bad_is_refused_on_opening_and_left_unchanged(
+    trained_memory_file, tmp_path, change, says
+):
+    # (train.py wrote to such a memory before failing with a traceback; the memory agent failed every trial)
+    path = tmp_path / "bad.sqlite"
+    shutil.copy(trained_memory_file[0], path)
+    conn = sqlite3.connect(path)
+    with conn:
+        assert conn.execute(change).rowcount == 1
+    conn.close()
+    before = path.read_bytes()
+    with pytest.raises(MemoryFileError, match=says):
+        MemoryStore(path)
+    assert path.read_bytes() == before
+
+
 def test_a_memory_whose_meta_lacks_the_position_scale_is_a_memory_file_error(trained_memory_file, tmp_path):
     path = tmp_path / "no-scale.sqlite"
     shutil.copy(trained_memory_file[0], path)
