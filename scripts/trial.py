@@ -27,7 +27,14 @@ from puzzlebox.lab.cli import OneLineParser, fail, one_line, run_script
 from puzzlebox.lab.errors import AgentClassError, ArmTrialFailed, ArmTrialRefused, RunStoreError, TrialConfigError
 from puzzlebox.lab.run_store import RunStore
 from puzzlebox.lab.runner import RunnerError, make_executor
-from puzzlebox.lab.trial_batch import InputError, TrialBatch, check_batch_numbers, run_batch, summary_lines
+from puzzlebox.lab.trial_batch import (
+    InputError,
+    TrialBatch,
+    check_batch_numbers,
+    check_distinct_specs,
+    run_batch,
+    summary_lines,
+)
 from puzzlebox.learning import AGENT_NAMES, LearningError, make_agent
 from puzzlebox.learning.memory import MemoryStore
 from puzzlebox.models import SpecError, load_spec
@@ -148,7 +155,8 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
     _check_twin_flags(args)
     try:
         specs = [load_spec(path) for path in args.specs]
-    except SpecError as err:
+        check_distinct_specs(specs, args.specs)
+    except (SpecError, InputError) as err:
         fail(str(err))
     reality = calibration = None
     if args.sim == "twin":

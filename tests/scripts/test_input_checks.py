@@ -448,3 +448,14 @@ def test_a_path_that_is_not_utf8_is_printed_escaped(tmp_path, spec):
     result = subprocess.run([*map(os.fsencode, argv), out], env=env, capture_output=True, timeout=300)
     assert result.returncode == 0 and b"Traceback" not in result.stderr, result.stderr
     assert b"out\\udcff" in result.stdout and os.path.exists(out + b"/results.json")
+
+
+def test_a_box_given_twice_or_two_boxes_of_one_name_are_refused(capsys, tmp_path, spec):
+    # overlapping globs ran the same spec and seed twice; two boxes of one name were summed as one
+    renamed = tmp_path / "other.json"
+    renamed.write_text(paper_family("test")[1].to_json().replace('"paper-test-1"', '"paper-test-0"'))
+    for second, says in ((spec, "the same box, 'paper-test-0'"), (renamed, "two different boxes of one name")):
+        line = one_line_exit_2(capsys, "trial", "--specs", spec, second, *TRIAL, "--agent", "dual", "--out",
+                               tmp_path / "o")  # fmt: skip
+        assert says in line
+    assert not (tmp_path / "o").exists()
