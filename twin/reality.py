@@ -69,6 +69,12 @@ def _probability(obj: Any, *names: str) -> None:
         _check(math.isfinite(value) and 0.0 <= value <= 1.0, name, f"is a probability in [0, 1], got {value!r}")
 
 
+MAX_OCCLUDERS = 20
+"""Most occluders a frame may carry (20 of up to 80 px cover most of a 640 x 480 frame; 1e6 was accepted)."""
+MAX_FT_DELAY = 0.5
+"""Oldest sample an F/T reading may return [s]: 50 times a real xArm's 10 ms (REALITY_NOTES), past any cell's."""
+
+
 @dataclass(frozen=True)
 class ScaleRange:
     """A random multiplier of a nominal value, drawn once per trial (or once per cell, for the cell's fields)."""
@@ -146,7 +152,11 @@ class CameraReality:
         _probability(self, "occluder_probability", "dropped_frame_probability")
         _check(self.focal_error < 0.5, "focal_error", f"must be < 0.5, got {self.focal_error!r}")
         _check(self.blur_depth > 0, "blur_depth", f"must be > 0, got {self.blur_depth!r}")
-        _check(self.occluder_count >= 1, "occluder_count", f"must be >= 1, got {self.occluder_count!r}")
+        _check(
+            1 <= self.occluder_count <= MAX_OCCLUDERS,
+            "occluder_count",
+            f"must be in 1..{MAX_OCCLUDERS}, got {self.occluder_count!r}",
+        )
         low, high = self.occluder_size
         _check(0 < low <= high, "occluder_size", f"needs 0 < low <= high [px], got {self.occluder_size!r}")
 
@@ -185,6 +195,7 @@ class ForceTorqueReality:
         _non_negative(self, "force_noise", "torque_noise", "force_bias", "torque_bias", "force_drift")
         _non_negative(self, "torque_drift", "rate_hz", "delay", "force_resolution", "torque_resolution")
         _check(self.delay == 0 or self.rate_hz > 0, "delay", "a delayed sensor needs a sampling rate_hz > 0")
+        _check(self.delay <= MAX_FT_DELAY, "delay", f"must be <= {MAX_FT_DELAY} s, got {self.delay!r}")
         if self.force_range is not None:
             _check(
                 len(self.force_range) == 3 and all(v > 0 for v in self.force_range),

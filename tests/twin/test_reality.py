@@ -91,6 +91,8 @@ def test_an_unknown_key_at_any_level_names_it_and_the_known_keys(tmp_path, data,
         ({"camera": {"dropped_frame_probability": 1.5}}, "dropped_frame_probability"),
         ({"physics": {"jam_probability": -0.2}}, "jam_probability"),
         ({"arm": {"encoder_noise": "loud"}}, "encoder_noise"),
+        ({"camera": {"occluder_count": 1000000}}, "occluder_count: must be in 1..20"),  # (was accepted)
+        ({"force_torque": {"rate_hz": 100, "delay": 1e6}}, "delay: must be <= 0.5 s"),  # (was accepted)
     ],
 )
 def test_a_negative_noise_or_a_probability_outside_0_1_is_a_profile_error(tmp_path, data, key):
