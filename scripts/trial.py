@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -96,8 +97,13 @@ def _check_twin_flags(args) -> None:
             fail("--record needs --sim twin")
         if not args.record.endswith(".rrd"):
             fail(f"--record {args.record}: a Rerun recording file ends in .rrd")
-        if not Path(args.record).resolve().parent.is_dir():
-            fail(f"--record {args.record}: directory {Path(args.record).resolve().parent} does not exist")
+        folder = Path(args.record).resolve().parent
+        if not folder.is_dir():
+            fail(f"--record {args.record}: directory {folder} does not exist")
+        try:  # a place that cannot be written failed every run at its end, after the work, and kept an --out
+            tempfile.TemporaryFile(dir=folder).close()
+        except OSError as err:
+            fail(f"--record {args.record}: directory {folder} cannot be written ({err.strerror})")
         try:
             import rerun  # noqa: F401  (the viz extra: refused here in one line, not in every run)
         except ImportError:

@@ -459,3 +459,11 @@ def test_a_box_given_twice_or_two_boxes_of_one_name_are_refused(capsys, tmp_path
                                tmp_path / "o")  # fmt: skip
         assert says in line
     assert not (tmp_path / "o").exists()
+
+
+def test_a_recording_that_cannot_be_written_is_refused_before_any_run(capsys, tmp_path, spec):
+    # (every run failed at its end with a PermissionError, and left an --out that a plain rerun refused)
+    line = one_line_exit_2(capsys, "trial", "--specs", spec, "--sim", "twin", "--runs", "1", "--seed", "0",
+                           "--max-actions", "2", "--agent", "oracle", "--record", READ_ONLY.parent / "x.rrd",
+                           "--out", tmp_path / "o")  # fmt: skip
+    assert "cannot be written" in line and not (tmp_path / "o").exists()
