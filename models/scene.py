@@ -21,7 +21,7 @@ from puzzlebox.models.errors import ModelsError
 from puzzlebox.models.kinds import get_kind
 from puzzlebox.models.puzzle_box import LockMode, build_puzzle_box, component_prefixes, lid_to_world, yaw_quat
 from puzzlebox.models.spec import PuzzleSpec
-from puzzlebox.models.xarm7 import ARM_JOINTS, XArm7Config, build_xarm7, compensate_gravity
+from puzzlebox.models.xarm7 import ARM_JOINTS, HOME_QPOS, XArm7Config, build_xarm7, compensate_gravity
 
 DEFAULT_BOX_POSE = (0.45, 0.0, 0.0)
 """Where the box stands when the spec leaves ``box.pose`` out: centred 45 cm in front of the robot [m, m, rad]."""
@@ -118,15 +118,29 @@ class Scene:
             compensate_gravity(spec, ROBOT)
         return spec
 
+    def _add_home_keyframe(self, spec: mujoco.MjSpec) -> None:
+        """Add the ``home`` keyframe to ``spec`` (the twin's reset, :meth:`twin.session.TwinSession.reset`): at
+        ``qpos0`` the arm's joints are all zero, its fingers 40 mm inside the world's geometry, and it falls onto the
+        lid in the first second of a plain simulation."""
+        model = spec.compile()
+        qpos, ctrl = model.qpos0.copy(), np.zeros(model.nu)
+        for joint, angle in zip(self.names.arm_joints, HOME_QPOS, strict=True):
+            qpos[model.joint(joint).qposadr[0]] = angle
+        for actuator, angle in zip(self.names.arm_actuators, HOME_QPOS, strict=True):
+            ctrl[model.actuator(actuator).id] = angle  # (position servos: the arm holds its posture)
+        spec.add_key(name="home", qpos=qpos.tolist(), ctrl=ctrl.tolist())
+
     def compile(self) -> mujoco.MjModel:
         return self.to_mjspec().compile()
 
     def export(self, out_dir: str | Path) -> Path:
         """Write ``out_dir/scene.xml`` and its assets (meshes, marker textures): loadable by plain
-        ``mujoco.MjModel.from_xml_path``."""
+        ``mujoco.MjModel.from_xml_path``, with a ``home`` keyframe (``mujoco.mj_resetDataKeyframe(model, data, 0)``,
+        or the viewer's "Load key"): the arm at its rest posture holding it, the gripper open, every part closed."""
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         spec = self.to_mjspec()
+        self._add_home_keyframe(spec)
         for filename, contents in self.root.get_assets().items():
             (out / filename).write_bytes(contents)
         path = out / "scene.xml"

@@ -10,6 +10,7 @@ import pytest
 
 from puzzlebox.models import Box, Component, Goal, PuzzleSpec, UnknownKindError
 from puzzlebox.models.generator import RandomGraphConfig, generate_random, paper_family
+from puzzlebox.models.kinds import get_kind
 from puzzlebox.models.scene import UnreachableBoxPose, build_scene
 
 SIM_SECONDS = 1.0
@@ -82,6 +83,25 @@ def test_scene_exports_to_files_plain_mujoco_loads(tmp_path):
     assert (model.nbody, model.njnt, model.ngeom, model.nu, model.neq) == (
         compiled.nbody, compiled.njnt, compiled.ngeom, compiled.nu, compiled.neq)  # fmt: skip
     assert model.body_gravcomp.sum() == compiled.body_gravcomp.sum() > 0
+
+
+def test_the_exported_scene_rests_in_its_home_keyframe(tmp_path):
+    # (without one, plain MuJoCo started the arm at zero, its fingers 40 mm inside the world, falling onto the lid)
+    spec = paper_family("test")[0]
+    model = mujoco.MjModel.from_xml_path(str(build_scene(spec).export(tmp_path)))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+    mujoco.mj_forward(model, data)
+    assert all(c.dist > -0.001 for c in data.contact[: data.ncon])  # nothing interpenetrates by more than 1 mm
+    parts = [model.joint(f"box/{c.name}:joint").qposadr[0] for c in spec.components]
+    arm = [model.joint(f"xarm7/joint{i}").qposadr[0] for i in range(1, 8)]
+    arm_at_home = data.qpos[arm].copy()
+    for _ in range(round(2.0 / model.opt.timestep)):  # 2 s, the keyframe's controls held
+        mujoco.mj_step(model, data)
+    travel = np.array([get_kind(c.kind).travel for c in spec.components])
+    assert np.all(np.abs(data.qpos[parts]) < 0.01 * travel)
+    assert np.abs(data.qpos[arm] - arm_at_home).max() < 0.01
+    assert not any(w.number for w in data.warning)
 
 
 def test_box_stands_at_its_pose_with_components_at_their_lid_poses():
