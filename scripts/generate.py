@@ -3,6 +3,7 @@
     python scripts/generate.py paper --split {train,test,all} --out DIR     # DIR/<name>.json
     python scripts/generate.py chain --kinds door,slide,wheel --seed S --out FILE
     python scripts/generate.py random --components N --seed S [--multi-locker] [--kinds paper|all] --out FILE
+                                      [--require-kinds KIND,...]     # every box holds each kind named
     python scripts/generate.py random|chain ... --count N --out DIR [--workers K | --ray auto|ADDRESS]
     python scripts/generate.py validate FILE...     # exit 1 and one line per problem if any is invalid
     python scripts/generate.py mjcf SPEC --out DIR [--box-only] [--locks {contact,latch}]
@@ -69,12 +70,17 @@ def _paper(args: argparse.Namespace) -> None:
         _print(write_spec_file(spec, Path(args.out) / f"{spec.name}.json", args.plot))
 
 
+def _kind_list(text: str | None) -> tuple[str, ...]:
+    """``--require-kinds door,slide``: the kinds, in order, each once (the generator refuses an unknown one)."""
+    return tuple(dict.fromkeys(k.strip() for k in text.split(",") if k.strip())) if text else ()
+
+
 def _generated(args: argparse.Namespace) -> int | None:
     """chain or random: a spec in the file ``--out``, or with ``--count N`` a dataset in the directory ``--out``."""
     if args.verb == "chain":
         generator = chain_settings(args.kinds)
     else:
-        generator = random_settings(args.components, args.multi_locker, args.kinds)
+        generator = random_settings(args.components, args.multi_locker, args.kinds, _kind_list(args.require_kinds))
     if args.count is None:
         spec = generate_spec(generator, seed=args.seed, name=args.name, anywhere=args.anywhere)
         return _print(write_spec_file(spec, Path(args.out), args.plot))
@@ -162,6 +168,8 @@ def main(argv: list[str] | None = None) -> int:
     rand.add_argument("--multi-locker", action="store_true", help="some components get two lockers")
     rand.add_argument("--kinds", choices=("paper", "all"), default="paper", help="kinds drawn: the paper's "
                       "door/slide/wheel (default) or every registered kind (models.kinds)")  # fmt: skip
+    rand.add_argument("--require-kinds", default=None, metavar="KIND,...", help="kinds every box holds at least one "
+                      "of, comma-separated (e.g. door,slide,wheel,lever,drawer with --kinds all)")  # fmt: skip
     _generator_flags(rand, "N")
     rand.set_defaults(run=_generated)
 

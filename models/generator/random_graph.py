@@ -49,6 +49,9 @@ class RandomGraphConfig:
     family: KindFamily = PAPER_FAMILY
     """Kinds drawn and the pairs that may lock each other: the paper's (default; its boxes unchanged) or
     :func:`models.kinds.registry_family` (every registered kind: ``generate.py random --kinds all``)."""
+    required_kinds: tuple[str, ...] = ()
+    """Kinds every box must hold at least one of (``generate.py random --require-kinds``): layouts without them are
+    drawn again. Empty (default): any, the boxes unchanged."""
 
 
 def _partner_kinds(family: KindFamily, kind: str) -> list[str]:
@@ -71,6 +74,11 @@ def generate_random(
     ):
         if not 0.0 <= p <= 1.0:
             raise GeneratorError(f"{label} must be in [0, 1], got {p}")
+    unknown = sorted(set(config.required_kinds) - set(config.family.kinds))
+    if unknown:
+        raise GeneratorError(f"required kinds {unknown} are not of the family drawn from: {list(config.family.kinds)}")
+    if len(set(config.required_kinds)) > n:
+        raise GeneratorError(f"{len(set(config.required_kinds))} required kinds do not fit in {n} components")
     box = box or BoxConfig()
     check_reach_size(n, box)
     rng = np.random.default_rng(seed)
@@ -118,6 +126,8 @@ def _try_build(
                 rules.append((second, 0, new, 0))
     if config.multi_locker and all(len(ls) < 2 for ls in lockers):
         return None  # asked for a two-locker component and this layout has none: draw another
+    if not set(config.required_kinds) <= set(layout.kinds):
+        return None  # a kind asked for is missing: draw another
     depth = [0] * config.num_components
     for c in range(1, config.num_components):  # lockers come first, so one pass suffices
         depth[c] = 1 + max(depth[locker] for locker in lockers[c])

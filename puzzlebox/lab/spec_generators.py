@@ -19,10 +19,14 @@ def chain_settings(kinds: str) -> dict[str, Any]:
     return {"generator": "chain", "kinds": [k.strip() for k in kinds.split(",") if k.strip()]}
 
 
-def random_settings(components: int, multi_locker: bool, kinds: str) -> dict[str, Any]:
+def random_settings(
+    components: int, multi_locker: bool, kinds: str, require_kinds: tuple[str, ...] = ()
+) -> dict[str, Any]:
     """The random generator's settings: ``components`` components, some with two lockers if ``multi_locker``, kinds
-    from the family ``kinds`` (``models.kinds.family_named``)."""
-    return {"generator": "random", "components": components, "multi_locker": multi_locker, "kinds": kinds}
+    from the family ``kinds`` (``models.kinds.family_named``), each of ``require_kinds`` in every box (the key only
+    when some are required: the settings of a dataset made before it stay the same)."""
+    settings = {"generator": "random", "components": components, "multi_locker": multi_locker, "kinds": kinds}
+    return settings | ({"require_kinds": list(require_kinds)} if require_kinds else {})
 
 
 def generate_spec(settings: Mapping[str, Any], *, seed: int, name: str | None, anywhere: bool) -> PuzzleSpec:
@@ -31,6 +35,7 @@ def generate_spec(settings: Mapping[str, Any], *, seed: int, name: str | None, a
     check_seed(seed)
     if settings["generator"] == "random":
         family = family_named(settings["kinds"])
-        config = RandomGraphConfig(settings["components"], multi_locker=settings["multi_locker"], family=family)
+        config = RandomGraphConfig(settings["components"], multi_locker=settings["multi_locker"], family=family,
+                                   required_kinds=tuple(settings.get("require_kinds", ())))  # fmt: skip
         return generate_random(config, seed=seed, name=name, box=BoxConfig(fit_reach=not anywhere))
     return generate_chain(settings["kinds"], seed=seed, name=name, box=BoxConfig(fit_reach=not anywhere))

@@ -1,3 +1,4 @@
+import dataclasses
 import json
 
 import numpy as np
@@ -154,3 +155,20 @@ def test_a_box_too_large_for_the_reach_is_refused_unless_fitting_is_off():
     assert anywhere.box.pose == (0.45, 0.0, 0.0) and unreachable_handles(anywhere, anywhere.box.pose)
     spec = generate_random(RandomGraphConfig(10), seed=0)
     assert spec.box.pose != anywhere.box.pose and unreachable_handles(spec, spec.box.pose) == []
+
+
+def test_required_kinds_are_in_every_box_and_the_default_boxes_are_unchanged():
+    from puzzlebox.models.kinds import registry_family
+
+    five = ("door", "slide", "wheel", "lever", "drawer")
+    config = RandomGraphConfig(6, family=registry_family(), required_kinds=five)
+    for seed in range(3):
+        spec = generate_random(config, seed=seed)
+        assert set(five) <= {c.kind for c in spec.components}
+        assert spec == generate_random(config, seed=seed)  # a pure function of its seed
+    plain = RandomGraphConfig(6, family=registry_family())
+    assert generate_random(plain, seed=3) == generate_random(dataclasses.replace(plain, required_kinds=()), seed=3)
+    with pytest.raises(GeneratorError, match=r"required kinds \['lever'\] are not of the family"):
+        generate_random(RandomGraphConfig(6, required_kinds=("lever",)), seed=0)
+    with pytest.raises(GeneratorError, match="5 required kinds do not fit in 4 components"):
+        generate_random(dataclasses.replace(config, num_components=4), seed=0)
