@@ -18,7 +18,8 @@ from puzzlebox.learning.puzzle_env import FaultConfig, PuzzleEnv, PuzzleEnvConfi
 from puzzlebox.learning.symbolic_world import SymbolicWorld
 from puzzlebox.learning.trial import ActionRecord, RunResult, run_episode, summarise
 
-gymnasium.register(id="puzzlebox/Puzzle-v0", entry_point="puzzlebox.learning.puzzle_env:PuzzleEnv")
+if "puzzlebox/Puzzle-v0" not in gymnasium.registry:  # (``import puzzlebox`` registers it first)
+    gymnasium.register(id="puzzlebox/Puzzle-v0", entry_point="puzzlebox.learning.puzzle_env:PuzzleEnv")
 """``gymnasium.make("puzzlebox/Puzzle-v0", spec=..., config=...)`` builds a :class:`PuzzleEnv`."""
 
 __all__ = [

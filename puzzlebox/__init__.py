@@ -4,9 +4,9 @@ One import root. The layers (DESIGN.md) are subpackages: :mod:`puzzlebox.models`
 MuJoCo models), :mod:`puzzlebox.twin` (the simulated cell), :mod:`puzzlebox.skills` (perception and motion
 primitives behind the ``Robot`` seam), :mod:`puzzlebox.learning` (agents, memory, symbolic simulator),
 :mod:`puzzlebox.real` (the real xArm-7 driver) and :mod:`puzzlebox.lab` (the composition layer: trials, sweeps,
-experiments). Importing ``puzzlebox`` imports none of them; it registers the twin's gymnasium environments
-``puzzlebox/TwinPuzzle-v0`` (the option level) and ``puzzlebox/BoxManipulation-v0`` (the low level, the arm at 20 Hz);
-the symbolic ``puzzlebox/Puzzle-v0`` is registered by :mod:`puzzlebox.learning`.
+experiments). Importing ``puzzlebox`` imports none of them; it registers the gymnasium environments
+``puzzlebox/Puzzle-v0`` (the symbolic simulator), ``puzzlebox/TwinPuzzle-v0`` (the twin at the option level) and
+``puzzlebox/BoxManipulation-v0`` (the twin at the low level, the arm at 20 Hz).
 """
 
 __version__ = "0.1.0"
@@ -42,6 +42,8 @@ def _register_environments() -> None:
     ``import puzzlebox`` (or ``gymnasium.make("puzzlebox:puzzlebox/...", ...)``), each imported only when made."""
     import gymnasium
 
+    if "puzzlebox/Puzzle-v0" not in gymnasium.registry:  # (the symbolic one, also registered by puzzlebox.learning)
+        gymnasium.register(id="puzzlebox/Puzzle-v0", entry_point="puzzlebox.learning.puzzle_env:PuzzleEnv")
     if "puzzlebox/TwinPuzzle-v0" not in gymnasium.registry:
         gymnasium.register(id="puzzlebox/TwinPuzzle-v0", entry_point="puzzlebox.lab.twin_puzzle_env:TwinPuzzleEnv")
     if "puzzlebox/BoxManipulation-v0" not in gymnasium.registry:

@@ -4,6 +4,8 @@ learning, never in a cycle; every package folder installs under the one import r
 from __future__ import annotations
 
 import ast
+import subprocess
+import sys
 import tomllib
 from pathlib import Path
 
@@ -103,3 +105,19 @@ def test_nothing_imports_a_layer_by_its_folder_name():
                 names = [node.module]
             bare += [f"{path.relative_to(ROOT)}: {n}" for n in names if n.split(".")[0] in MAY_IMPORT]
     assert bare == []
+
+
+def test_import_puzzlebox_registers_all_three_environments_and_imports_no_layer():
+    # (Puzzle-v0 was registered only once puzzlebox.learning was imported)
+    code = (
+        "import sys, gymnasium, puzzlebox\n"
+        "names = ('puzzlebox/Puzzle-v0', 'puzzlebox/TwinPuzzle-v0', 'puzzlebox/BoxManipulation-v0')\n"
+        "assert all(n in gymnasium.registry for n in names), names\n"
+        "assert not any(m.startswith(('puzzlebox.learning', 'puzzlebox.lab', 'puzzlebox.twin')) for m in sys.modules)\n"
+        "from puzzlebox.models.generator import paper_family\n"
+        "env = gymnasium.make('puzzlebox/Puzzle-v0', spec=paper_family('test')[0])\n"
+        "print(sorted(env.reset(seed=0)[0]))\n"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "['goal', 'kinds', 'poses', 'states']"
