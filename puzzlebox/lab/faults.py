@@ -17,7 +17,10 @@ Classes so far:
 - the twin's faults (:data:`TWIN_FAULTS`): frames dropped, occluded, noised; F/T noise; parts that jam;
   handles that slip — one oracle trial each, which must end with its reason named (or solve anyway).
 - the second round (:func:`second_round`, :mod:`puzzlebox.lab.input_faults`): two writers into one ``--out``,
-  names of every kind, malformed inputs, crafted memories, ``experiment.py`` stopped by a signal.
+  names of every kind, malformed inputs, crafted memories, ``experiment.py`` stopped by a signal;
+- the third round (:func:`third_round_rows`, :mod:`puzzlebox.lab.third_round_faults`): agents that misbehave,
+  inputs that are not regular files, a closed stdout, the environment and odd paths, bad memory contents, boxes
+  given twice, absurd profile values.
 
 Writes ``DIR/faults.json`` and ``DIR/faults.md`` (one table; the measured one is in docs/faults.md).
 """
@@ -410,6 +413,24 @@ def second_round(out: Path, config: FaultsConfig) -> list[FaultRow]:
     return rows
 
 
+def third_round_rows(out: Path) -> list[FaultRow]:
+    """The classes of issue 56 (:mod:`puzzlebox.lab.third_round_faults`), one row each."""
+    from puzzlebox.lab.third_round_faults import third_round
+
+    classes = third_round(out / "third", _specs(out) / "paper-test-0.json")
+    return [
+        FaultRow(
+            fault,
+            c["cases"],
+            f"{c['detected']}/{c['cases']} said so (exit code and line)",
+            f"{c['survived']}/{c['cases']} without a traceback or a hang",
+            "nothing run or written",
+            "; NOT: " + "; ".join(c["missed"]) if c["missed"] else "",
+        )  # fmt: skip
+        for fault, c in classes.items()
+    ]
+
+
 TWIN_FAULTS: dict[str, dict[str, dict[str, Any]]] = {
     "camera: every frame dropped": {"camera": {"dropped_frame_probability": 1.0}},
     "every free part jams on every try": {"physics": {"jam_probability": 1.0}},
@@ -473,6 +494,7 @@ def run_faults(out: Path, config: FaultsConfig) -> dict[str, Any]:
         lambda: killed_worker(out, config),
         lambda: physics_divergence(out),
         lambda: second_round(out, config),
+        lambda: third_round_rows(out),
     ]
     steps.append(lambda: twin_faults(out, config))
     summary: dict[str, Any] = {}

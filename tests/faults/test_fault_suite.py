@@ -9,6 +9,9 @@ Where each fault class of issue 11 is tested:
 - physics that diverges, a video killed in mid-write: here;
 - the twin's faults (frames dropped, F/T noise, jams, slips): ``tests/skills/test_robustness.py`` and the suite.
 
+And those of issue 56 (`puzzlebox/lab/third_round_faults.py`, in the suite): each also has its own test in
+`tests/scripts/test_input_checks.py`, `tests/learning/test_try_outcomes.py`, `tests/learning/test_memory.py`.
+
 And those of issue 37: two writers into one ``--out``: ``tests/lab/test_out_lock.py`` and the suite; names of every
 kind: ``tests/scripts/test_spec_names.py``; malformed inputs and a full disk: ``tests/scripts/test_input_checks.py``;
 crafted memories: ``tests/learning/test_memory_schema.py``; ``experiment.py`` stopped by a signal:
@@ -49,19 +52,30 @@ def test_the_quick_fault_suite_detects_survives_and_keeps_every_case(tmp_path):
     result = python(ROOT / "scripts/experiment.py", "faults", "--out", out, "--quick")
     assert result.returncode == 0, result.stderr
     rows = {r["fault"]: r for r in json.loads((out / "faults.json").read_text())["rows"]}
-    assert len(rows) == 14  # 7 classes of the tools + the quick suite's 2 twin faults + issue 37's 5 (quick)
+    # 7 classes of the tools + the quick suite's 2 twin faults + issue 37's 5 (quick) + issue 56's 7
+    assert len(rows) == 21
     for row in rows.values():
         for figure in (row["detected"], row["survived"], row["data_kept"]):
             for done, of in re.findall(r"(\d+)/(\d+)", figure):
                 assert done == of, row
     assert "0 runs lost, 0 duplicated" in rows["trial.py killed (SIGKILL) and resumed"]["data_kept"]
     assert "0 runs lost, 0 duplicated" in rows["a trial.py pool worker killed (SIGKILL)"]["data_kept"]
-    assert (out / "faults.md").read_text().count("\n| ") == 15  # header + 14 rows
+    assert (out / "faults.md").read_text().count("\n| ") == 22  # header + 21 rows
     for kind in ("trial", "sweep"):
         race = rows[f"two {kind}.py into one --out, started together"]
         assert race["data_kept"] == "0 summaries lost" and race["detected"].startswith("2/2 second writers refused")
     assert rows["memory with a trigger, a view, an extra table"]["detected"] == "3/3 refused in one line (exit 2)"
     assert rows["malformed inputs"]["detected"] == "10/10 one line, exit 2"  # one of each command and loader
+    third = (
+        "an agent that misbehaves",
+        "inputs that are not regular files",
+        "a reader that closes stdout early",
+        "the environment and odd paths",
+        "a memory whose contents are bad",
+        "boxes given twice",
+        "absurd values",
+    )
+    assert all(rows[f]["detected"].split(" ")[0] in ("1/1", "2/2", "3/3") for f in third)  # each case said so
     blank = rows["twin: camera: every frame dropped"]
     assert blank["detected"].startswith("ended: MarkersNotFound") and blank["data_kept"] == "1/1 run recorded"
     bad = python(ROOT / "scripts/experiment.py", "faults", "--out", out, "--runs", "1")
