@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sqlite3
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -10,8 +11,9 @@ from typing import Any
 import numpy as np
 
 from puzzlebox.learning.agents.base import Agent
-from puzzlebox.learning.errors import AgentError
+from puzzlebox.learning.errors import AgentError, LearningError
 from puzzlebox.models import World
+from puzzlebox.models.errors import ModelsError
 from puzzlebox.models.try_outcome import Cause, ReadsItsResult, TryResult
 
 MAX_FAILURES_IN_A_ROW = 3
@@ -127,11 +129,13 @@ def _agent_name(agent: Agent) -> str:
 
 
 def _from(agent: Agent, method: str, call: Callable[..., Any], *args: Any) -> Any:
-    """``call(*args)``, one of ``agent``'s methods: anything it raises but a Ctrl-C (``SystemExit`` too: a user's
-    agent must not end the command silently) is the agent's :class:`AgentError`, naming it."""
+    """``call(*args)``, one of ``agent``'s methods: what it raises (``SystemExit`` too: a user's agent must not end the
+    command silently) is the agent's :class:`AgentError`, naming it — but a Ctrl-C, and the conditions the library's
+    callers handle themselves (a full disk, a memory file, a kind: ``OSError``, ``sqlite3.Error``, ``LearningError``,
+    ``ModelsError``), pass as they were raised."""
     try:
         return call(*args)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, OSError, sqlite3.Error, LearningError, ModelsError):
         raise
     except BaseException as err:  # noqa: BLE001 - the seam: whatever an agent raises is reported as the agent's
         raise AgentError(f"agent {_agent_name(agent)!r} raised {type(err).__name__} in {method}(): {err}") from err
