@@ -135,9 +135,9 @@ def _from(agent: Agent, method: str, call: Callable[..., Any], *args: Any) -> An
     ``ModelsError``), pass as they were raised."""
     try:
         return call(*args)
-    except (KeyboardInterrupt, OSError, sqlite3.Error, LearningError, ModelsError):
+    except (OSError, sqlite3.Error, LearningError, ModelsError):
         raise
-    except BaseException as err:  # noqa: BLE001 - the seam: whatever an agent raises is reported as the agent's
+    except (Exception, SystemExit) as err:  # (a Ctrl-C or a stop request, BaseExceptions, pass as they are)  # noqa: BLE001 - the seam: whatever an agent raises is reported as the agent's
         raise AgentError(f"agent {_agent_name(agent)!r} raised {type(err).__name__} in {method}(): {err}") from err
 
 
