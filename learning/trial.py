@@ -46,7 +46,7 @@ class ActionRecord(ReadsItsResult):
             cause = None if entry["cause"] is None else Cause(entry["cause"])
         else:
             cause = Cause.from_legacy(reason)
-            if cause is not None and (outcome == "moved" or (outcome == "blocked") != (cause.family == "locked")):
+            if cause is not None and not cause.fits(outcome):
                 cause = None
         return cls(entry["component"], TryResult(outcome, reason, cause=cause))
 

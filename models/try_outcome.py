@@ -76,6 +76,11 @@ class Cause(StrEnum):
         """The head of the reason text (what reports group failures by): an error's class name or ``latched``."""
         return _PREFIXES.get(self, "latched")
 
+    def fits(self, outcome: str) -> bool:
+        """Whether a try of ``outcome`` can have this cause: a lock's causes a ``blocked`` try, the others a
+        ``failed`` one; a ``moved`` try has none."""
+        return outcome != "moved" and (outcome == "blocked") == (self.family == "locked")
+
     @property
     def family(self) -> str:
         """The coarse class: ``locked``, ``grasp empty``, ``slipped``, ``unreachable``, ``force limit``,
@@ -154,8 +159,7 @@ class TryResult:
     def __post_init__(self) -> None:
         if self.outcome not in OUTCOMES:
             raise ValueError(f"outcome must be one of {list(OUTCOMES)}, got {self.outcome!r}")
-        locked = self.cause is not None and self.cause.family == "locked"
-        if self.cause is not None and (self.outcome == "moved" or (self.outcome == "blocked") != locked):
+        if self.cause is not None and not self.cause.fits(self.outcome):
             raise ValueError(f"a {self.outcome!r} try cannot be caused by {self.cause.value!r}")
 
     @property
