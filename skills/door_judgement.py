@@ -90,7 +90,10 @@ class SwingJudge:
             self.track.clear()  # (the turn over which the pad slid is measured pressed all the while)
         pressed_at, peak = self.pressed_at, self.peak
         if self.track and pressed_at is not None and self.held_part_way(pressed_at[1], r.normal):
-            return Judgement("blocked", Cause.HELD_PART_WAY, r.progress, peak, held_at=r.face)
+            # where it stands: the face's turn since the pad first pressed on it, from where the door stood then
+            # (the face's own reading carries the perception's offset: 1 mm of it is ~3 deg)
+            held_at = lim.start + r.face - pressed_at[1]
+            return Judgement("blocked", Cause.HELD_PART_WAY, r.progress, peak, held_at=held_at)
         slid = pressed_at is not None and r.progress - pressed_at[0] >= lim.slide_turn
         if slid and pressed_at is not None and r.face - pressed_at[1] < 0.5 * (r.progress - pressed_at[0]):
             if lim.start >= c.blocked_progress:  # a door held part-way open is stuck, not latched: no evidence

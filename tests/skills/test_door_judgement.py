@@ -58,6 +58,10 @@ def test_a_face_that_stops_part_way_while_the_pad_goes_on_is_held_part_way_where
     on = [0.30 + k / 200 for k in range(1, 12)]  # the pad slides on 5.5 % (4.7 deg), the face stays
     judgement = swing(pressed(steps + on, steps + [0.30] * 11))
     assert (judgement.outcome, judgement.cause, judgement.held_at) == ("blocked", Cause.HELD_PART_WAY, 0.30)
+    # the face read with the perception's offset (3 % of the travel, ~1 mm): where it stands is its turn since the
+    # pad first pressed on it, not the offset reading
+    offset = swing(pressed(steps + on, [f - 0.03 for f in steps + [0.30] * 11]))
+    assert offset.cause is Cause.HELD_PART_WAY and offset.held_at == pytest.approx(0.30)
 
 
 def test_a_pad_that_lost_the_face_early_is_judged_by_how_far_the_face_turned_while_pressed():

@@ -454,22 +454,21 @@ def test_a_door_arc_planned_from_a_wrong_hinge_yields_to_the_load_across_it():
 
 
 LATCHED_OPEN = TwinConfig(scene=SceneConfig(locks="latch"))
-"""The two tests below measure what an open door's post does to a gripper that meets it: a latch holds the door
-rigidly where it stands (the worst case, as a door jammed open); with the contact mechanisms the door swings back
-to its locker's pin under the pad, which then strikes nothing hard (9 N at full pace)."""
+"""A latch holds a door rigidly where it stands (the worst case, as a door jammed open)."""
 
 
 def test_the_lift_off_a_handle_steps_around_an_open_door_standing_over_it():
     """paper-train-0 at one reachable placement: opening slide-3 brings the open gripper under the post of door-0,
-    which stands open past vertical over it. Lifted at full pace the pad met the post with ~100 N true before the
-    filtered reading stopped it; lifted slowly at first, stopped at a light touch and stepped sideways along the
-    pads, the toggle ends well under the force limit."""
+    which stands open past vertical over it (balanced on its hinge, it stays at its stop under the pad). Lifted at
+    full pace the pad met the post with ~80 N true before the filtered reading stopped it; lifted slowly at first,
+    stopped at a light touch and stepped sideways along the pads, the toggle ends well under the force limit. (The
+    gripper upright, as the toggle is called here: the world leans it away from the door and meets no post.)"""
     spec = placed(paper_family("train")[0], (0.432, 0.2434, 2.0084))
     limit = PrimitiveConfig().sensing.force_limit
     peaks = {}
     full_pace = PrimitiveConfig.of(lift_slow_height=0.0, lift_contact_force=59.0)
     for name, config in (("guarded", PrimitiveConfig()), ("full pace", full_pace)):
-        with TwinSession(spec, seed=0, config=LATCHED_OPEN) as session:
+        with TwinSession(spec, seed=0) as session:
             world = twin_world(session)
             watch = TrueForceWatch(session.robot, session)
             world.toggler.robot, world.toggler.config = watch, config
@@ -484,9 +483,11 @@ def test_the_lift_off_a_handle_steps_around_an_open_door_standing_over_it():
 
 def test_a_slide_opening_under_an_open_doors_post_is_grasped_leaning_away_from_it():
     """paper-train-0 at another reachable placement: door-0, open at its stop, reaches its post out over slide-3,
-    which opens along door-0's hinge line. Upright, the gripper's knuckles ran into the post as the slide moved
-    (51 N here; under the realistic profile 61 N and the force stop, every try); leaning away from the door about
-    its closing axis, the gripper passes it and the slide opens with the pads' own load alone."""
+    which opens along door-0's hinge line, held rigidly at its stop by a latch. Upright, the gripper's knuckles run
+    into the post as the slide moves: the post stops the slide at 14 % of its travel and the try reads it held
+    part-way, a false blocked (before doors were balanced, 51 N and moved; under the realistic profile 61 N and the
+    force stop, every try); leaning away from the door about its closing axis, the gripper passes it and the slide
+    opens with the pads' own load alone."""
     spec = placed(paper_family("train")[0], (0.3785, -0.0679, 1.7884))
     peaks = {}
     for name, config in (("leaning", PrimitiveConfig()), ("upright", PrimitiveConfig.of(lean_angle=0.0))):
@@ -498,6 +499,7 @@ def test_a_slide_opening_under_an_open_doors_post_is_grasped_leaning_away_from_i
             for component in ("door-0", "slide-1", "door-2", "slide-3"):
                 watch.peak = 0.0
                 result = world.try_toggle(names.index(component))
-                assert result.moved, (name, component, result)
-            peaks[name] = watch.peak  # slide-3's try
-    assert peaks["leaning"] < 20.0 < 40.0 < peaks["upright"], peaks
+                assert result.moved or (name, component) == ("upright", "slide-3"), (name, component, result)
+            peaks[name] = (result.moved, watch.peak)  # slide-3's try
+    assert peaks["leaning"][0] and peaks["leaning"][1] < 20.0, peaks
+    assert not peaks["upright"][0] or peaks["upright"][1] > 40.0, peaks  # upright, the post holds it or is struck
