@@ -122,6 +122,12 @@ class WorldConfig:
     """A grasp point this close to where an open door may overhang (:mod:`skills.door_clearance`) is descended
     onto cautiously [m]: the fingers, 42 mm apart and 30 mm wide, reach ~30 mm from it, and the door's pose
     is known to ~5 mm."""
+    shut_blocked_doors: bool = True
+    """After a door's opening try ends ``blocked``, look where it stands (:meth:`RobotWorld._fraction_open`) and push
+    it shut from there if it stands past ``blocked_progress``: balanced on its hinge, a locked door carried to its
+    lock's wall (~20-30 % of its travel) by a push, or lifted by tries as other kinds, stays there; standing raised
+    it hid the slide beside it from the next grasp (closed on nothing five times), and the next push from where it
+    stood met the post at 47 N."""
     other_kinds: int = 2
     """Most other kinds a part that will not move as its kind says is tried as, in one try (module docstring);
     0: never."""
@@ -273,6 +279,8 @@ class RobotWorld:
             if other is not None:
                 result = other
                 effort.add(other)
+        if opening and outcome.outcome == "blocked" and self._swings_up(marker) and self.config.shut_blocked_doors:
+            self._shut_if_raised(marker, effort)
         if outcome.moved:
             self.states[index] ^= 1
             self.moved_as.add(marker)
@@ -358,6 +366,16 @@ class RobotWorld:
         if is_door and opening and result.outcome == "failed" and result.progress >= judgement.blocked_progress:
             self.unsettled.add(marker)  # the next try of it looks first
         return result, failures, empty
+
+    def _shut_if_raised(self, marker: int, effort: _Effort) -> None:
+        """Push ``marker``'s door (its opening try just ended ``blocked``) shut from where a look sees it stand, if
+        past ``blocked_progress`` of its travel (:attr:`WorldConfig.shut_blocked_doors`); its cost goes to
+        ``effort``. A door the look does not see is left as it is (a blocked door stands low, where it is seen)."""
+        at = self._fraction_open(marker)
+        if at is None or at < self.toggler.config.judgement.blocked_progress:
+            return
+        effort.add(self.toggler.toggle(self.joint_models[marker], False, door_at=at))
+        self.unsettled.discard(marker)
 
     def _doors_overhanging(self, marker: int, opening: bool) -> list[int]:
         """The other doors that may stand open (believed open, or left part-way by a failed try) over where

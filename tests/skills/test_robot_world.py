@@ -1,16 +1,19 @@
 """End to end in the twin: perception -> agent -> primitives -> physics, outcomes sensed by the robot."""
 
+import dataclasses
 import json
 import subprocess
 import sys
 from pathlib import Path
 
+import mujoco
 import numpy as np
 from world_fixtures import twin_world
 
 from puzzlebox.learning import DualAgent, OracleAgent, run_episode
 from puzzlebox.models import TryResult, World
 from puzzlebox.models.generator import generate_chain
+from puzzlebox.models.kinds import get_kind
 from puzzlebox.models.try_outcome import Cause
 from puzzlebox.skills.primitives import ToggleResult
 from puzzlebox.skills.robot_world import DOOR_STAYED, HELD_UNDER_PINCH_AND_PUSH, RobotWorld
@@ -157,3 +160,41 @@ def test_an_eight_part_box_past_the_overviews_view_is_found_by_searching_again_a
                     RobotWorld(*arguments)
             else:
                 assert sorted(RobotWorld(*arguments).markers) == sorted(markers)
+
+
+def _door_after_a_blocked_try_leaving_it_at_a_quarter(shut: bool) -> tuple[float, list[bool], float]:
+    """chain(slide, door, slide, wheel) seed 1: door-1's opening try stood in for by placing the door at 25 % of its
+    travel and reading it blocked; the world's own look and closing push follow. Gives where the door then stands
+    (fraction of its travel), the toggles' directions (True: opening) and the action's peak filtered force [N]."""
+    spec = generate_chain(["slide", "door", "slide", "wheel"], seed=1)
+    travel = get_kind("door").travel
+    with TwinSession(spec, seed=0) as session:
+        world = twin_world(session)
+        world.config = dataclasses.replace(world.config, shut_blocked_doors=shut)
+        j = spec.index_of("door-1")
+        door = [world.ground_truth_name(k) for k in range(len(world.markers))].index("door-1")
+        real_toggle, calls = world.toggler.toggle, []
+
+        def held_at_its_wall(jm, opening=True, **options):
+            calls.append(opening)
+            if len(calls) > 1:
+                return real_toggle(jm, opening, **options)
+            session.data.qpos[session.component_qpos[j]] = 0.25 * travel
+            mujoco.mj_forward(session.model, session.data)
+            return ToggleResult("blocked", "latched: held part-way (25% of the travel)", 0.25, 20.0,
+                                cause=Cause.HELD_PART_WAY)  # fmt: skip
+
+        world.toggler.toggle = held_at_its_wall
+        outcome = world.try_toggle(door)
+        assert outcome.outcome == "blocked" and world.states[door] == 0
+        return session.component_positions()[j] / travel, calls, world.log[-1].peak_force
+
+
+def test_a_door_left_raised_by_a_blocked_try_is_pushed_shut_from_where_it_is_seen():
+    """Balanced on its hinge, a locked door carried to its lock's wall by a push stays there (~27 % of its travel):
+    after an opening try that ends ``blocked`` the world looks where the door stands and pushes it shut from there
+    (``WorldConfig.shut_blocked_doors``); without, it stays raised."""
+    at, calls, peak = _door_after_a_blocked_try_leaving_it_at_a_quarter(shut=True)
+    assert calls == [True, False] and at < 0.05 and peak < 45.0, (at, calls, peak)  # seen raised, pushed shut
+    at, calls, _ = _door_after_a_blocked_try_leaving_it_at_a_quarter(shut=False)
+    assert calls == [True] and at > 0.2, (at, calls)  # left raised
