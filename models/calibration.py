@@ -44,6 +44,45 @@ MAX_REPROJECTION_PX = 2.0
 """Largest RMS reprojection error of a usable intrinsic calibration [px] (the twin's: 0.06-0.08 px)."""
 MAX_IMAGE_SIDE = 16384
 """Largest image side [px]."""
+MAX_ASPECT = 1.5
+"""Largest ratio of the two focal lengths (``fx / fy`` or ``fy / fx``): pixels are square to ~1 % on cameras of
+this kind; a ratio past this is a mistyped matrix."""
+RADIAL_SCALE = (0.5, 2.0)
+"""Bounds of the radial distortion's factor ``1 + k1 r^2 + k2 r^4 + k3 r^6`` anywhere inside the image: wide lenses
+shrink the corners by ~20-30 %; a factor of 1000 (``k1 = 1000``) would move every corner off the sensor."""
+MAX_TANGENTIAL = 0.05
+"""Largest tangential (decentring) coefficient ``|p1|``, ``|p2|`` (lenses: ~1e-3)."""
+LENS_SAMPLES = 64
+"""Radii sampled from the centre to the image's farthest corner for the distortion check."""
+
+
+def _check_lens(K: np.ndarray, dist: np.ndarray, size: tuple[int, int]) -> None:
+    """``K`` and ``dist`` describe a lens that maps the image (``size``, ``(width, height)`` [px]) onto itself: the
+    principal point inside the image, square-ish pixels (:data:`MAX_ASPECT`), and a distortion that neither folds
+    the image over (the distorted radius grows with the radius) nor scales any point of it past
+    :data:`RADIAL_SCALE`, with small tangential terms. Only the reprojection error a procedure reports about itself
+    was checked before: a distortion of 1000 passed and put every marker off where it stands."""
+    fx, fy, cx, cy = K[0, 0], K[1, 1], K[0, 2], K[1, 2]
+    width, height = size
+    if not (0.0 <= cx <= width and 0.0 <= cy <= height):
+        raise CalibrationError(f"K's principal point ({cx:g}, {cy:g}) px lies outside the {width}x{height} image")
+    if max(fx / fy, fy / fx) > MAX_ASPECT:
+        raise CalibrationError(f"K's focal lengths fx = {fx:g} px and fy = {fy:g} px differ by more than "
+                               f"{MAX_ASPECT:g}x (pixels are square)")  # fmt: skip
+    k1, k2, p1, p2, k3 = (float(v) for v in dist)
+    if max(abs(p1), abs(p2)) > MAX_TANGENTIAL:
+        raise CalibrationError(f"dist's tangential terms p1 = {p1:g}, p2 = {p2:g} exceed {MAX_TANGENTIAL:g}")
+    corner = math.hypot(max(cx, width - cx) / fx, max(cy, height - cy) / fy)  # normalised radius [-]
+    r = np.linspace(0.0, corner, LENS_SAMPLES)
+    factor = 1.0 + k1 * r**2 + k2 * r**4 + k3 * r**6
+    low, high = RADIAL_SCALE
+    folds = np.diff(r * factor) <= 0.0
+    if factor.min() < low or factor.max() > high or folds.any():
+        raise CalibrationError(
+            f"dist's radial terms k1 = {k1:g}, k2 = {k2:g}, k3 = {k3:g} scale the image by {factor.min():.3g}-"
+            f"{factor.max():.3g} out to its corners{' and fold it over' if folds.any() else ''} (a lens: "
+            f"{low:g}-{high:g}, growing outwards)"
+        )
 
 
 def _check_rigid(T: np.ndarray, name: str) -> None:
@@ -108,6 +147,7 @@ class CameraCalibration:
                 or not all(isinstance(v, int | np.integer) and not isinstance(v, bool) for v in size)
                 or not all(0 < v <= MAX_IMAGE_SIDE for v in size)):  # fmt: skip
             raise CalibrationError(f"image_size must be two integers in [1, {MAX_IMAGE_SIDE}] px, got {size!r}")
+        _check_lens(K, dist, (int(size[0]), int(size[1])))
         error = self.reprojection_error_px
         if not (math.isnan(error) or (math.isfinite(error) and 0 <= error <= MAX_REPROJECTION_PX)):
             raise CalibrationError(

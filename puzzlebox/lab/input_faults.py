@@ -137,7 +137,9 @@ def names_run(out: Path, spec: Path) -> tuple[int, int, bool]:
     return 2 * len(NAMES), done, result.returncode == 0 and "Traceback" not in result.stderr
 
 
-def _calibration(spec: Path) -> dict[str, Any]:
+def ideal_cell_calibration(spec: Path) -> dict[str, Any]:
+    """A calibration file's contents for ``spec``'s box in the ideal twin cell: the nominal pinhole on every camera,
+    the poses the identity (only its form matters: the fault cases edit it and it is refused before use)."""
     from puzzlebox.lab.cells import TWIN_CAMERAS
     from puzzlebox.models.calibration import CameraCalibration, CellCalibration
 
@@ -195,7 +197,7 @@ def malformed_inputs(out: Path, spec: Path, only: tuple[str, ...] | None = None)
         path.write_text(json.dumps(content))
         cases[name] = [SCRIPTS / "sweep.py", path, "--out", where / "o-sweep"]
     for name, edit in calibrations.items():
-        data = _calibration(spec)
+        data = ideal_cell_calibration(spec)
         edit(data)
         path = where / f"calibration-{len(cases)}.json"
         path.write_text(json.dumps(data))

@@ -77,11 +77,15 @@ def _cases(out: Path, spec: Path) -> list[Case]:
     renamed.write_text(paper_family("test")[1].to_json().replace('"paper-test-1"', '"paper-test-0"'))
     profile = out / "absurd-profile.json"
     profile.write_text(json.dumps({"camera": {"occluder_count": 1_000_000}}))
+    lens = out / "absurd-lens.json"
+    lens.write_text(json.dumps(_calibration_with_distortion(spec, 1000.0)))
     loop = out / "loop-a"
     if not loop.is_symlink():
         loop.symlink_to(out / "loop-b")
         (out / "loop-b").symlink_to(loop)
     trial = [SCRIPTS / "trial.py", "--sim", "symbolic", "--runs", 1, "--seed", 0, "--max-actions", 5]
+    twin = (SCRIPTS / "trial.py", "--specs", spec, "--sim", "twin", "--runs", 1, "--seed", 0, "--max-actions", 2,
+            "--agent", "oracle")  # fmt: skip
     twelve = out / "closed-pipe"
     return [
         Case(
@@ -166,31 +170,19 @@ def _cases(out: Path, spec: Path) -> list[Case]:
             2,
             "two different boxes of one name",
         ),
-        Case(
-            "absurd values",
-            (
-                SCRIPTS / "trial.py",
-                "--specs",
-                spec,
-                "--sim",
-                "twin",
-                "--runs",
-                1,
-                "--seed",
-                0,
-                "--max-actions",
-                2,
-                "--agent",
-                "oracle",
-                "--reality",
-                profile,
-                "--out",
-                out / "o-prof",
-            ),
-            2,
-            "occluder_count",
-        ),  # fmt: skip
+        Case("absurd values", (*twin, "--reality", profile, "--out", out / "o-prof"), 2, "occluder_count"),
+        Case("absurd values", (*twin, "--calibration", lens, "--out", out / "o-lens"), 2, "radial terms k1 = 1000"),
     ]
+
+
+def _calibration_with_distortion(spec: Path, k1: float) -> dict[str, Any]:
+    """A calibration of ``spec``'s ideal cell whose overview lens has radial distortion ``k1`` (only its form
+    matters: it is refused before use)."""
+    from puzzlebox.lab.input_faults import ideal_cell_calibration
+
+    data = ideal_cell_calibration(spec)
+    data["cameras"]["overview"]["dist"] = [k1, 0.0, 0.0, 0.0, 0.0]
+    return data
 
 
 def _memory_of_an_unknown_kind(out: Path, spec: Path, memory: Path) -> None:

@@ -254,6 +254,11 @@ CALIBRATION_CASES = {
         T_base_camera=np.eye(4).tolist(), T_tcp_camera=None), "calibrated as fixed"),
     "cell_seed -1": (lambda d: d["cell"].update(cell_seed=-1), "'cell_seed' must be"),
     "image size of text": (lambda d: d["cameras"]["overview"].update(image_size=["a", 480]), "image_size"),
+    "a distortion of 1000": (lambda d: d["cameras"]["overview"].update(dist=[1000.0, 0, 0, 0, 0]),
+                             "radial terms k1 = 1000"),
+    "fx three times fy": (lambda d: d["cameras"]["overview"]["K"][0].__setitem__(0, 1800.0), "differ by more"),
+    "the principal point off the image": (lambda d: d["cameras"]["overview"]["K"][0].__setitem__(2, 3195.0),
+                                          "principal point"),
 }  # fmt: skip
 
 

@@ -5,6 +5,8 @@ files and a calibration made for another cell are clear errors."""
 
 from __future__ import annotations
 
+import re
+
 import cv2
 import numpy as np
 import pytest
@@ -239,6 +241,29 @@ def test_a_calibration_file_round_trips(tmp_path):
     assert loaded_wrist.on_arm and loaded_wrist.to_dict() == wrist.to_dict()
     assert np.array_equal(loaded_wrist.T_tcp_camera, T_tcp_camera)
     assert loaded_cell.cell == CELL
+
+
+def test_a_lens_that_does_not_map_the_image_onto_itself_is_refused_and_real_lenses_pass():
+    """The distortion check samples the radial factor from the centre to the farthest corner: a wide lens (its
+    corners shrunk ~25 %), this module's camera and the twin's pinhole pass; k1 = 1000, a barrel strong enough to
+    fold the corners back in, large tangential terms, fx three times fy and a principal point off the image do
+    not."""
+    wide = np.array([-0.32, 0.11, 0.0005, -0.0008, -0.015])  # a typical 90 deg-class lens
+    for dist in (DIST_TRUE, wide, np.zeros(5)):
+        CameraCalibration(K_TRUE, dist, SIZE, T_base_camera=np.eye(4))
+    scaled = K_TRUE.copy()
+    scaled[0, 0] *= 3.0
+    off = K_TRUE.copy()
+    off[0, 2] = -40.0
+    for K, dist, message in (
+        (K_TRUE, [1000.0, 0, 0, 0, 0], "scale the image by 1-"),
+        (K_TRUE, [-3.0, 0, 0, 0, 0], "fold it over"),
+        (K_TRUE, [0.0, 0, 0.2, 0, 0], "tangential"),
+        (scaled, DIST_TRUE, "differ by more than 1.5x"),
+        (off, DIST_TRUE, "principal point (-40, 237.8) px lies outside"),
+    ):
+        with pytest.raises(CalibrationError, match=re.escape(message)):
+            CameraCalibration(K, np.asarray(dist), SIZE, T_base_camera=np.eye(4))
 
 
 def test_a_calibration_applies_only_to_the_cell_it_was_made_for(tmp_path):
