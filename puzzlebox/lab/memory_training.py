@@ -36,6 +36,23 @@ def training_command(flags: dict[str, Any]) -> dict[str, Any]:
     return command
 
 
+def nothing_to_resume(store: MemoryStore, command: dict) -> str:
+    """Why ``store`` holds no run of ``command`` to resume: no training run at all, or how the latest one's command
+    differs (the flags whose values differ, as ``--flag theirs (this: ours)``)."""
+    runs = store.training_log()
+    if not runs:
+        return "the memory holds no training run"
+    config = dict(cast("dict[str, Any]", runs[-1]["config"]))
+    ours = json.loads(json.dumps(command))
+    differ = [f"--{key.replace('_', '-')} {config.get(key)!r} (this: {ours.get(key)!r})"
+              for key in sorted(set(config) | set(ours) - {"versions", "command"})
+              if key not in ("versions", "command") and config.get(key) != ours.get(key)]  # fmt: skip
+    return (
+        f"none of the memory's {len(runs)} training run(s) was made by this command; the latest differs in "
+        f"{', '.join(differ[:4])}{' ...' if len(differ) > 4 else ''}"
+    )
+
+
 def resumed_run(store: MemoryStore, command: dict) -> tuple[int | None, set[int]]:
     """The latest training run in ``store`` made by the same ``command`` (versions aside) and the seeds of the
     episodes it stored; (None, empty) when there is none."""
@@ -53,9 +70,15 @@ class MemoryTraining:
 
     def __init__(self, memory: str, command: dict[str, Any], resume: bool) -> None:
         self.memory = memory
+        if resume and not Path(memory).exists():
+            raise TrainingError(f"--resume: {memory} does not exist, so holds no run to continue; leave out --resume "
+                                "to begin one")  # fmt: skip
         try:
             self.store = MemoryStore(memory)
             self.run_id, self.done_seeds = resumed_run(self.store, command) if resume else (None, set())
+            if resume and self.run_id is None:
+                raise TrainingError(f"--resume: {nothing_to_resume(self.store, command)}; leave out --resume to begin "
+                                    "a new run")  # fmt: skip
             if self.run_id is None:
                 self.run_id = self.store.begin_training_run({"command": "train", **command, "versions": versions()})
         except LearningError as err:

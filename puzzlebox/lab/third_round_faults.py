@@ -172,6 +172,21 @@ def _cases(out: Path, spec: Path) -> list[Case]:
         ),
         Case("absurd values", (*twin, "--reality", profile, "--out", out / "o-prof"), 2, "occluder_count"),
         Case("absurd values", (*twin, "--calibration", lens, "--out", out / "o-lens"), 2, "radial terms k1 = 1000"),
+        Case(
+            "absurd values",
+            (
+                SCRIPTS / "train.py",
+                "--specs",
+                spec,
+                "--episodes",
+                2,
+                "--memory",
+                out / "no-such-memory.sqlite",
+                "--resume",
+            ),
+            2,
+            "holds no run to continue",
+        ),  # fmt: skip
     ]
 
 

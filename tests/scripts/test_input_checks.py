@@ -472,3 +472,25 @@ def test_a_recording_that_cannot_be_written_is_refused_before_any_run(capsys, tm
                            "--max-actions", "2", "--agent", "oracle", "--record", READ_ONLY.parent / "x.rrd",
                            "--out", tmp_path / "o")  # fmt: skip
     assert "cannot be written" in line and not (tmp_path / "o").exists()
+
+
+def test_train_resume_with_no_run_of_the_command_is_refused_naming_what_differs(capsys, tmp_path, spec):
+    """``--resume`` continues the latest run of the same command; with none, it began a new run in silence (a
+    changed ``--episodes`` trained the memory twice over). Now one line names the flags the latest run differs in,
+    and the memory is unchanged."""
+    from puzzlebox.learning.memory import MemoryStore
+    from puzzlebox.scripts import train
+
+    memory = tmp_path / "m.sqlite"
+    common = ["--specs", spec, "--memory", memory, "--seed", 0]
+    line = one_line_exit_2(capsys, "train", *common, "--episodes", 2, "--resume")
+    assert "does not exist, so holds no run to continue; leave out --resume" in line and not memory.exists()
+    MemoryStore(memory).close()
+    line = one_line_exit_2(capsys, "train", *common, "--episodes", 2, "--resume")
+    assert "--resume: the memory holds no training run; leave out --resume" in line
+    assert train.main(list(map(str, [*common, "--episodes", 2]))) == 0
+    before = memory.read_bytes()
+    line = one_line_exit_2(capsys, "train", *common, "--episodes", 3, "--resume")
+    assert "none of the memory's 1 training run(s) was made by this command" in line
+    assert "--episodes 2 (this: 3)" in line and memory.read_bytes() == before
+    assert train.main(list(map(str, [*common, "--episodes", 2, "--resume"]))) == 0  # the same command resumes
