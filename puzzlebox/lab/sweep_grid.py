@@ -53,6 +53,8 @@ KEYS = {"sim", "specs", "generate", "placements", "placement_seed", "seeds", "ag
 
 
 AGENT_KEYS = {"name", "memory", "checkpoint", "label", "max_lockers"}
+MAX_LABEL = 64
+"""Longest agent label of a sweep [characters]."""
 
 MAX_PLACEMENTS = 1000
 """Most placements per spec."""
@@ -172,6 +174,11 @@ def _check_types(sweep: dict[str, Any]) -> None:
         for key in ("name", "memory", "checkpoint", "label"):
             if key in entry and not (isinstance(entry[key], str) and (entry[key] or key != "name")):
                 raise SweepError(f"'agents': '{key}' must be a string, got {_shown(entry[key])}")
+        label = entry.get("label", "")
+        if not label.isprintable() or "|" in label or len(label) > MAX_LABEL:
+            # it heads a column of cells.md and names the cells' files: a newline or a '|' broke the table
+            raise SweepError(f"'agents': 'label' must be printable text of at most {MAX_LABEL} characters without "
+                             f"'|' (it heads a table column), got {_shown(label)}")  # fmt: skip
         if "max_lockers" in entry and not _integer(entry["max_lockers"]):
             raise SweepError(f"'agents': 'max_lockers' must be an integer, got {_shown(entry['max_lockers'])}")
     if "profiles" in sweep:

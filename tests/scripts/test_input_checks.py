@@ -75,6 +75,8 @@ SWEEP_CASES = {
     "a grid too large": (GOOD | {"seeds": {"start": 0, "count": 600_000}, "agents": ["oracle", "dual"]}, "the grid"),
     "placements of text": (GOOD | {"sim": "twin", "placements": ["x"]}, "'placements' must be"),
     "a calibration for no profile": (GOOD | {"sim": "twin", "calibrations": {"harsh": "c.json"}}, "does not run"),
+    "a label with a newline": (GOOD | {"agents": [{"name": "oracle", "label": "a\nb"}]}, "'label' must be printable"),
+    "a label with a bar": (GOOD | {"agents": [{"name": "oracle", "label": "a|b"}]}, "without '|'"),
 }
 
 
