@@ -74,6 +74,10 @@ class PuzzleEnv(gym.Env[dict[str, Any], np.int64]):
     metadata = {"render_modes": ["ansi"], "render_fps": 1}
 
     def __init__(self, spec: PuzzleSpec, config: PuzzleEnvConfig | None = None, render_mode: str | None = None) -> None:
+        if not isinstance(spec, PuzzleSpec):  # (a path: PuzzleSpec.from_json(Path(...).read_text()) reads one)
+            raise ConfigError(f"spec must be a PuzzleSpec, got {type(spec).__name__} {spec!r:.60}")
+        if config is not None and not isinstance(config, PuzzleEnvConfig):
+            raise ConfigError(f"config must be a PuzzleEnvConfig or None, got {type(config).__name__}")
         self.puzzle = spec
         self.config = config or PuzzleEnvConfig()
         n = len(spec.components)

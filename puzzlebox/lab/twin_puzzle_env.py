@@ -64,6 +64,12 @@ class TwinPuzzleEnv(gym.Env[dict[str, Any], np.int64]):
         ground_truth: bool = False,
         render_mode: str | None = None,
     ) -> None:
+        if not isinstance(spec, PuzzleSpec):
+            raise TrialConfigError(f"spec must be a PuzzleSpec, got {type(spec).__name__} {spec!r:.60}")
+        if config is not None and not isinstance(config, TrialConfig):
+            raise TrialConfigError(f"config must be a TrialConfig or None, got {type(config).__name__}")
+        if isinstance(max_actions, bool) or not isinstance(max_actions, int | np.integer):
+            raise TrialConfigError(f"max_actions must be an integer, got {type(max_actions).__name__}")
         config = config or TrialConfig()
         if spec.box is None:
             raise TrialConfigError(f"spec {spec.name!r} is a disassembly scene: the twin holds puzzle boxes only")

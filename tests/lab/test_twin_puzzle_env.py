@@ -65,6 +65,24 @@ def test_what_cannot_run_is_refused_clearly():
         env.step(0)
 
 
+def test_gymnasium_make_with_arguments_of_the_wrong_type_is_a_typed_error_naming_what_is_wanted():
+    """A spec given as a number or a path, a config of the wrong class: a library error saying what is wanted (a
+    raw ``AttributeError: 'int' object has no attribute 'components'`` before), before any physics is built."""
+    from puzzlebox.learning import ConfigError
+
+    for wrong in (5, "paper-test-0.json"):
+        with pytest.raises(ConfigError, match="spec must be a PuzzleSpec, got"):
+            gymnasium.make("puzzlebox/Puzzle-v0", spec=wrong)
+        with pytest.raises(TrialConfigError, match="spec must be a PuzzleSpec, got"):
+            gymnasium.make("puzzlebox/TwinPuzzle-v0", spec=wrong)
+    with pytest.raises(ConfigError, match="config must be a PuzzleEnvConfig"):
+        gymnasium.make("puzzlebox/Puzzle-v0", spec=SPEC, config=3)
+    with pytest.raises(TrialConfigError, match="config must be a TrialConfig"):
+        gymnasium.make("puzzlebox/TwinPuzzle-v0", spec=SPEC, config={"sim": "twin"})
+    with pytest.raises(TrialConfigError, match="max_actions must be an integer"):
+        gymnasium.make("puzzlebox/TwinPuzzle-v0", spec=SPEC, max_actions=2.5)
+
+
 def test_an_agent_acting_through_the_environment_makes_the_trials_tries():
     """The project's dual agent driven through the gymnasium API (observations rebuilt by the world, outcomes
     from ``info``) tries what ``run_trial`` tries for the same seed, with the same sensed outcomes."""
