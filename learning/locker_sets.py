@@ -78,14 +78,44 @@ def locker_set_count(num_components: int, max_lockers: int) -> int:
     return sum(math.comb(num_components, j) * 2**j for j in range(min(max_lockers, num_components) + 1))
 
 
+MAX_BELIEF_ENTRIES = 500_000
+"""Most probabilities a belief over locker sets may hold, ``N x 2 x H`` (every decision reads them all): at 20
+parts and k = 3 (397 000) a decision takes ~5 s on one core; 62 parts at k = 3 would hold 38 million (~8 min a
+decision, 300 MB) and ran on without a word."""
+
+
+def set_count(num_components: int, max_lockers: int) -> int:
+    """H, the number of sets of up to ``max_lockers`` lockers of N components: ``sum_(j <= k) C(N, j) 2^j``."""
+    n = num_components
+    return sum(math.comb(n, j) * 2**j for j in range(min(max_lockers, n) + 1))
+
+
+def check_belief_size(num_components: int, max_lockers: int) -> None:
+    """Refuse a belief over sets of up to ``max_lockers`` lockers of N components larger than
+    :data:`MAX_BELIEF_ENTRIES` (``ConfigError`` naming the largest k that fits), before anything is built."""
+    n, k = num_components, max_lockers
+    entries = n * 2 * set_count(n, k)
+    if entries <= MAX_BELIEF_ENTRIES:
+        return
+    fits = max((j for j in range(1, k) if n * 2 * set_count(n, j) <= MAX_BELIEF_ENTRIES), default=None)
+    advice = f"use max_lockers {fits} or fewer" if fits else "even one locker a part is too many hypotheses"
+    raise ConfigError(
+        f"a belief over sets of up to {k} lockers of {n} parts holds {entries:,} probabilities (at most "
+        f"{MAX_BELIEF_ENTRIES:,}: every decision reads them all; 397,000 take ~5 s): {advice}"
+    )
+
+
 @functools.lru_cache(maxsize=32)
 def locker_sets(num_components: int, max_lockers: int) -> LockerSets:
-    """The hypothesis table for N components and sets of up to ``max_lockers`` (cached per (N, k))."""
+    """The hypothesis table for N components and sets of up to ``max_lockers`` (cached per (N, k)); refused past
+    :data:`MAX_BELIEF_ENTRIES` (:func:`check_belief_size`)."""
     n, k = num_components, max_lockers
     if n < 1:
         raise ConfigError(f"a belief needs at least one component, got {n}")
     if k < 1:
         raise ConfigError(f"max_lockers must be >= 1, got {k}")
+    if k > 1:
+        check_belief_size(n, k)
     padding = 2 * n
     members = [[padding] * k]
     for size in range(1, min(k, n) + 1):

@@ -37,6 +37,7 @@ from puzzlebox.lab.trial_batch import (
     summary_lines,
 )
 from puzzlebox.learning import AGENT_NAMES, LearningError, make_agent
+from puzzlebox.learning.locker_sets import check_belief_size
 from puzzlebox.learning.memory import MemoryStore
 from puzzlebox.models import SpecError, load_spec
 
@@ -162,6 +163,12 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
     try:
         specs = [load_spec(path) for path in args.specs]
         check_distinct_specs(specs, args.specs)
+        if args.max_lockers is not None and args.max_lockers > 1:  # the belief's size: refused before any run
+            for spec, path in zip(specs, args.specs, strict=True):
+                try:
+                    check_belief_size(len(spec.components), args.max_lockers)
+                except LearningError as err:
+                    raise InputError(f"--max-lockers {args.max_lockers} on {path}: {err}") from None
     except (SpecError, InputError) as err:
         fail(str(err))
     reality = calibration = None

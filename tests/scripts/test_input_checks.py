@@ -496,3 +496,22 @@ def test_train_resume_with_no_run_of_the_command_is_refused_naming_what_differs(
     assert "none of the memory's 1 training run(s) was made by this command" in line
     assert "--episodes 2 (this: 3)" in line and memory.read_bytes() == before
     assert train.main(list(map(str, [*common, "--episodes", 2, "--resume"]))) == 0  # the same command resumes
+
+
+def test_a_belief_too_large_to_decide_in_is_refused_before_any_run(capsys, tmp_path):
+    """62 parts at --max-lockers 3 would hold 38 million probabilities (~8 min a decision) and ran 300 s without a
+    word; the belief's size is checked for every spec before anything runs, naming the largest k that fits. The
+    learning layer refuses it alike where the table would be built."""
+    from puzzlebox.learning import ConfigError
+    from puzzlebox.learning.locker_sets import MAX_BELIEF_ENTRIES, locker_sets, set_count
+    from puzzlebox.models.generator import generate_chain
+
+    path = tmp_path / "chain24.json"
+    path.write_text(generate_chain(["slide", "door"] * 12, seed=0).to_json())
+    line = one_line_exit_2(capsys, "trial", "--specs", path, "--sim", "symbolic", "--agent", "dual", "--max-lockers",
+                           3, "--runs", 1, "--seed", 0, "--max-actions", 5, "--out", tmp_path / "o")  # fmt: skip
+    assert "--max-lockers 3 on" in line and "832,560 probabilities" in line and "use max_lockers 2 or fewer" in line
+    assert not (tmp_path / "o").exists()
+    assert 24 * 2 * set_count(24, 2) <= MAX_BELIEF_ENTRIES < 24 * 2 * set_count(24, 3)
+    with pytest.raises(ConfigError, match="62 parts holds 38,470,876 probabilities"):
+        locker_sets(62, 3)
