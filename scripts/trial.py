@@ -28,11 +28,11 @@ from puzzlebox.lab.cli import OneLineParser, fail, one_line, run_script
 from puzzlebox.lab.errors import AgentClassError, ArmTrialFailed, ArmTrialRefused, RunStoreError, TrialConfigError
 from puzzlebox.lab.run_store import RunStore
 from puzzlebox.lab.runner import RunnerError, make_executor
+from puzzlebox.lab.spec_files import check_distinct_specs
 from puzzlebox.lab.trial_batch import (
     InputError,
     TrialBatch,
     check_batch_numbers,
-    check_distinct_specs,
     run_batch,
     summary_lines,
 )

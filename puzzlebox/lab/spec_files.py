@@ -1,13 +1,15 @@
 """Spec files as ``generate.py`` reads and writes them: a generated spec written (with its top view if asked),
 a file loaded as a puzzle box (not a disassembly scene), several loaded at once with every problem named, and
-a file's validation lines."""
+a file's validation lines; a set of boxes checked to hold each box once and each name for one box."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 from puzzlebox.lab.cli import one_line
 from puzzlebox.lab.errors import NotABoxSpec, SpecFileError, SpecFilesInvalid
+from puzzlebox.lab.inputs import InputError
 from puzzlebox.models import LockTable, PuzzleSpec, SpecError, load_spec, save_spec
 
 
@@ -58,3 +60,17 @@ def validation_lines(file: str) -> tuple[list[str], bool]:
         return [f"{file}: {problem}" for problem in err.problems], False
     plan = LockTable.from_spec(spec).shortest_solution()
     return [f"{file}: valid ({len(spec.components)} components, shortest solution {len(plan or [])} actions)"], True
+
+
+def check_distinct_specs(specs: Sequence[PuzzleSpec], paths: Sequence[str]) -> None:
+    """Each box once, each name one box (:class:`~puzzlebox.lab.inputs.InputError` naming both files): overlapping
+    globs ran the same spec and seed twice, and two boxes of one name were summed as one in every summary."""
+    seen: dict[str, tuple[str, str]] = {}  # name -> (its content, its file)
+    for spec, path in zip(specs, paths, strict=True):
+        content = spec.to_json()
+        if spec.name in seen:
+            other_content, other = seen[spec.name]
+            same = "the same box" if other_content == content else "two different boxes of one name"
+            raise InputError(f"--specs gives {same}, {spec.name!r} ({other} and {path}): give each box once, each "
+                             "name to one box")  # fmt: skip
+        seen[spec.name] = (content, path)

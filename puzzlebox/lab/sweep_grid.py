@@ -36,6 +36,7 @@ import numpy as np
 from puzzlebox.lab.cells import CellError, check_twin_cameras, profile_of_calibration
 from puzzlebox.lab.inputs import MAX_ACTIONS, MAX_COUNT, MAX_TASKS, InputError, check_seed
 from puzzlebox.lab.runner import Task
+from puzzlebox.lab.spec_files import check_distinct_specs
 from puzzlebox.lab.trial_task import trial_task
 from puzzlebox.learning import AGENT_NAMES
 from puzzlebox.learning.agents.factory import BELIEF_AGENT_NAMES
@@ -243,7 +244,12 @@ def _specs(sweep: dict[str, Any], base: Path) -> list[PuzzleSpec]:
         files = [f for pattern in sweep["specs"] for f in sorted(glob.glob(str(base / pattern)))]
         if not files:
             raise SweepError(f"'specs' {sweep['specs']} match no file under {base}")
-        return [load_spec(f) for f in files]
+        specs = [load_spec(f) for f in files]
+        try:  # cells are named by the box: two boxes of one name were reported as one cell of both
+            check_distinct_specs(specs, files)
+        except InputError as err:
+            raise SweepError(str(err).replace("--specs gives", "'specs' match", 1)) from None
+        return specs
     recipe = dict(sweep["generate"])
     kind, seed, count = recipe.pop("generator", None), recipe.pop("seed", 0), recipe.pop("count", 1)
     box = BoxConfig(fit_reach=not recipe.pop("anywhere", False))

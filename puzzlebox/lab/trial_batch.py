@@ -87,20 +87,6 @@ def check_batch_numbers(specs: int, runs: int, seed: int, max_actions: int, work
         check_count(workers, "--workers", MAX_WORKERS)
 
 
-def check_distinct_specs(specs: Sequence[PuzzleSpec], paths: Sequence[str]) -> None:
-    """Each box once, each name one box (:class:`~puzzlebox.lab.inputs.InputError` naming both files): overlapping
-    globs ran the same spec and seed twice, and two boxes of one name were summed as one in every summary."""
-    seen: dict[str, tuple[str, str]] = {}  # name -> (its content, its file)
-    for spec, path in zip(specs, paths, strict=True):
-        content = spec.to_json()
-        if spec.name in seen:
-            other_content, other = seen[spec.name]
-            same = "the same box" if other_content == content else "two different boxes of one name"
-            raise InputError(f"--specs gives {same}, {spec.name!r} ({other} and {path}): give each box once, each "
-                             "name to one box")  # fmt: skip
-        seen[spec.name] = (content, path)
-
-
 def batch_results(runs: Sequence[dict[str, Any]], batch: TrialBatch, planned: int) -> dict[str, Any]:
     """``results.json``: the contract's summary (:func:`puzzlebox.learning.summarise`), the twin's figures, and
     ``runs_done`` of ``runs_planned``."""

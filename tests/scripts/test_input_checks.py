@@ -515,3 +515,21 @@ def test_a_belief_too_large_to_decide_in_is_refused_before_any_run(capsys, tmp_p
     assert 24 * 2 * set_count(24, 2) <= MAX_BELIEF_ENTRIES < 24 * 2 * set_count(24, 3)
     with pytest.raises(ConfigError, match="62 parts holds 38,470,876 probabilities"):
         locker_sets(62, 3)
+
+
+def test_a_sweep_over_two_boxes_of_one_name_or_one_box_twice_is_refused(capsys, tmp_path):
+    """Cells are named by their box: two different boxes named ``random-n5-s0`` (generated with ``--kinds paper`` and
+    ``--kinds all``) were reported as one cell of both, and overlapping globs ran one box twice."""
+    from puzzlebox.models.generator import RandomGraphConfig, generate_random
+    from puzzlebox.models.kinds import family_named
+
+    for folder, family in (("paper", "paper"), ("all", "all")):
+        (tmp_path / folder).mkdir()
+        spec = generate_random(RandomGraphConfig(num_components=5, family=family_named(family)), seed=0)
+        (tmp_path / folder / "box.json").write_text(spec.to_json())
+    sweep = tmp_path / "grid.json"
+    for globs, message in ((["paper/*.json", "all/*.json"], "two different boxes of one name"),
+                           (["paper/*.json", "paper/box*.json"], "the same box")):  # fmt: skip
+        sweep.write_text(json.dumps({"sim": "symbolic", "specs": globs, "agents": ["oracle"], "max_actions": 5}))
+        line = one_line_exit_2(capsys, "sweep", sweep, "--out", tmp_path / "out")
+        assert f"'specs' match {message}" in line and not (tmp_path / "out").exists()
