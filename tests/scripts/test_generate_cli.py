@@ -174,6 +174,29 @@ def test_chain_datasets_and_dataset_mistakes(tmp_path):
         assert len(bad.stderr.strip().splitlines()) == 1
 
 
+def test_a_dataset_directory_holds_one_dataset(tmp_path):
+    """Generated into the folder of another dataset, the old specs stayed beside the new ones under a replaced
+    manifest; now anything but this dataset's own files is refused before a file is written. The same command again,
+    or after a stop, writes the same files."""
+    chain = ("chain", "--kinds", "door,slide,wheel", "--seed", 0, "--count", 3, "--out", tmp_path / "c")
+    assert generate(*chain).returncode == 0
+    before = _tree(tmp_path / "c")
+    other = generate("random", "--components", 5, "--seed", 0, "--count", 2, "--out", tmp_path / "c")
+    assert other.returncode == 2 and "holds another dataset (manifest.json:" in other.stderr, other.stderr
+    assert _tree(tmp_path / "c") == before
+    again = generate(*chain)
+    assert again.returncode == 0, again.stderr
+    assert _tree(tmp_path / "c") == before
+    (tmp_path / "c" / "manifest.json").unlink()  # as a stopped run leaves it: specs and the marker of its run
+    (tmp_path / "c" / ".dataset-started.json").write_text(json.dumps({"generator": json.loads(
+        before["manifest.json"])["generator"]}))  # fmt: skip
+    assert generate(*chain).returncode == 0 and _tree(tmp_path / "c") == before
+    (tmp_path / "notes").mkdir()
+    (tmp_path / "notes" / "todo.txt").write_text("x")
+    stray = generate("random", "--components", 5, "--seed", 0, "--count", 2, "--out", tmp_path / "notes")
+    assert stray.returncode == 2 and "holds 1 file(s) of no dataset (todo.txt)" in stray.stderr, stray.stderr
+
+
 # -- generate.py mesh SPEC --out DIR: the box as GLB, OBJ and STL files, and one-line failures ----------------
 
 
