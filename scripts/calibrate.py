@@ -26,6 +26,9 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import json
+import os
+import tempfile
 import time
 from pathlib import Path
 
@@ -79,6 +82,18 @@ def load_inputs(args: argparse.Namespace):
     return spec, profile
 
 
+def _kept_elsewhere(calibration) -> str:
+    """Where the calibration made is kept when ``--out`` cannot be written: a file in the temporary folder, or, if
+    that fails too, the calibration itself printed on stdout (JSON)."""
+    kept = Path(tempfile.gettempdir()) / f"puzzlebox-calibration-{os.getpid()}-{int(time.time())}.json"
+    try:
+        calibration.save(kept)
+    except OSError:
+        print(json.dumps(calibration.to_dict(), indent=1))
+        return "the calibration is printed on stdout (JSON): save it as the file"
+    return f"the calibration is kept in {kept}: move it where it belongs"
+
+
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     spec, profile = load_inputs(args)
@@ -95,14 +110,17 @@ def main(argv: list[str] | None = None) -> int:
     except CellCalibrationError as err:
         fail(str(err), code=err.exit_code)
     overview, figures = run.overview, run.figures
-    path = run.calibration.save(args.out)
     settings = {
         "command": "calibrate",
         **{k: str(v) if isinstance(v, Path) else v for k, v in vars(args).items()},
         **run.settings,
         "versions": versions(),
     }
-    write_json(path.with_name(path.name + ".config.json"), settings)
+    try:
+        path = run.calibration.save(args.out)
+        write_json(path.with_name(path.name + ".config.json"), settings)
+    except OSError as err:  # a full disk after the whole procedure: the calibration is not lost with it
+        fail(f"cannot write {args.out} ({err.strerror or err}); {_kept_elsewhere(run.calibration)}", code=1)
     wall = time.perf_counter() - start
     for name, f in figures.items():
         frame = "T_base_camera" if name == overview else "T_tcp_camera"

@@ -533,3 +533,34 @@ def test_a_sweep_over_two_boxes_of_one_name_or_one_box_twice_is_refused(capsys, 
         sweep.write_text(json.dumps({"sim": "symbolic", "specs": globs, "agents": ["oracle"], "max_actions": 5}))
         line = one_line_exit_2(capsys, "sweep", sweep, "--out", tmp_path / "out")
         assert f"'specs' match {message}" in line and not (tmp_path / "out").exists()
+
+
+def test_calibrate_on_a_full_disk_keeps_the_calibration_and_says_where(capsys, tmp_path, monkeypatch):
+    """The procedure ran to its end, then the write failed with a traceback and the calibration was lost; now one line
+    (exit 1) names where it is kept, a file in the temporary folder that loads as the calibration made."""
+    from puzzlebox.models.calibration import CellCalibration
+    from puzzlebox.scripts import calibrate
+
+    save, target = CellCalibration.save, tmp_path / "cal.json"
+
+    def full_at_the_target(self, path):
+        if Path(path) == target:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return save(self, path)
+
+    monkeypatch.setattr(CellCalibration, "save", full_at_the_target)
+    monkeypatch.setenv("TMPDIR", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    import tempfile
+
+    monkeypatch.setattr(tempfile, "tempdir", None)  # (re-read TMPDIR)
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as stopped:
+        calibrate.main(["--out", str(target), "--overview-views", "6", "--wrist-views", "6"])
+    err = capsys.readouterr().err.strip()
+    assert stopped.value.code == 1 and len(err.splitlines()) == 1 and "Traceback" not in err, err
+    assert "cannot write" in err and "No space left on device" in err and "the calibration is kept in" in err
+    kept = Path(err.split("kept in ")[1].split(":")[0])
+    assert kept.parent == tmp_path / "tmp" and set(CellCalibration.load(kept).cameras) == {
+        "overview", "xarm7/gripper/wrist_camera"}  # fmt: skip
+    assert not target.exists()
