@@ -11,6 +11,7 @@ types and sizes; its grid is built from a sweep that passed).
 from __future__ import annotations
 
 import copy
+import functools
 import json
 import uuid
 from collections.abc import Callable
@@ -129,3 +130,59 @@ def test_every_input_file_kind_fuzzed_is_read_or_refused_with_its_typed_error(ki
 
     read_or_refused()
     assert seen["read"] + seen["refused"] >= EXAMPLES and seen["refused"] > EXAMPLES // 4, seen
+
+
+class _Chooser:
+    """An agent that chooses ``choice`` (whatever it is), or raises it if it is an exception."""
+
+    name = "fuzzed"
+
+    def __init__(self, choice: Any) -> None:
+        self.choice = choice
+
+    def begin_episode(self, observation: Any, rng: Any) -> None:
+        pass
+
+    def choose(self, observation: Any) -> Any:
+        if isinstance(self.choice, BaseException):
+            raise self.choice
+        return self.choice
+
+    def record(self, index: int, result: Any, observation: Any) -> None:
+        pass
+
+    def end_episode(self, solved: bool) -> None:
+        pass
+
+
+CHOICES = (
+    st.integers(-10, 10) | st.integers() | st.floats() | st.booleans() | st.none() | st.text(max_size=3)
+    | st.builds(lambda v: __import__("numpy").int64(v), st.integers(-10, 10)) | JSON_VALUES
+    | st.sampled_from([ValueError("x"), KeyError("k"), SystemExit(0), RuntimeError("r"), IndexError(3)])
+)  # fmt: skip
+"""What an agent's ``choose`` may give: indices in and out of range, other types, or an exception."""
+
+
+@functools.cache
+def _paper_test_0() -> Any:
+    return paper_family("test")[0]
+
+
+@settings(max_examples=EXAMPLES // 4, deadline=None, suppress_health_check=list(HealthCheck))
+@given(CHOICES)
+def test_the_agent_seam_fuzzed_takes_a_part_or_refuses_with_an_agent_error(choice):
+    """Whatever an agent chooses, the episode takes one of the parts or ends with ``AgentError`` naming the agent,
+    before the world tries anything (a choice of -1 had the twin's arm try the last part)."""
+    from puzzlebox.learning import AgentError, SymbolicWorld, run_episode
+
+    spec = _paper_test_0()
+    world = SymbolicWorld(spec, 0)
+    parts = len(spec.components)
+    valid = isinstance(choice, int | __import__("numpy").integer) and not isinstance(choice, bool) and (
+        0 <= choice < parts)  # fmt: skip
+    try:
+        result = run_episode(_Chooser(choice), world, spec.name, 0, max_actions=2)
+    except AgentError as err:
+        assert not valid and "'fuzzed'" in str(err), (choice, err)
+    else:
+        assert valid and result.num_actions >= 1, (choice, result)
