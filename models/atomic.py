@@ -58,8 +58,11 @@ def write_atomically(path: str | Path, write: Callable[[Path], object]) -> Path:
 
 
 def write_text_atomically(path: str | Path, text: str) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` atomically."""
-    return write_atomically(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    """Write ``text`` (UTF-8) to ``path`` atomically. A lone surrogate (a byte of a non-UTF-8 path, as Python decodes
+    command-line arguments) is written as its escape ``\\udcff``: in JSON that escape reads back to the same string
+    (the path round-trips); in Markdown and HTML it is shown as is. Strict UTF-8 ended ``trial.py --out`` such a path
+    in a ``UnicodeEncodeError`` traceback."""
+    return write_atomically(path, lambda tmp: tmp.write_text(text, encoding="utf-8", errors="backslashreplace"))
 
 
 class PublishedOnExit:

@@ -564,3 +564,19 @@ def test_calibrate_on_a_full_disk_keeps_the_calibration_and_says_where(capsys, t
     assert kept.parent == tmp_path / "tmp" and set(CellCalibration.load(kept).cameras) == {
         "overview", "xarm7/gripper/wrist_camera"}  # fmt: skip
     assert not target.exists()
+
+
+def test_paths_with_bytes_that_are_not_utf8_are_written_and_resumed(tmp_path, spec):
+    """A byte of a non-UTF-8 path reaches Python as a lone surrogate (``\\udcff``); every file that names the path
+    (a trial's config, its report) ended in a ``UnicodeEncodeError`` traceback. It is written as its JSON escape, which
+    reads back to the same path: the trial runs, resumes and reports."""
+    from puzzlebox.scripts import report, trial
+
+    out, box = tmp_path / "r\udcffsults", tmp_path / "b\udcfex.json"
+    box.write_bytes(spec.read_bytes())
+    common = ["--specs", str(box), "--sim", "symbolic", "--agent", "dual", "--runs", "1", "--seed", "0",
+              "--max-actions", "5", "--out", str(out)]  # fmt: skip
+    assert trial.main(common) == 0 and (out / "results.json").is_file()
+    assert json.loads((out / "config.json").read_text())["specs"] == [str(box)]
+    assert trial.main([*common, "--resume"]) == 0  # the configuration read back equals this one
+    assert report.main([str(out)]) == 0 and (out / "report.html").is_file()
