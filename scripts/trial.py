@@ -28,7 +28,7 @@ from puzzlebox.lab.cli import OneLineParser, fail, one_line, run_script
 from puzzlebox.lab.errors import AgentClassError, ArmTrialFailed, ArmTrialRefused, RunStoreError, TrialConfigError
 from puzzlebox.lab.run_store import RunStore
 from puzzlebox.lab.runner import RunnerError, make_executor
-from puzzlebox.lab.spec_files import check_distinct_specs
+from puzzlebox.lab.spec_files import check_box_reach, check_distinct_specs
 from puzzlebox.lab.trial_batch import (
     InputError,
     TrialBatch,
@@ -179,6 +179,10 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
             reality, calibration = load_cell(args.reality, args.calibration, dict(zip(args.specs, specs, strict=True)))
         except CellError as err:
             fail(one_line(err))
+        try:
+            check_box_reach(specs, args.specs, reality.placement)
+        except InputError as err:
+            fail(str(err))
     try:  # what every run needs is checked once here: a bad memory or checkpoint is one line, not N errors
         memory = MemoryStore.open_existing(args.memory) if args.memory else None  # read, never written
         if not own_agent:

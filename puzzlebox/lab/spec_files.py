@@ -7,10 +7,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
+
 from puzzlebox.lab.cli import one_line
 from puzzlebox.lab.errors import NotABoxSpec, SpecFileError, SpecFilesInvalid
 from puzzlebox.lab.inputs import InputError
 from puzzlebox.models import LockTable, PuzzleSpec, SpecError, load_spec, save_spec
+from puzzlebox.models.placement import PlacementRange, sample_reachable_pose
+from puzzlebox.models.scene import DEFAULT_BOX_POSE, SceneConfig, SceneError, unreachable_handles
 
 
 def write_spec_file(spec: PuzzleSpec, path: Path, plot: bool) -> list[str]:
@@ -74,3 +78,26 @@ def check_distinct_specs(specs: Sequence[PuzzleSpec], paths: Sequence[str]) -> N
             raise InputError(f"--specs gives {same}, {spec.name!r} ({other} and {path}): give each box once, each "
                              "name to one box")  # fmt: skip
         seen[spec.name] = (content, path)
+
+
+def check_box_reach(specs: Sequence[PuzzleSpec], paths: Sequence[str], placement: PlacementRange | None) -> None:
+    """Each box can stand where the twin will place it (:class:`~puzzlebox.lab.inputs.InputError` naming the file):
+    at its own pose (``placement`` None) every handle within the arm's reach, or somewhere reachable in ``placement``
+    (a reality profile's range; drawn as the runs draw it, from seed 0). Checked at run time only, every run failed
+    and left an ``--out`` that a plain rerun refused."""
+    scene = SceneConfig()
+    for spec, path in zip(specs, paths, strict=True):
+        if spec.box is None:
+            continue
+        if placement is None:
+            pose = spec.box.pose if spec.box.pose is not None else DEFAULT_BOX_POSE
+            far = unreachable_handles(spec, (pose[0], pose[1], pose[2]), scene)
+            if far:
+                raise InputError(f"{path}: box pose {list(pose)} puts handles outside the arm's reach "
+                                 f"({scene.min_reach:.2f}..{scene.max_reach:.2f} m from its base axis): "
+                                 f"{', '.join(far[:2])}{', ...' if len(far) > 2 else ''}")  # fmt: skip
+            continue
+        try:
+            sample_reachable_pose(spec, np.random.default_rng(0), placement, scene)
+        except SceneError as err:
+            raise InputError(f"{path}: the reality profile's placement holds no reachable pose ({err})") from None

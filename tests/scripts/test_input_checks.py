@@ -580,3 +580,19 @@ def test_paths_with_bytes_that_are_not_utf8_are_written_and_resumed(tmp_path, sp
     assert json.loads((out / "config.json").read_text())["specs"] == [str(box)]
     assert trial.main([*common, "--resume"]) == 0  # the configuration read back equals this one
     assert report.main([str(out)]) == 0 and (out / "report.html").is_file()
+
+
+def test_a_box_out_of_reach_is_refused_before_any_run(capsys, tmp_path, spec):
+    """A box pose out of the arm's reach, or a profile whose placement range holds no reachable pose, failed every
+    run at its start and left an ``--out`` that a plain rerun refused; now one line before anything is written."""
+    data = json.loads(spec.read_text())
+    data["box"]["pose"] = [1.6, 0.0, 0.0]
+    far = tmp_path / "far.json"
+    far.write_text(json.dumps(data))
+    twin = ["--sim", "twin", "--agent", "oracle", "--runs", 1, "--seed", 0, "--max-actions", 3, "--out", tmp_path / "o"]
+    line = one_line_exit_2(capsys, "trial", "--specs", far, *twin)
+    assert "box pose [1.6, 0.0, 0.0] puts handles outside the arm's reach" in line
+    profile = tmp_path / "range.json"
+    profile.write_text(json.dumps({"name": "far-range", "placement": {"x": [1.5, 1.6]}}))
+    line = one_line_exit_2(capsys, "trial", "--specs", spec, *twin, "--reality", profile)
+    assert "placement holds no reachable pose" in line and not (tmp_path / "o").exists()
