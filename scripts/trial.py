@@ -28,7 +28,7 @@ from puzzlebox.lab.cli import OneLineParser, fail, one_line, run_script
 from puzzlebox.lab.errors import AgentClassError, ArmTrialFailed, ArmTrialRefused, RunStoreError, TrialConfigError
 from puzzlebox.lab.run_store import RunStore
 from puzzlebox.lab.runner import RunnerError, make_executor
-from puzzlebox.lab.spec_files import check_box_reach, check_distinct_specs
+from puzzlebox.lab.spec_files import check_belief_sizes, check_box_reach, check_distinct_specs
 from puzzlebox.lab.trial_batch import (
     InputError,
     TrialBatch,
@@ -37,7 +37,6 @@ from puzzlebox.lab.trial_batch import (
     summary_lines,
 )
 from puzzlebox.learning import AGENT_NAMES, LearningError, make_agent
-from puzzlebox.learning.locker_sets import check_belief_size
 from puzzlebox.learning.memory import MemoryStore
 from puzzlebox.models import SpecError, load_spec
 
@@ -163,12 +162,7 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
     try:
         specs = [load_spec(path) for path in args.specs]
         check_distinct_specs(specs, args.specs)
-        if args.max_lockers is not None and args.max_lockers > 1:  # the belief's size: refused before any run
-            for spec, path in zip(specs, args.specs, strict=True):
-                try:
-                    check_belief_size(len(spec.components), args.max_lockers)
-                except LearningError as err:
-                    raise InputError(f"--max-lockers {args.max_lockers} on {path}: {err}") from None
+        check_belief_sizes(specs, args.specs, args.max_lockers)
     except (SpecError, InputError) as err:
         fail(str(err))
     reality = calibration = None

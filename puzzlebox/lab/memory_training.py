@@ -44,9 +44,9 @@ def nothing_to_resume(store: MemoryStore, command: dict) -> str:
         return "the memory holds no training run"
     config = dict(cast("dict[str, Any]", runs[-1]["config"]))
     ours = json.loads(json.dumps(command))
+    keys = sorted((set(config) | set(ours)) - {"versions", "command"})
     differ = [f"--{key.replace('_', '-')} {config.get(key)!r} (this: {ours.get(key)!r})"
-              for key in sorted(set(config) | set(ours) - {"versions", "command"})
-              if key not in ("versions", "command") and config.get(key) != ours.get(key)]  # fmt: skip
+              for key in keys if config.get(key) != ours.get(key)]  # fmt: skip
     return (
         f"none of the memory's {len(runs)} training run(s) was made by this command; the latest differs in "
         f"{', '.join(differ[:4])}{' ...' if len(differ) > 4 else ''}"

@@ -12,6 +12,8 @@ import numpy as np
 from puzzlebox.lab.cli import one_line
 from puzzlebox.lab.errors import NotABoxSpec, SpecFileError, SpecFilesInvalid
 from puzzlebox.lab.inputs import InputError
+from puzzlebox.learning.errors import LearningError
+from puzzlebox.learning.locker_sets import check_belief_size
 from puzzlebox.models import LockTable, PuzzleSpec, SpecError, load_spec, save_spec
 from puzzlebox.models.placement import PlacementRange, sample_reachable_pose
 from puzzlebox.models.scene import DEFAULT_BOX_POSE, SceneConfig, SceneError, unreachable_handles
@@ -101,3 +103,16 @@ def check_box_reach(specs: Sequence[PuzzleSpec], paths: Sequence[str], placement
             sample_reachable_pose(spec, np.random.default_rng(0), placement, scene)
         except SceneError as err:
             raise InputError(f"{path}: the reality profile's placement holds no reachable pose ({err})") from None
+
+
+def check_belief_sizes(specs: Sequence[PuzzleSpec], paths: Sequence[str], max_lockers: int | None) -> None:
+    """Each box's belief over sets of up to ``max_lockers`` lockers fits
+    (:func:`puzzlebox.learning.locker_sets.check_belief_size`; :class:`~puzzlebox.lab.inputs.InputError` naming the
+    file): a belief too large ran on without a word. None or 1: the paper's belief, always small."""
+    if max_lockers is None or max_lockers <= 1:
+        return
+    for spec, path in zip(specs, paths, strict=True):
+        try:
+            check_belief_size(len(spec.components), max_lockers)
+        except LearningError as err:
+            raise InputError(f"--max-lockers {max_lockers} on {path}: {err}") from None
