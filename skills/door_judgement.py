@@ -102,7 +102,8 @@ class SwingJudge:
         pressed_hard = r.normal > self.push.blocked_force or r.magnitude > c.blocked_magnitude
         if pressed_hard and r.progress < c.blocked_progress:
             return Judgement("blocked", Cause.LOCKED_PUSHED, r.progress, peak)
-        if pressed_hard and lim.start >= c.blocked_progress and r.progress - lim.start < c.blocked_progress:
+        jammed = r.normal > self.push.jam_force or pressed_hard
+        if jammed and lim.start >= c.blocked_progress and r.progress - lim.start < c.blocked_progress:
             # a door that stood part-way and will not go on: stuck, or its lock's rod at its wall. Judged only where
             # it stood (as the slide test judges it) the push went on, and without a calibration file it pressed a
             # door held at 27 % with 48-55 N until the pad slipped off (24 of 251 recorded swings, 40-60 N)

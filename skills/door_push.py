@@ -359,10 +359,13 @@ class DoorPusher:
         contact = max(p.judgement.contact_force, p.judgement.contact_noise_margin * self.watch.filtered_noise_now())
         ticks = round(c.actuation.actuate_time * self.watch.slowdown / c.motion.tick)
         pace = (end - start) / ticks  # of the travel per tick, past the slow start
-        slow_span = max(
-            0.0, c.actuation.breakaway_fraction - start
-        )  # the start of the travel, driven slowly as a pinch's
-        pacing = Pacing(pace, pace * c.actuation.breakaway_pace, slow_span)  # slow start, then a ramp up
+        # the start of the travel, driven slowly as a pinch's; from part-way (a door a pinch lost at its lock's
+        # wall stands still there) slower still, closing in too, and at least ``blocked_progress`` past its start
+        part_way = start >= c.judgement.blocked_progress  # (where a jam is read, :class:`SwingJudge`)
+        slow_span = max(0.0, c.actuation.breakaway_fraction - start, c.judgement.blocked_progress if part_way else 0.0)
+        slow_pace = c.actuation.breakaway_pace * (p.plan.part_way_pace if part_way else 1.0)
+        pacing = Pacing(pace, pace * slow_pace, slow_span)  # slow start, then a ramp up
+        approach_time = p.plan.approach_time * self.watch.slowdown / (p.plan.part_way_pace if part_way else 1.0)
         last_tick = pacing.ticks_to(end - start)
         limits = SwingLimits(
             start, contact, p.judgement.held_turn / door.travel, p.judgement.slide_turn / door.travel,
@@ -375,9 +378,7 @@ class DoorPusher:
         for k in range(1, last_tick + 1 + round(2 * c.motion.settle_time / c.motion.tick)):
             paced = pacing.at(k)
             s = min(start + paced, end, max(progress, start) + lead)
-            closing_in = max(0.0, 1.0 - k * c.motion.tick / (p.plan.approach_time * self.watch.slowdown)) * (
-                p.plan.gap + p.plan.depth
-            )
+            closing_in = max(0.0, 1.0 - k * c.motion.tick / approach_time) * (p.plan.gap + p.plan.depth)
             self.motion.tick(tcp_for(door.point_at(s * door.travel, pressed(k) + np.array([closing_in, 0.0]))))
             pad_edge = self.pad_edge(door, p.plan.pad_offset)
             progress = self.pinch.progress = (

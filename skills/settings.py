@@ -436,6 +436,12 @@ class DoorPushPlan:
     over it."""
     overtravel: float = 0.06
     """As the pinch's ``door_overtravel``, for a push (fraction of the travel): a pushed door follows the pad."""
+    part_way_pace: float = 0.3
+    """Pace of a push from part-way (a door that stood past ``blocked_progress``: a pinch lost it, a try left it), as
+    a fraction of the usual, while the pad closes in on the face and over its slow start [-]: such a door may stand
+    still at its lock's wall, where the pad meets a face that does not give. At the usual pace the true load rose
+    19, 26, 32, 47 N in four 10 ms ticks while the filtered reading showed 0-19 N (paper-test-1 seed 87038,
+    realistic)."""
     start_margin: float = 0.035
     """How far behind a door's seen angle a push after a pinch that lost its hold starts (fraction of the
     travel, 3 deg): a door let go part-way open falls back ~1 deg while the arm comes round. Behind the
@@ -469,6 +475,12 @@ class DoorPushJudgement:
     blocked_force: float = 30.0
     """Normal force on a handle's back face that, with little progress, means a latch [N] (a free door
     under the harsh profile's damping and friction took up to 13 N)."""
+    jam_force: float = 20.0
+    """Normal force on the back face that, with little progress, ends a push from part-way (a door that stood
+    past ``blocked_progress``: ``jammed``, no evidence) [N]. The pad meets a door held there (a pinch lost it at
+    its lock's wall) with the door already still: the true load rose 0 -> 44 N in three 10 ms ticks while the
+    filtered reading (~30 ms late) showed 7 N, and at ``blocked_force`` each push put 45-46 N on the wrist
+    (paper-test-1 seed 87038, realistic). A free door pushed on from part-way takes under half of it."""
 
 
 @dataclass(frozen=True)
@@ -712,12 +724,14 @@ _DOOR_PART_OF: dict[str, str] = {
     "lead": "plan",
     "overtravel": "plan",
     "start_margin": "plan",
+    "part_way_pace": "plan",
     "contact_force": "judgement",
     "contact_noise_margin": "judgement",
     "slide_turn": "judgement",
     "held_turn": "judgement",
     "end_force": "judgement",
     "blocked_force": "judgement",
+    "jam_force": "judgement",
     "top_up_from": "top_up_plan",
     "top_up_height": "top_up_plan",
     "top_up_low": "top_up_plan",
@@ -727,7 +741,6 @@ _DOOR_PART_OF: dict[str, str] = {
     "top_up_force": "top_up_plan",
     "top_up_noise_margin": "top_up_plan",
 }
-"""Which part of :class:`DoorPushConfig` holds each of its settings ("": the config itself)."""
 """Which part of :class:`DoorPushConfig` holds each of its settings."""
 
 

@@ -88,5 +88,11 @@ def test_a_door_that_stood_part_way_and_will_not_go_on_under_a_hard_push_is_stuc
     file)."""
     judgement = swing([SwingReading(0.28, 0.27, 6.0, 4.0, 6.0), SwingReading(0.29, 0.27, 31.0, 20.0, 31.0)], start=0.27)
     assert (judgement.outcome, judgement.cause, judgement.held_at) == ("failed", Cause.JAMMED, 0.27)
+    # a door held there stands still as the pad meets it: read at ``jam_force`` (20 N), under ``blocked_force``
+    light = swing([SwingReading(0.28, 0.27, 6.0, 4.0, 6.0), SwingReading(0.28, 0.27, 21.0, 8.0, 21.0)], start=0.27)
+    assert (light.outcome, light.cause) == ("failed", Cause.JAMMED)
+    closed = [SwingReading(0.02, 0.01, 6.0, 4.0, 6.0), SwingReading(0.02, 0.01, 21.0, 8.0, 21.0)]
+    with pytest.raises(ValueError, match="cut short"):  # from its start, 20 N ends nothing: the swing goes on
+        swing(closed, start=0.0)
     free = swing(pressed([0.27 + k / 20 for k in range(16)], [0.27 + k / 20 for k in range(16)]), 0.27, 1.02)
     assert free.outcome == "moved"  # a light push that turns the door carries it on
