@@ -2,8 +2,8 @@
 
 A *disassembly scene* is a spec with no ``box`` whose components carry 6-DOF poses
 ``[x, y, z, roll, pitch, yaw]`` [m, rad] in one common frame (the two measured lab computers in
-``/work/shared/data/disassembly/`` are relative to the first case screw). Every component has two
-states: 0 = in place (mounted, as found), 1 = removed. The puzzle-box family (:mod:`models.kinds`:
+``learning/data/disassembly/``, shipped with the package, are relative to the first case screw). Every component has
+two states: 0 = in place (mounted, as found), 1 = removed. The puzzle-box family (:mod:`models.kinds`:
 door, slide, wheel) is a separate family; one spec never mixes the two.
 
 Per kind (state 0 / state 1):

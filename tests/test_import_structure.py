@@ -121,3 +121,31 @@ def test_import_puzzlebox_registers_all_three_environments_and_imports_no_layer(
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "['goal', 'kinds', 'poses', 'states']"
+
+
+DISTRIBUTION_OF = {"xarm": "xarm-python-sdk", "cv2": "opencv-python-headless"}
+"""The distribution of an import name that ``importlib.metadata`` may not map (an optional extra not installed)."""
+TYPING_ONLY = {"_typeshed"}
+"""Import names that exist only for the type checker (under ``if TYPE_CHECKING``)."""
+
+
+def test_every_third_party_package_the_library_imports_is_declared():
+    # (daqp, imported by skills/ik_qp.py, was installed only as another package's dependency)
+    import re
+    from importlib.metadata import packages_distributions
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    requirements = project["dependencies"] + [r for extra in project["optional-dependencies"].values() for r in extra]
+    declared = {re.split(r"[<>=\[ ;]", r)[0].lower().replace("_", "-") for r in requirements}
+    installed = packages_distributions()
+    undeclared = set()
+    for path in _modules().values():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else []
+            if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                names = [node.module]
+            for top in {n.split(".")[0] for n in names} - set(sys.stdlib_module_names) - TYPING_ONLY - {"puzzlebox"}:
+                dists = installed.get(top) or [DISTRIBUTION_OF.get(top, top)]
+                if not {d.lower().replace("_", "-") for d in dists} & declared:
+                    undeclared.add(f"{path.relative_to(ROOT)}: {top} ({', '.join(dists)})")
+    assert sorted(undeclared) == []

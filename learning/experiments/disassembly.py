@@ -41,8 +41,9 @@ from puzzlebox.learning.trial import run_episode
 from puzzlebox.models import LockTable, PuzzleSpec, load_spec, spec_from_dict
 from puzzlebox.models.disassembly_variants import VariantConfig, disassembly_variant
 
-DATA_DIR = Path(__file__).resolve().parents[3] / "shared" / "data" / "disassembly"
-"""Where the two measured computers live (``../shared/data/disassembly`` beside the repository)."""
+DATA_DIR = Path(__file__).resolve().parents[1] / "data" / "disassembly"
+"""Where the two measured computers live: ``puzzlebox.learning``'s data (``learning/data/disassembly``), with
+their source."""
 AGENTS = ("memory", "dual", "dqn", "model-based")
 DEEP = ("dqn", "model-based")
 PAPER = {
@@ -133,8 +134,8 @@ def scenes(config: DisassemblyConfig) -> tuple[PuzzleSpec, list[PuzzleSpec]]:
     paths = [data / f"{name}.json" for name in (config.train_scene, config.test_scene)]
     missing = [str(p) for p in paths if not p.is_file()]
     if missing:
-        raise ConfigError(f"the disassembly data is missing: {', '.join(missing)} (the measured computers ship in "
-                          "../shared/data/disassembly beside the repository)")  # fmt: skip
+        raise ConfigError(f"the disassembly data is missing: {', '.join(missing)} (the measured computers ship with "
+                          f"the package, in {DATA_DIR})")  # fmt: skip
     train, test = (load_spec(p) for p in paths)
     if config.validation:
         return train, [disassembly_variant(train, config.validation_seed + v, config.variant)

@@ -6,12 +6,12 @@ enforce (``bench.py`` does, before numpy loads)."""
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
 import numpy as np
 
 from puzzlebox.learning import DualAgent, PuzzleEnv, PuzzleEnvConfig, SymbolicWorld
 from puzzlebox.learning.dual_controller import DualControllerConfig
+from puzzlebox.learning.experiments.disassembly import DATA_DIR as DISASSEMBLY_DATA
 from puzzlebox.models.generator import RandomGraphConfig, generate_random
 from puzzlebox.models.generator.chain import MAX_REACHABLE_COMPONENTS, BoxConfig
 from puzzlebox.models.spec_loading import load_spec
@@ -72,8 +72,8 @@ def multi_locker_latency(n: int = 8, episodes: int = 5, max_decisions: int = 40)
     return out
 
 
-DISASSEMBLY_SCENE = Path(__file__).resolve().parents[3] / "shared" / "data" / "disassembly" / "lab-computer-b.json"
-"""The 8-component disassembly scene of the paper's second domain (``../shared/data``), when present."""
+DISASSEMBLY_SCENE = DISASSEMBLY_DATA / "lab-computer-b.json"
+"""The 8-component disassembly scene of the paper's second domain (shipped with the package)."""
 
 
 def disassembly_latency(episodes: int = 5, max_decisions: int = 24) -> dict[str, dict[str, float]] | None:

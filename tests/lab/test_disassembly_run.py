@@ -9,13 +9,10 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-import pytest
-
 from puzzlebox.lab.disassembly_run import run_disassembly, tasks_for
-from puzzlebox.learning.experiments.disassembly import DATA_DIR, DisassemblyConfig
+from puzzlebox.learning.experiments.disassembly import DisassemblyConfig
 
 ROOT = Path(__file__).resolve().parents[2]
-pytestmark = pytest.mark.skipif(not DATA_DIR.is_dir(), reason=f"{DATA_DIR} (the shared disassembly data) is absent")
 QUICK = DisassemblyConfig().quick()
 
 

@@ -9,9 +9,8 @@ from dataclasses import replace
 import pytest
 
 from puzzlebox.learning.errors import ConfigError
-from puzzlebox.learning.experiments.disassembly import DATA_DIR, DisassemblyConfig, jobs_for, scenes
+from puzzlebox.learning.experiments.disassembly import DisassemblyConfig, jobs_for, scenes
 
-pytestmark = pytest.mark.skipif(not DATA_DIR.is_dir(), reason=f"{DATA_DIR} (the shared disassembly data) is absent")
 QUICK = DisassemblyConfig().quick()
 
 
@@ -43,3 +42,19 @@ def test_the_holding_rule_ablation_reaches_the_belief_agents_only_and_default_ta
     assert all("holding_rule" not in j.settings for j in jobs_for(["memory", "dual"], QUICK))
     assert all(j.settings["holding_rule"] is False for j in jobs_for(["memory", "dual"], ablation))
     assert all("holding_rule" not in j.settings for j in jobs_for(["dqn"], ablation))
+
+
+def test_the_measured_computers_ship_with_the_package():
+    # (they were read from a folder beside the repository: a pip install could not run the experiment)
+    import fnmatch
+    import tomllib
+    from pathlib import Path
+
+    from puzzlebox.learning.experiments.disassembly import DATA_DIR
+
+    root = Path(__file__).resolve().parents[2]
+    patterns = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]
+    shipped = patterns["puzzlebox.learning"]
+    files = sorted(p.relative_to(DATA_DIR.parents[1]).as_posix() for p in DATA_DIR.iterdir())
+    assert {"data/disassembly/lab-computer-a.json", "data/disassembly/lab-computer-b.json"} <= set(files)
+    assert all(any(fnmatch.fnmatch(f, p) for p in shipped) for f in files), (files, shipped)
