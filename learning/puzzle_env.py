@@ -64,8 +64,10 @@ class PuzzleEnv(gym.Env[dict[str, Any], np.int64]):
 
     The puzzle is :attr:`puzzle` (``spec`` is gymnasium's registration record).
 
-    Observation (a ``Dict``): ``states`` (N,) 0/1; ``kinds`` (N,) kind codes (index in
-    :attr:`kind_names`: ``models.KIND_NAMES`` for puzzle boxes); ``poses`` (N, D) component poses in the
+    Observation (a ``Dict``): ``states`` (N,) 0/1; ``kinds`` (N,) kind codes (index in :attr:`kind_names`,
+    ``models.disassembly_kinds.family_kind_names(spec.kinds)``: the paper's three kinds, ``models.KIND_NAMES``,
+    for a paper box; every registered kind (door, slide, wheel, drawer, lever) for a box with another kind; the
+    disassembly kinds for a disassembly scene); ``poses`` (N, D) component poses in the
     world frame — ``[x, y, yaw]`` [m, m, rad] for planar puzzles, the box placed at ``box.pose`` (identity
     when absent), ``[x, y, z, roll, pitch, yaw]`` for disassembly scenes;
     ``goal`` the index of the goal component. Info: ``moved`` (bool) and ``num_actions``.
@@ -91,7 +93,8 @@ class PuzzleEnv(gym.Env[dict[str, Any], np.int64]):
         self._true_poses = spec.poses_in_world()
         self.kind_names = family_kind_names(spec.kinds)
         """The kind family of the spec: observed kind codes are indices here (``models.KIND_NAMES`` for
-        puzzle boxes, ``models.disassembly_kinds.DISASSEMBLY_KIND_NAMES`` for disassembly scenes)."""
+        paper boxes, every registered kind for boxes with another kind,
+        ``models.disassembly_kinds.DISASSEMBLY_KIND_NAMES`` for disassembly scenes)."""
         self._true_kinds = np.array([self.kind_names.index(c.kind) for c in spec.components], dtype=np.int64)
         self.action_space = spaces.Discrete(n)
         self.observation_space = spaces.Dict(

@@ -150,10 +150,12 @@ def _part_chosen(agent: Agent, index: Any, parts: int) -> int:
 
 def summarise(runs: list[RunResult | dict[str, Any]], max_actions: int) -> dict[str, Any]:
     """The ``results.json`` object: success rate, mean actions (an unsolved run counts ``max_actions``)
-    and every run (``RunResult`` or its dict with extra keys, as twin trials give)."""
+    and every run (``RunResult`` or its dict with extra keys, as twin trials give). With no run finished (stopped
+    before the first ended) there is no rate: ``success_rate`` and ``mean_actions`` are None and ``ended`` says so."""
     rows = [r.to_dict() if isinstance(r, RunResult) else r for r in runs]
     if not rows:
-        return {"success_rate": 0.0, "mean_actions": float(max_actions), "runs": []}
+        return {"success_rate": None, "mean_actions": None, "max_actions": max_actions, "runs": [],
+                "ended": "no run finished"}  # fmt: skip
     counted = [r["num_actions"] if r["solved"] else max_actions for r in rows]
     return {
         "success_rate": float(np.mean([r["solved"] for r in rows])),

@@ -44,10 +44,10 @@ class SpecError(ModelsError):
 class UnknownKindError(ModelsError, KeyError):
     """A component kind that no template describes."""
 
-    def __init__(self, kind: str, available: Iterable[str]) -> None:
+    def __init__(self, kind: str, available: Iterable[str], message: str | None = None) -> None:
         self.kind = kind
         self.available = tuple(sorted(available))
-        super().__init__(f"unknown component kind {kind!r}. Available kinds: {list(self.available)}")
+        super().__init__(message or f"unknown component kind {kind!r}. Available kinds: {list(self.available)}")
 
     def __str__(self) -> str:  # KeyError would quote the whole message
         return str(self.args[0])

@@ -51,9 +51,21 @@ ALLOWED_NEIGHBOURS: frozenset[frozenset[str]] = PAPER_FAMILY.neighbours
 components of the same kind)."""
 
 
-def kind_code(name: str) -> int:
-    """Integer code of a kind (its index in :data:`KIND_NAMES`)."""
-    return PAPER_FAMILY.code(name)
+def kind_code(name: str, kinds: tuple[str, ...] = KIND_NAMES) -> int:
+    """Integer code of a kind: its index in ``kinds``, the kind names of a family (default :data:`KIND_NAMES`, the
+    paper's; a box's own: ``models.disassembly_kinds.family_kind_names(spec.kinds)``, as the environments code
+    them). :class:`UnknownKindError` says when the kind is registered but not of that family."""
+    if name in kinds:
+        return kinds.index(name)
+    if name in registered_kinds():
+        raise UnknownKindError(
+            name,
+            kinds,
+            f"kind {name!r} is registered but not one of {list(kinds)}, whose codes these are (the paper's "
+            "family by default); a box of other kinds codes them as the environments do: "
+            f"kind_code(kind, family_kind_names(spec.kinds)), here {list(registry_family().kinds)}",
+        )
+    raise UnknownKindError(name, registered_kinds())
 
 
 def may_neighbour(kind_a: str, kind_b: str) -> bool:

@@ -91,7 +91,7 @@ def batch_results(runs: Sequence[dict[str, Any]], batch: TrialBatch, planned: in
     """``results.json``: the contract's summary (:func:`puzzlebox.learning.summarise`), the twin's figures, and
     ``runs_done`` of ``runs_planned``."""
     results = summarise(list(runs), batch.max_actions)
-    if batch.sim == "twin":
+    if batch.sim == "twin" and runs:  # (no figures of no run)
         results.update(twin_figures(list(runs)))
     results["runs_done"], results["runs_planned"] = len(runs), planned
     return results
@@ -145,6 +145,9 @@ def run_batch(batch: TrialBatch, store: RunStore, executor: Executor) -> tuple[R
 
 def summary_lines(results: dict[str, Any], batch: TrialBatch, out: Path) -> list[str]:
     """What ``trial.py`` prints when a batch ends: success and actions, and the twin's figures."""
+    if not results["runs"]:
+        return [f"{batch.agent} on {len(batch.specs)} spec(s) x {batch.runs} run(s): no run finished -> "
+                f"{out / 'results.json'}"]  # fmt: skip
     lines = [
         f"{batch.agent} on {len(batch.specs)} spec(s) x {batch.runs} run(s): success {results['success_rate']:.1%}, "
         f"mean actions {results['mean_actions']:.2f} -> {out / 'results.json'}"

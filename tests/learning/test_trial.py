@@ -110,3 +110,10 @@ def test_on_action_sees_every_try_as_it_happens():
     seen: list = []
     result = run_episode(OracleAgent(spec), SymbolicWorld(spec, 0), spec.name, 0, 10, on_action=seen.append)
     assert seen == result.actions and len(seen) == 3
+
+
+def test_a_summary_of_no_finished_run_gives_no_rate():
+    # (stopped before any run ended, results.json said success_rate 0.0 and mean_actions 30.0)
+    summary = summarise([], max_actions=30)
+    assert summary["success_rate"] is None and summary["mean_actions"] is None
+    assert summary["ended"] == "no run finished" and summary["runs"] == [] and summary["max_actions"] == 30

@@ -135,7 +135,7 @@ def test_a_new_kind_changes_neither_the_paper_family_nor_its_boxes(monkeypatch):
     assert (PAPER_FAMILY, KIND_NAMES, ALLOWED_NEIGHBOURS, [kind_code(k) for k in KIND_NAMES]) == family
     assert KIND_NAMES == ("door", "slide", "wheel") and [kind_code(k) for k in KIND_NAMES] == [0, 1, 2]
     assert not any(may_neighbour(THROWAWAY, k) for k in (*KIND_NAMES, THROWAWAY))  # ... the paper does not
-    with pytest.raises(UnknownKindError):
+    with pytest.raises(UnknownKindError, match="registered but not one of"):
         kind_code(THROWAWAY)
     assert [spec.to_json() for spec in paper_family("all")] == before
 
@@ -202,3 +202,15 @@ def test_template_mjcf_and_handle_agree(name, with_lever):
     jm = joint_model(name, T)
     assert np.allclose(jm.grasp_point, handle + [0, 0, HANDLE_HEIGHT / 2 - GRASP_DEPTH], atol=1e-3)
     assert np.allclose(jm.axis, data.xaxis[joint.id], atol=1e-9)
+
+
+def test_a_kind_outside_the_paper_family_is_coded_in_its_box_s_family_and_refused_in_the_paper_s_saying_so():
+    # (kind_code("lever") said "Available kinds: ['door', 'slide', 'wheel']" while the environments code five)
+    from puzzlebox.models.disassembly_kinds import family_kind_names
+
+    five = family_kind_names(("door", "lever"))
+    assert kind_code("lever", five) == five.index("lever") and kind_code("door", five) == kind_code("door") == 0
+    with pytest.raises(UnknownKindError, match=r"'lever' is registered but not one of \['door', 'slide', 'wheel'\]"):
+        kind_code("lever")
+    with pytest.raises(UnknownKindError, match="unknown component kind 'hinge'.*'lever'"):
+        kind_code("hinge")
