@@ -1,4 +1,4 @@
-"""Train the memory agent in the symbolic simulator or end to end in the twin, and write its memory.
+r"""Train the memory agent in the symbolic simulator or end to end in the twin, and write its memory.
 
     python scripts/train.py --specs FILE... --episodes E --memory MEM.sqlite [--seed S] [--max-lockers K] [--resume]
     python scripts/train.py --specs FILE... --episodes E --memory MEM.sqlite --sim twin \

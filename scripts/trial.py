@@ -1,4 +1,4 @@
-"""Run seeded trials of an agent on puzzle specs and write ``DIR/results.json``.
+r"""Run seeded trials of an agent on puzzle specs and write ``DIR/results.json``.
 
     python scripts/trial.py --specs FILE... [--memory MEM.sqlite] --sim {symbolic,twin} --runs K --seed S \
                             --max-actions M --out DIR [--agent NAME|package.module:Class] [--max-lockers K] \
