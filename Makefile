@@ -7,7 +7,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 export MUJOCO_GL ?= egl
 
-.PHONY: demo test lint install clean
+.PHONY: demo test test-fast lint install clean
 
 install: $(STAMP)
 
@@ -57,6 +57,11 @@ lint: $(STAMP) $(MUJOCO_STUBS) $(PYRIGHT_ROOT)
 
 test: lint
 	$(BIN)/python -m pytest -q -n 2 --dist loadgroup --no-loadscope-reorder  # both cores, the longest work first (tests/_schedule.py)
+
+# The edit-test loop: the unit and physics tests, without lint and without the tests recorded at 2 CPU seconds or
+# more (end-to-end trials, experiments: marked slow by tests/_schedule.py). make test stays the whole suite.
+test-fast: $(STAMP)
+	$(BIN)/python -m pytest -q -n 2 --dist loadgroup --no-loadscope-reorder -m "not slow"
 
 # The main job on the built-in default: the paper's boxes, a memory trained in the symbolic simulator on
 # the 9 training boxes (one episode each), then an unseen box solved end to end in the MuJoCo twin

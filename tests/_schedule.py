@@ -54,6 +54,10 @@ GROUPED = (
 """Modules whose module-scoped fixtures take seconds (a twin trial, a calibration, a generated box...): kept on one
 worker so that the fixture is built once."""
 
+SLOW_FROM_S = 2.0
+"""A work unit (a test, or a :data:`GROUPED` module) recorded at this many CPU seconds or more is marked ``slow``
+(:func:`mark_slow`): ``make test-fast`` leaves those out (``pytest -m "not slow"``), for the edit-test loop."""
+
 RECORD_ENV = "PUZZLEBOX_TEST_COSTS"
 """Set to a path: every test's CPU seconds are appended there (``seconds<TAB>node id`` lines)."""
 
@@ -85,6 +89,16 @@ def order_longest_first(items: list[pytest.Item], costs: dict[str, float]) -> No
             units[item.nodeid].append(item)
     cost = {key: sum(costs.get(_base_id(i.nodeid), UNKNOWN_COST_S) for i in unit) for key, unit in units.items()}
     items[:] = [item for key in sorted(units, key=lambda k: -cost[k]) for item in units[key]]
+    mark_slow(units, cost)
+
+
+def mark_slow(units: dict[str, list[pytest.Item]], cost: dict[str, float]) -> None:
+    """Mark ``slow`` every test of a unit that costs :data:`SLOW_FROM_S` or more (a grouped module as a whole: its
+    module-scoped fixture, charged to its first test, is what costs)."""
+    for key, unit in units.items():
+        if cost[key] >= SLOW_FROM_S:
+            for item in unit:
+                item.add_marker(pytest.mark.slow)
 
 
 def _cpu_s() -> float:
