@@ -14,8 +14,9 @@
   their ratio; overview render time per 640x480 frame without and with shadows;
 - twin trial: simulated/wall time of one oracle twin trial on a paper test box (ideal cell, no video), the
   first in the process (renderer, scene and IK model built) and a second one (kept from the first);
-- twin trial outputs: wall time of the same oracle trial plain, with ``--video`` and with ``--record``, in turn
-  (medians of 3), and the ratios to plain; the rollout views' box visibility over every frame of 5 trials;
+- twin trial outputs: wall time of the same oracle trial plain, with ``--video``, with ``--record`` and with
+  ``--state-log``, in turn (medians of 3), and the ratios to plain (and the state log's size); the rollout views'
+  box visibility over every frame of 5 trials;
 - manipulation (``puzzlebox/lab/manipulation_speed.py``): ``BoxManipulation-v0`` control steps per second (state
   observations) beside bare ``mj_step`` replaying the same run (the same simulated time), with their ratio, and
   ``make_vec`` async with 2 workers against 1 (``--only manipulation``: these figures alone);

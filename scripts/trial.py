@@ -2,7 +2,7 @@ r"""Run seeded trials of an agent on puzzle specs and write ``DIR/results.json``
 
     python scripts/trial.py --specs FILE... [--memory MEM.sqlite] --sim {symbolic,twin} --runs K --seed S \
                             --max-actions M --out DIR [--agent NAME|package.module:Class] [--max-lockers K] \
-                            [--video] [--record FILE.rrd] [--reality ideal|realistic|harsh|FILE.json] \
+                            [--video] [--state-log] [--record FILE.rrd] [--reality ideal|realistic|harsh|FILE.json] \
                             [--calibration FILE.json] [--wrong-kind] [--locks contact|latch] \
                             [--workers K | --ray auto|ADDRESS] [--resume | --force] \
                             [--robot twin|xarm --ip ADDRESS --cell FILE]
@@ -57,6 +57,7 @@ def _arm_main(args, arm: Callable[[str, Any], Any] | None) -> int:
         reach_arm(args.ip, args.cell, probe=arm is None)  # an address where no arm answers is refused first
         twin_only = [flag for flag, given in (
             ("--video", args.video), ("--record", args.record is not None), ("--wrong-kind", args.wrong_kind),
+            ("--state-log", args.state_log),
             ("--reality", args.reality != "ideal"), ("--workers", args.workers is not None),
             ("--ray", args.ray is not None), ("--resume", args.resume),
         ) if given]  # fmt: skip
@@ -92,6 +93,8 @@ def _arm_main(args, arm: Callable[[str, Any], Any] | None) -> int:
 def _check_twin_flags(args) -> None:
     if args.video and args.sim != "twin":
         fail("--video needs --sim twin")
+    if args.state_log and args.sim != "twin":
+        fail("--state-log needs --sim twin")
     if args.record is not None:
         if args.sim != "twin":
             fail("--record needs --sim twin")
@@ -129,6 +132,8 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
     parser.add_argument("--checkpoint", default=None, help="checkpoint from train.py (deep agents)")
     parser.add_argument("--max-lockers", type=int, metavar="K", help="memory/dual: up to K lockers a part")
     parser.add_argument("--video", action="store_true", help="record rollout videos (twin only)")
+    parser.add_argument("--state-log", action="store_true",
+                        help="twin: each run's state at every control tick, DIR/states/<run>.npz")  # fmt: skip
     parser.add_argument("--record", default=None, metavar="FILE.rrd", help="a Rerun recording of each twin run")
     parser.add_argument("--wrong-kind", action="store_true", help="twin: tell the pipeline one kind wrong per run")
     parser.add_argument("--reality", default="ideal", help="twin reality profile: ideal, realistic, harsh or a file")
@@ -192,9 +197,11 @@ def main(argv: list[str] | None = None, *, arm: Callable[[str, Any], Any] | None
         del experiment["max_lockers"]
     if args.locks == "latch" or args.sim != "twin":  # latches: the configuration made before mechanisms existed
         del experiment["locks"]
+    if not args.state_log:  # likewise: a directory made before state logs existed resumes
+        del experiment["state_log"]
     batch = TrialBatch(tuple(specs), args.runs, args.seed, args.sim, args.agent, args.max_actions, args.memory,
                        args.checkpoint, reality, calibration, args.video, args.record, args.wrong_kind,
-                       args.max_lockers, args.locks)  # fmt: skip
+                       args.max_lockers, args.locks, args.state_log)  # fmt: skip
     # symbolic runs last less than a hand-over; a pool is started for no more twin runs than there are
     workers = args.workers or (min(os.cpu_count() or 1, len(specs) * args.runs) if args.sim == "twin" else 1)
     try:

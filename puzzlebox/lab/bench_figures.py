@@ -93,7 +93,9 @@ def measured_figures(quick: bool) -> Iterator[Figure]:
     yield Figure(("rollout",), rollout, [
         f"twin trial outputs (oracle, ideal, median of {rollout['repeats']}): plain {rollout['plain_wall_s']:.2f} s, "
         f"--video {rollout['video_wall_s']:.2f} s (x{rollout['video_over_plain']:.2f}), --record "
-        f"{rollout['record_wall_s']:.2f} s (x{rollout['record_over_plain']:.2f})"
+        f"{rollout['record_wall_s']:.2f} s (x{rollout['record_over_plain']:.2f}), --state-log "
+        f"{rollout['state_log_wall_s']:.2f} s (x{rollout['state_log_over_plain']:.3f}, "
+        f"{rollout['state_log_bytes'] / 1e6:.2f} MB)"
     ])  # fmt: skip
     seen = box_visibility_figures(quick)
     yield Figure(("box_visibility",), seen, [

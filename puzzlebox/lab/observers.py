@@ -3,8 +3,9 @@ a Rerun recording, one's own).
 
 A trial hands every observer explicit events (:class:`TrialObserver`): :meth:`~TrialObserver.attach` once the
 world and the agent exist, :meth:`~TrialObserver.sensed` after each reading the pipeline takes of the robot,
-:meth:`~TrialObserver.waited` after each stretch of robot time, :meth:`~TrialObserver.action_begins` /
-:meth:`~TrialObserver.action_ended` around each try, :meth:`~TrialObserver.finish` at the end. The events come
+:meth:`~TrialObserver.commanded` after each command it gives, :meth:`~TrialObserver.waited` after each stretch of
+robot time, :meth:`~TrialObserver.action_begins` / :meth:`~TrialObserver.action_ended` around each try,
+:meth:`~TrialObserver.finish` at the end. The events come
 from :class:`ObservedRobot` (the ``Robot`` the pipeline drives, forwarding each call to the cell's robot) and
 from :class:`puzzlebox.lab.narrated_world.NarratedWorld`. An observer reads the cell (``session``: the twin's
 physics; None on a real arm) and what the pipeline sensed; it senses nothing itself, so a trial is the same
@@ -53,6 +54,10 @@ class TrialObserver:
     def sensed(self, what: str, value: Any) -> None:
         """The pipeline read ``what`` (``"joint_positions"``, ``"wrench"`` or ``"capture:<camera>"``) and got
         ``value`` (an array, or a :class:`~puzzlebox.models.robot.CameraImage` or None)."""
+
+    def commanded(self, what: str, value: Any) -> None:
+        """The pipeline commanded ``what`` (``"joint_positions"``: an array [rad]; ``"gripper"``: a closure, 0 open
+        .. 1 closed)."""
 
     def waited(self, now: float) -> None:
         """Robot time passed, to ``now`` [s] (every control tick of a motion, every settle and look)."""
@@ -112,9 +117,13 @@ class ObservedRobot:
 
     def command_joint_positions(self, q: np.ndarray) -> None:
         self._robot.command_joint_positions(q)
+        for observer in self._observers:
+            observer.commanded("joint_positions", q)
 
     def command_gripper(self, closure: float) -> None:
         self._robot.command_gripper(closure)
+        for observer in self._observers:
+            observer.commanded("gripper", closure)
 
     def wait(self, seconds: float) -> None:
         self._robot.wait(seconds)

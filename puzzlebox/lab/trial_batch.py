@@ -32,7 +32,9 @@ class TrialBatch:
 
     ``video``: a rollout video per run (``rollout.mp4`` for a single run, else ``rollout-<spec>-s<seed>.mp4``, in
     the output directory); ``record``: a Rerun recording per run (``FILE.rrd`` for one, else
-    ``FILE-<spec>-s<seed>.rrd``). The other fields are :func:`puzzlebox.lab.trial_task.trial_task`'s."""
+    ``FILE-<spec>-s<seed>.rrd``); ``state_log``: each run's state at every control tick, ``states/<run key>.npz``
+    in the output directory (:mod:`puzzlebox.lab.state_log`). The other fields are
+    :func:`puzzlebox.lab.trial_task.trial_task`'s."""
 
     specs: tuple[PuzzleSpec, ...]
     runs: int
@@ -49,6 +51,7 @@ class TrialBatch:
     misreport_kind: bool = False
     max_lockers: int | None = None
     locks: str = "contact"
+    state_log: bool = False
 
     def tasks(self, out: Path) -> list:
         """One runner task per spec and seed, keyed ``<spec index>-<spec slug>-seed<seed>`` (the slug of a name:
@@ -65,13 +68,15 @@ class TrialBatch:
                 if self.record:
                     path = Path(self.record)
                     record = str(path.resolve() if single else path.with_name(f"{path.stem}-{slug}-s{seed}.rrd"))
+                key = f"{i:03d}-{slug}-seed{seed}"
+                states = str((out / "states" / f"{key}.npz").resolve()) if self.state_log else None
                 tasks.append(trial_task.trial_task(
-                    f"{i:03d}-{slug}-seed{seed}", spec, seed, sim=self.sim, agent=self.agent,
+                    key, spec, seed, sim=self.sim, agent=self.agent,
                     max_actions=self.max_actions, memory=self.memory, checkpoint=self.checkpoint,
                     reality=self.reality.to_dict() if self.reality is not None else None,
                     calibration=self.calibration.to_dict() if self.calibration is not None else None, video=video,
                     misreport_kind=self.misreport_kind, max_lockers=self.max_lockers, record=record,
-                    locks=self.locks,
+                    locks=self.locks, state_log=states,
                 ))  # fmt: skip
         return tasks
 

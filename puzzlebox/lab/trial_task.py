@@ -53,6 +53,7 @@ def trial_task(
     max_lockers: int | None = None,
     record: str | None = None,
     locks: str = "contact",
+    state_log: str | None = None,
 ) -> Task:
     """The task of one run (``reality`` and ``calibration`` as their ``to_dict()``; twin only;
     ``misreport_kind``: one component's kind told wrong, drawn from the seed; ``max_lockers``: the most
@@ -76,7 +77,8 @@ def trial_task(
         settings["max_lockers"] = max_lockers
     if sim == "twin" and locks != "latch":  # a latch task is the task it was before mechanisms existed
         settings["locks"] = locks
-    context = {k: v for k, v in (("video", video), ("record", record)) if v}  # outputs: not part of the record
+    outputs = (("video", video), ("record", record), ("state_log", state_log))
+    context = {k: v for k, v in outputs if v}  # outputs: not part of the record
     return Task(key, run_trial, settings, context=context or None)
 
 
@@ -88,18 +90,26 @@ def _memory(path: str, sha256: str) -> MemoryStore:
 
 def run_trial(settings: Mapping[str, Any], context: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """Run the trial ``settings`` describe (see :func:`trial_task`); returns its run entry. ``context`` may name
-    a ``video`` file and a Rerun ``record`` file to write (where they go does not change the record)."""
+    a ``video`` file, a Rerun ``record`` file and a ``state_log`` file to write (where they go does not change the
+    record)."""
     spec = spec_from_dict(settings["spec"])
     if _hook is not None:
         _hook.start(f"{spec.name} seed {settings['seed']}")
     try:
-        return _run(spec, settings, (context or {}).get("video"), (context or {}).get("record"))
+        outputs = context or {}
+        return _run(spec, settings, outputs.get("video"), outputs.get("record"), outputs.get("state_log"))
     finally:
         if _hook is not None:
             _hook.close()
 
 
-def _run(spec: PuzzleSpec, settings: Mapping[str, Any], video: str | None, record: str | None = None) -> dict[str, Any]:
+def _run(
+    spec: PuzzleSpec,
+    settings: Mapping[str, Any],
+    video: str | None,
+    record: str | None = None,
+    state_log: str | None = None,
+) -> dict[str, Any]:
     memory = _memory(settings["memory"], settings["memory_sha256"]) if settings["memory"] else None
     name = settings["agent"]
     agent = make_agent_object(name) if is_agent_class_name(name) else None
@@ -115,7 +125,7 @@ def _run(spec: PuzzleSpec, settings: Mapping[str, Any], video: str | None, recor
             max_lockers=settings.get("max_lockers", 1), locks=settings.get("locks", "latch"),
         )  # fmt: skip
         return run_trial_of(spec, config, agent=agent, memory=memory, video=video, recording=record,
-                         on_action=_on_action).to_dict()  # fmt: skip
+                         on_action=_on_action, state_log=state_log).to_dict()  # fmt: skip
     config = TrialConfig(sim="symbolic", agent=name, seed=settings["seed"], max_actions=settings["max_actions"],
                          checkpoint=settings["checkpoint"], max_lockers=settings.get("max_lockers", 1))  # fmt: skip
     return run_trial_of(spec, config, agent=agent, memory=memory, on_action=_on_action).to_dict()

@@ -33,13 +33,15 @@ def run_trial(
     on_action: Callable[[Any], None] | None = None,
     cell: TwinCell | RealCell | None = None,
     on_record: Callable[[dict[str, Any]], None] | None = None,
+    state_log: str | Path | None = None,
 ) -> TrialRecord:
     """One trial of ``agent`` on ``spec`` under ``config`` (default :class:`TrialConfig`: the twin, ``ideal``).
 
     ``agent``: any object with the ``puzzlebox.learning.Agent`` methods (default: the registered agent
     ``config.agent``, made for this spec; the memory agent reads ``memory``, or the file ``config.memory``).
     ``observers`` see every reading, wait and action of a twin trial (:mod:`puzzlebox.lab.observers`) without
-    changing it. ``video`` (MP4) and ``recording`` (Rerun ``.rrd``) are written there, twin only.
+    changing it. ``video`` (MP4), ``recording`` (Rerun ``.rrd``) and ``state_log`` (the state at every control
+    tick, ``.npz``: :mod:`puzzlebox.lab.state_log`) are written there, twin only.
     ``on_action`` is called after every try with its :class:`~puzzlebox.learning.ActionRecord`.
     ``cell``: where the trial runs — a :class:`~puzzlebox.lab.cells.TwinCell` (its profile and calibration
     replace ``config.reality`` and ``config.calibration``) or a :class:`~puzzlebox.lab.cells.RealCell` (the arm
@@ -51,14 +53,16 @@ def run_trial(
     if memory is None and agent is None and config.memory is not None:
         memory = MemoryStore.open_existing(config.memory)
     if isinstance(cell, RealCell):
-        if video is not None or recording is not None:
-            raise TrialConfigError("a video or a recording is of a twin trial: a real cell has no simulator to draw")
+        if video is not None or recording is not None or state_log is not None:
+            raise TrialConfigError(
+                "a video, a recording or a state log is of a twin trial: a real cell has no simulator to draw"
+            )
         return _run_real(spec, config, cell, agent, memory, observers, on_action, on_record)
     if isinstance(cell, TwinCell):
         if config.sim != "twin":
             raise TrialConfigError("a TwinCell is the twin's: TrialConfig(sim='twin')")
         config = dataclasses.replace(config, reality=cell.profile, calibration=cell.calibration)
-    record = _run_sim(spec, config, agent, memory, observers, video, recording, on_action)
+    record = _run_sim(spec, config, agent, memory, observers, video, recording, on_action, state_log)
     if on_record is not None:
         on_record(record.to_dict())
     return record
@@ -73,16 +77,17 @@ def _run_sim(
     video: str | Path | None,
     recording: str | Path | None,
     on_action: Callable[[Any], None] | None,
+    state_log: str | Path | None = None,
 ) -> TrialRecord:
     if config.sim == "twin":
         from puzzlebox.lab.twin_trial import run_twin_trial  # MuJoCo and rendering only when asked
 
         return run_twin_trial(
             spec, config, agent, memory, observers, None if video is None else Path(video),
-            None if recording is None else Path(recording), on_action,
+            None if recording is None else Path(recording), on_action, None if state_log is None else Path(state_log),
         )  # fmt: skip
-    if video is not None or recording is not None:
-        raise TrialConfigError("a video or a recording is of a twin trial (sim='twin')")
+    if video is not None or recording is not None or state_log is not None:
+        raise TrialConfigError("a video, a recording or a state log is of a twin trial (sim='twin')")
     if agent is None:
         checkpoint = None if config.checkpoint is None else str(config.checkpoint)
         agent = make_agent(config.agent, spec, memory, checkpoint, max_lockers=config.max_lockers)

@@ -84,8 +84,9 @@ def twin_trial_figures(quick: bool) -> dict[str, float]:
 
 def rollout_figures(quick: bool) -> dict[str, float]:
     """Wall time of the same oracle twin trial (first paper test box, ideal cell) plain, with ``--video`` (the
-    multi-view rollout, drawn in a second process) and with ``--record`` (a Rerun recording), in turn after a
-    warm-up trial, ``repeats`` times each: medians and the ratios to plain (targets x1.5 and x1.3)."""
+    multi-view rollout, drawn in a second process), with ``--record`` (a Rerun recording) and with ``--state-log``
+    (the state at every control tick, :mod:`puzzlebox.lab.state_log`), in turn after a warm-up trial, ``repeats``
+    times each: medians and the ratios to plain (targets x1.5, x1.3 and x1.05), and the state log's size."""
     import tempfile
 
     from puzzlebox.lab import TrialConfig, run_trial
@@ -93,7 +94,8 @@ def rollout_figures(quick: bool) -> dict[str, float]:
 
     spec = paper_family("test")[0]
     repeats = 1 if quick else 3
-    walls: dict[str, list[float]] = {"plain": [], "video": [], "record": []}
+    walls: dict[str, list[float]] = {"plain": [], "video": [], "record": [], "state_log": []}
+    log_bytes: list[int] = []
     with tempfile.TemporaryDirectory() as tmp:
         run_trial(
             spec, TrialConfig(agent="oracle", seed=0, max_actions=30)
@@ -102,14 +104,20 @@ def rollout_figures(quick: bool) -> dict[str, float]:
             for label in walls:
                 video = Path(tmp, f"v{k}.mp4") if label == "video" else None
                 record = Path(tmp, f"r{k}.rrd") if label == "record" else None
+                states = Path(tmp, f"s{k}.npz") if label == "state_log" else None
                 start = time.perf_counter()
                 run_trial(
-                    spec, TrialConfig(agent="oracle", seed=0, max_actions=30), video=video, recording=record
-                ).to_dict()
+                    spec, TrialConfig(agent="oracle", seed=0, max_actions=30), video=video, recording=record,
+                    state_log=states,
+                ).to_dict()  # fmt: skip
                 walls[label].append(time.perf_counter() - start)
+                if states is not None:
+                    log_bytes.append(states.stat().st_size)
     out = {f"{label}_wall_s": float(np.median(times)) for label, times in walls.items()}
     out["video_over_plain"] = out["video_wall_s"] / out["plain_wall_s"]
     out["record_over_plain"] = out["record_wall_s"] / out["plain_wall_s"]
+    out["state_log_over_plain"] = out["state_log_wall_s"] / out["plain_wall_s"]
+    out["state_log_bytes"] = int(np.median(log_bytes))
     out["repeats"] = repeats
     return out
 

@@ -15,6 +15,7 @@ from puzzlebox.lab.narrated_world import NarratedWorld
 from puzzlebox.lab.observers import ObservedRobot, PeakWristForce, SensedDigest, TrialContext, TrialObserver
 from puzzlebox.lab.process_memory import release_freed_memory
 from puzzlebox.lab.rollout_observers import RecordingDetector, RerunRecording, RolloutVideo, scene_cameras
+from puzzlebox.lab.state_log import StateLog
 from puzzlebox.lab.trial_config import TrialConfig
 from puzzlebox.lab.trial_record import TrialRecord
 from puzzlebox.learning import Agent, RunResult, make_agent, run_episode
@@ -116,11 +117,14 @@ def run_twin_trial(
     video: Path | None = None,
     recording: Path | None = None,
     on_action: Callable[[Any], None] | None = None,
+    state_log: Path | None = None,
 ) -> TrialRecord:
     """One end-to-end twin trial of ``agent`` (default: ``config.agent`` made for the spec, with ``memory``):
     the record, with a ``timeline``. ``video``: an MP4 of the rollout written there; ``recording``: a Rerun
-    recording (``.rrd``); both are published when the trial ends and discarded if it raises. ``observers`` see
-    every reading, wait and action; ``on_action`` is called after every try (a progress bar)."""
+    recording (``.rrd``); ``state_log``: the trial's state at every control tick (``.npz``,
+    :mod:`puzzlebox.lab.state_log`); each is published when the trial ends and discarded if it raises.
+    ``observers`` see every reading, command, wait and action; ``on_action`` is called after every try (a
+    progress bar)."""
     wall = time.perf_counter()
     with twin_session(spec, config) as session:
         spec = session.spec  # placed by the profile, if it places boxes
@@ -138,7 +142,8 @@ def run_twin_trial(
                 if recording is not None:
                     rrd = outputs.enter_context(TrialRecording(recording, f"{spec.name}-seed{seed}"))
                     watching.append(RerunRecording(session, rrd, detector))
-            watching += [peak, digest, *observers]
+            states = StateLog(session, spec.name, seed) if state_log is not None else None
+            watching += [peak, digest, *observers, *([states] if states is not None else [])]
             robot = ObservedRobot(session.robot, watching)
             trial = TrialContext(spec, seed, session)
             world = None
@@ -164,6 +169,8 @@ def run_twin_trial(
                                    ended=f"{type(err).__name__}: {err}")  # fmt: skip
             for observer in watching:
                 observer.finish()
+            if states is not None and state_log is not None:
+                states.save(state_log)
         sim_time = session.time
         box_pose = tuple(session.box_pose)
         reality = session.reality.name

@@ -333,3 +333,21 @@ def test_a_twin_trial_told_a_wrong_kind_finds_it_within_the_force_margin(tmp_pat
     (tried,) = [a for a in entry["timeline"] if a["component"] == "slide-3"]
     assert tried["tried_kinds"] == ["slide"] and tried["moved"] and tried["true_moved"]
     assert entry["peak_true_wrist_force_n"] <= 45.0
+
+
+def test_state_log_writes_each_twin_run_s_states_beside_its_record(tmp_path):
+    from puzzlebox.lab.state_log import load_state_log
+    from puzzlebox.models import save_spec
+    from puzzlebox.models.generator import generate_chain
+
+    spec = save_spec(generate_chain(["slide", "wheel"], seed=1), tmp_path / "chain.json")
+    common = ["--specs", spec, "--runs", 2, "--seed", 0, "--max-actions", 1, "--agent", "oracle"]
+    symbolic = run(ROOT / "scripts/trial.py", *common, "--sim", "symbolic", "--out", tmp_path / "s", "--state-log")
+    assert symbolic.returncode == 2 and "--state-log needs --sim twin" in symbolic.stderr
+    out = tmp_path / "t"
+    twin = run(ROOT / "scripts/trial.py", *common, "--sim", "twin", "--out", out, "--state-log", "--workers", 1)
+    assert twin.returncode == 0, twin.stderr
+    runs = sorted(p.stem for p in (out / "runs").glob("*.json"))
+    assert sorted(p.stem for p in (out / "states").glob("*.npz")) == runs and len(runs) == 2
+    log, meta = load_state_log(out / "states" / f"{runs[1]}.npz")
+    assert meta["seed"] == 1 and log["action"][-1] == 0 and len(log["time"]) > 100
