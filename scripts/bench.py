@@ -1,6 +1,6 @@
 """Speed figures, measured in one run on this machine (ratios matter more than absolutes here).
 
-    python scripts/bench.py --out FILE [--quick] [--scale-trials T] [--only manipulation|soak] [--trials T]
+    python scripts/bench.py --out FILE [--quick] [--scale-trials T] [--only manipulation|soak|outputs] [--trials T]
 
 - agent decision latency: median and 90th percentile milliseconds per dual-controller decision on
   random lock graphs of N = 5, 10, 16, 32 components (beliefs as they evolve during real episodes;
@@ -14,9 +14,9 @@
   their ratio; overview render time per 640x480 frame without and with shadows;
 - twin trial: simulated/wall time of one oracle twin trial on a paper test box (ideal cell, no video), the
   first in the process (renderer, scene and IK model built) and a second one (kept from the first);
-- twin trial outputs: wall time of the same oracle trial plain, with ``--video``, with ``--record`` and with
-  ``--state-log``, in turn (medians of 3), and the ratios to plain (and the state log's size); the rollout views'
-  box visibility over every frame of 5 trials;
+- twin trial outputs (``--only outputs``: these alone): wall time of the same oracle trial plain, with ``--video``,
+  with ``--record`` and with ``--state-log``, in turn (medians of 3), and the ratios to plain (and the state log's
+  size); the rollout views' box visibility over every frame of 5 trials;
 - manipulation (``puzzlebox/lab/manipulation_speed.py``): ``BoxManipulation-v0`` control steps per second (state
   observations) beside bare ``mj_step`` replaying the same run (the same simulated time), with their ratio, and
   ``make_vec`` async with 2 workers against 1 (``--only manipulation``: these figures alone);
@@ -45,6 +45,7 @@ from puzzlebox.lab.bench_figures import (  # noqa: E402
     default_scale_trials,
     manipulation_figures,
     measured_figures,
+    output_figures,
     scale_figures,
 )
 from puzzlebox.lab.bench_soak import SoakConfig, SoakPoint, soak_points, soak_verdict  # noqa: E402
@@ -82,7 +83,7 @@ def main(argv: list[str] | None = None) -> int:
         "--scale-trials", type=int, default=None,
         help="twin trials per executor for the scale figures (default 40; --quick 4; 0 skips them)",
     )  # fmt: skip
-    parser.add_argument("--only", choices=("manipulation", "soak"), help="measure these figures alone")
+    parser.add_argument("--only", choices=("manipulation", "soak", "outputs"), help="measure these figures alone")
     parser.add_argument("--trials", type=int, default=None, help="twin trials of the soak (--only soak; default 200)")
     args = parser.parse_args(argv)
     if args.scale_trials is not None and not 0 <= args.scale_trials <= MAX_SCALE_TRIALS:
@@ -99,7 +100,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"-> {path}")
         lock.release()
         return 0
-    for figure in manipulation_figures(args.quick) if args.only else measured_figures(args.quick):
+    only = {"manipulation": manipulation_figures, "outputs": output_figures}.get(args.only or "", measured_figures)
+    for figure in only(args.quick):
         figure.keep(results)
         for line in figure.lines:
             print(line)

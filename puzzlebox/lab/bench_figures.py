@@ -89,6 +89,18 @@ def measured_figures(quick: bool) -> Iterator[Figure]:
             if f"{label}_sim_s" in trial
         )
     ])  # fmt: skip
+    yield from output_figures(quick)
+    seen = box_visibility_figures(quick)
+    yield Figure(("box_visibility",), seen, [
+        f"rollout views: over {seen['frames']} frames of {seen['trials']} trials the best view showed at least "
+        f"{seen['worst_frame_best_view']:.1%} of the box ({seen['frames_below_0.9']} frames below 90 %)"
+    ])  # fmt: skip
+    yield from manipulation_figures(quick)
+
+
+def output_figures(quick: bool) -> Iterator[Figure]:
+    """The twin trial's outputs (video, Rerun recording, state log) against the plain trial (``--only outputs``:
+    this figure alone)."""
     rollout = rollout_figures(quick)
     yield Figure(("rollout",), rollout, [
         f"twin trial outputs (oracle, ideal, median of {rollout['repeats']}): plain {rollout['plain_wall_s']:.2f} s, "
@@ -97,12 +109,6 @@ def measured_figures(quick: bool) -> Iterator[Figure]:
         f"{rollout['state_log_wall_s']:.2f} s (x{rollout['state_log_over_plain']:.3f}, "
         f"{rollout['state_log_bytes'] / 1e6:.2f} MB)"
     ])  # fmt: skip
-    seen = box_visibility_figures(quick)
-    yield Figure(("box_visibility",), seen, [
-        f"rollout views: over {seen['frames']} frames of {seen['trials']} trials the best view showed at least "
-        f"{seen['worst_frame_best_view']:.1%} of the box ({seen['frames_below_0.9']} frames below 90 %)"
-    ])  # fmt: skip
-    yield from manipulation_figures(quick)
 
 
 def manipulation_figures(quick: bool) -> Iterator[Figure]:
