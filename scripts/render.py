@@ -4,6 +4,11 @@ alone with its lock features (twin.gallery).
 
     python scripts/render.py SPEC --out DIR [--camera NAME] [--video] [--seed S]
     python scripts/render.py SPEC --out DIR [--views] [--turntable [--frames N] [--fps F]]
+    python scripts/render.py replay LOG.npz --out FILE.mp4 [--period S] [--fps F]
+
+``replay`` draws a twin trial's rollout video from its state log (``trial.py --state-log``: ``DIR/states/<run>.npz``)
+without its physics: the frames the trial would have drawn live with ``--video`` (at ``--period 0.1`` simulated
+seconds apart, the default), or as many as another ``--period`` asks, played at ``--fps``.
 
 Writes ``DIR/<camera>.png`` (and ``DIR/sweep.mp4``, ``DIR/sweep.json``); or ``DIR/top.png``,
 ``DIR/three-quarter.png``, ``DIR/component-<name>.png``, the annotated ``DIR/top-annotated.png`` and
@@ -15,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -31,7 +37,36 @@ from puzzlebox.twin.session import TwinSession
 from puzzlebox.twin.video import VideoWriter
 
 
+def replay(argv: list[str]) -> int:
+    """``render.py replay LOG.npz --out FILE.mp4 [--period S] [--fps F]`` (module docstring)."""
+    from puzzlebox.lab.replay_video import replay_video
+    from puzzlebox.twin.rollout_video import RolloutConfig, VideoError
+
+    parser = OneLineParser(prog="render.py replay", description="Draw a twin trial's rollout video from its state log.")
+    parser.add_argument("log", help="a state log (trial.py --state-log: DIR/states/<run>.npz)")
+    parser.add_argument("--out", required=True, help="the MP4 file to write")
+    parser.add_argument("--period", type=float, default=0.1, help="simulated time between frames [s] (default 0.1)")
+    parser.add_argument("--fps", type=float, default=30.0, help="playback rate [frames/s] (default 30)")
+    args = parser.parse_args(argv)
+    if not 0.01 <= args.period <= 60.0 or not 0 < args.fps <= 1000:
+        fail(f"--period must be in [0.01, 60] s and --fps in (0, 1000], got {args.period} and {args.fps}")
+    out = Path(args.out)
+    if out.suffix.lower() != ".mp4":
+        fail(f"--out {out}: the video is an MP4 file (.mp4)")
+    if not Path(args.log).is_file():
+        fail(f"{args.log}: no such state log")
+    try:
+        frames = replay_video(args.log, out, RolloutConfig(period=args.period, fps=args.fps))
+    except (ValueError, OSError, VideoError, TwinError, SpecError) as err:
+        fail(f"{args.log}: {one_line(err)}")
+    print(f"{frames} frames -> {out}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["replay"]:
+        return replay(argv[1:])
     parser = OneLineParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("spec", help="puzzle spec file")
     parser.add_argument("--out", required=True, help="output directory")

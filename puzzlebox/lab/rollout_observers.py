@@ -5,19 +5,18 @@ marker detections (:class:`RecordingDetector`). Neither senses anything: the tri
 
 from __future__ import annotations
 
-import collections
 import math
 from collections.abc import Callable
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from puzzlebox.lab.observers import TrialContext, TrialObserver
+from puzzlebox.lab.rollout_frames import FrameMaker
 from puzzlebox.models.kinds import get_kind
 from puzzlebox.skills import MarkerDetector
 from puzzlebox.twin.rerun_log import TrialRecording
-from puzzlebox.twin.rollout_video import BackgroundRollout, Caption, Look, RolloutFrame, SceneCameras
+from puzzlebox.twin.rollout_video import BackgroundRollout, Caption, Look, SceneCameras
 from puzzlebox.twin.session import TwinSession
 
 __all__ = ["RecordingDetector", "RerunRecording", "RolloutVideo", "agent_belief", "scene_cameras"]
@@ -75,25 +74,18 @@ def agent_belief(agent: Any) -> np.ndarray | None:
 
 class RolloutVideo(TrialObserver):
     """Hands a :class:`~puzzlebox.twin.rollout_video.RolloutFrame` to the background drawer every
-    ``RolloutConfig.period`` of simulated time: the joint positions, the caption of the action under way and the
-    part it tries, the looks the pipeline took since the previous frame (what ``detector`` found, with the state
-    at each capture: the frame draws them on that state, and no later frame draws them) and the recent wrist
-    force the primitives sensed. Drawing happens in the other process."""
+    ``RolloutConfig.period`` of simulated time (:class:`puzzlebox.lab.rollout_frames.FrameMaker`: the joint
+    positions, the caption of the action under way and the part it tries, the looks the pipeline took since the
+    previous frame, what ``detector`` found, with the state at each capture, and the recent wrist force the
+    primitives sensed). Drawing happens in the other process."""
 
     def __init__(self, session: TwinSession, rollout: BackgroundRollout, detector: RecordingDetector) -> None:
         self._session, self._rollout = session, rollout
-        self._period = rollout.config.period
-        self._window = rollout.config.plot_window
-        self._next = 0.0
-        self._caption = Caption()
-        self._part = ""
-        self._parts = [c.name for c in session.spec.components]
+        self._frames = FrameMaker([c.name for c in session.spec.components], rollout.config.period,
+                                  rollout.config.plot_window)  # fmt: skip
         self._world: Any = None
-        self._forces: collections.deque[tuple[float, float]] = collections.deque()
         self._captured: dict[str, tuple[float, np.ndarray]] = {}
         """Camera -> time and joint positions of its latest capture."""
-        self._looks: dict[str, Look] = {}
-        """Camera -> its latest look since the last frame."""
         detector.listeners.append(self._look)
 
     def sensed(self, what: str, value: Any) -> None:
@@ -103,42 +95,30 @@ class RolloutVideo(TrialObserver):
     def _look(self, camera: str, time: float, found: list[tuple[int, np.ndarray]]) -> None:
         captured = self._captured.get(camera)
         qpos = captured[1] if captured is not None and captured[0] == time else None
-        self._looks[camera] = Look(time, found, qpos)
+        self._frames.look(camera, Look(time, found, qpos))
 
     def attach(self, trial: TrialContext) -> None:
         self._world = trial.world
 
     def waited(self, now: float) -> None:
-        if self._world is not None:
-            force_in_base = self._world.toggler.force_in_base
-            self._forces.append((now, math.sqrt(force_in_base @ force_in_base)))
-            while self._forces and self._forces[0][0] < now - self._window:
-                self._forces.popleft()
-        while self._next <= now:  # a frame per grid time 0, period, 2 period, ... this wait passed: the state
-            self._frame(self._next)  # at its end (a 10 ms control tick; a look or a settle waits up to ~1 s)
-            self._next += self._period
+        world = self._world
+        force = None
+        if world is not None:
+            force_in_base = world.toggler.force_in_base
+            force = math.sqrt(force_in_base @ force_in_base)
+        phase = "surveying" if world is None else world.toggler.phase
+        for frame in self._frames.waited(now, self._session.data.qpos, force, phase):
+            self._rollout.add(frame)
 
     def action_begins(self, caption: Caption) -> None:
-        self._caption = caption
-        # the caption names the part "<spec name> (<kind>)"
-        self._part = next((p for p in self._parts if caption.component.startswith(f"{p} (")), "")
+        self._frames.action_begins(caption)
 
     def action_ended(self, caption: Caption) -> None:
-        self._caption = caption
-        self._part = ""
+        self._frames.action_ended(caption)
 
-    def finish(self) -> None:
-        self._frame(self._session.time)  # the last frame, whatever the time: how the last action ended
-
-    def _frame(self, now: float) -> None:
+    def finish(self) -> None:  # the last frame, whatever the time: how the last action ended
         phase = "surveying" if self._world is None else self._world.toggler.phase
-        looks, self._looks = self._looks, {}  # each look on the first frame after it, and on no other
-        self._rollout.add(
-            RolloutFrame(
-                time=now, qpos=self._session.data.qpos.copy(), caption=replace(self._caption, phase=phase),
-                looks=looks, forces=np.array(self._forces, dtype=float).reshape(-1, 2), highlight=self._part,
-            )
-        )  # fmt: skip
+        self._rollout.add(self._frames.frame(self._session.time, self._session.data.qpos, phase))
 
 
 class RerunRecording(TrialObserver):

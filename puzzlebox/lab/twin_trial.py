@@ -15,7 +15,7 @@ from puzzlebox.lab.narrated_world import NarratedWorld
 from puzzlebox.lab.observers import ObservedRobot, PeakWristForce, SensedDigest, TrialContext, TrialObserver
 from puzzlebox.lab.process_memory import release_freed_memory
 from puzzlebox.lab.rollout_observers import RecordingDetector, RerunRecording, RolloutVideo, scene_cameras
-from puzzlebox.lab.state_log import StateLog
+from puzzlebox.lab.state_log import StateLog, scene_of
 from puzzlebox.lab.trial_config import TrialConfig
 from puzzlebox.lab.trial_record import TrialRecord
 from puzzlebox.learning import Agent, RunResult, make_agent, run_episode
@@ -126,6 +126,7 @@ def run_twin_trial(
     ``observers`` see every reading, command, wait and action; ``on_action`` is called after every try (a
     progress bar)."""
     wall = time.perf_counter()
+    scene = scene_of(spec, config) if state_log is not None else None  # (the spec as given: placed alike again)
     with twin_session(spec, config) as session:
         spec = session.spec  # placed by the profile, if it places boxes
         seed = config.seed
@@ -134,7 +135,7 @@ def run_twin_trial(
         with contextlib.ExitStack() as outputs:
             watching: list[TrialObserver] = []
             detector = None
-            if video is not None or recording is not None:
+            if video is not None or recording is not None or scene is not None:
                 detector = RecordingDetector()
                 if video is not None:
                     rollout = outputs.enter_context(BackgroundRollout(video, session.model, scene_cameras(session)))
@@ -142,7 +143,7 @@ def run_twin_trial(
                 if recording is not None:
                     rrd = outputs.enter_context(TrialRecording(recording, f"{spec.name}-seed{seed}"))
                     watching.append(RerunRecording(session, rrd, detector))
-            states = StateLog(session, spec.name, seed) if state_log is not None else None
+            states = StateLog(session, scene, detector) if scene is not None else None
             watching += [peak, digest, *observers, *([states] if states is not None else [])]
             robot = ObservedRobot(session.robot, watching)
             trial = TrialContext(spec, seed, session)
@@ -169,7 +170,7 @@ def run_twin_trial(
                                    ended=f"{type(err).__name__}: {err}")  # fmt: skip
             for observer in watching:
                 observer.finish()
-            if states is not None and state_log is not None:
+            if states is not None and state_log is not None:  # (not written if the trial raised)
                 states.save(state_log)
         sim_time = session.time
         box_pose = tuple(session.box_pose)

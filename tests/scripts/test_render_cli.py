@@ -75,3 +75,26 @@ def test_render_refuses_command_line_mistakes_on_one_line(tmp_path):
         assert result.returncode == 2, (args, result.stderr)
         lines = result.stderr.strip().splitlines()
         assert len(lines) == 1 and lines[0].startswith("error:") and expected in lines[0], (args, result.stderr)
+
+
+def test_replay_draws_a_logged_trial_s_rollout_without_its_physics_and_refuses_what_is_not_a_log(tmp_path):
+    from puzzlebox.lab import TrialConfig, run_trial
+    from puzzlebox.models.generator import generate_chain
+
+    log = tmp_path / "states" / "trial.npz"
+    record = run_trial(generate_chain(["slide", "wheel"], seed=1), TrialConfig(agent="oracle", seed=5, max_actions=1),
+                       state_log=log)  # fmt: skip
+    out = tmp_path / "replay.mp4"
+    result = run(ROOT / "scripts/render.py", "replay", log, "--out", out, "--period", "1.0", "--fps", "10")
+    assert result.returncode == 0, result.stderr
+    frames = int(result.stdout.split()[0])
+    assert frames == int(record.sim_time_s) + 2  # one a simulated second from 0, and the last
+    assert iio.imread(out).shape[0] == frames
+    not_a_log = tmp_path / "x.npz"
+    not_a_log.write_bytes(b"not an npz")
+    for bad, said in ((not_a_log, "x.npz"), (tmp_path / "missing.npz", "no such state log")):
+        refused = run(ROOT / "scripts/render.py", "replay", bad, "--out", tmp_path / "r.mp4")
+        assert refused.returncode == 2 and "Traceback" not in refused.stderr and said in refused.stderr
+        assert not (tmp_path / "r.mp4").exists()
+    wrong = run(ROOT / "scripts/render.py", "replay", log, "--out", tmp_path / "r.gif")
+    assert wrong.returncode == 2 and ".mp4" in wrong.stderr
