@@ -172,6 +172,8 @@ class ActionLog(ReadsItsResult):
     true_moved: bool | None = None
     tried_kinds: tuple[str, ...] = ()
     """The other kinds the part was tried as in this try, in order (``kind`` is the one in use after it)."""
+    opening: bool | None = None
+    """Whether the try was to open the part (True: from its closed state as the world believed it) or to close it."""
 
     def to_dict(self) -> dict[str, Any]:
         """The try as a record's ``timeline`` entry."""
@@ -180,6 +182,7 @@ class ActionLog(ReadsItsResult):
             "reason": self.reason, "moved": self.moved, "progress": self.progress, "peak_force": self.peak_force,
             "attempts": self.attempts, "sim_time": self.sim_time, "wall_time": self.wall_time,
             "true_moved": self.true_moved, "tried_kinds": self.tried_kinds, "cause": self.cause,
+            "opening": self.opening,
         }  # fmt: skip
 
 
@@ -297,6 +300,7 @@ class RobotWorld:
             ActionLog(
                 index, marker, kind_of(self.kinds, marker), outcome, result.progress, effort.peak, effort.attempts,
                 effort.sim_time, effort.wall_time, None if before is None else bool(before != after), tried,
+                bool(opening),
             )
         )  # fmt: skip
         return outcome

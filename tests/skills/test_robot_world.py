@@ -198,3 +198,14 @@ def test_a_door_left_raised_by_a_blocked_try_is_pushed_shut_from_where_it_is_see
     assert calls == [True, False] and at < 0.05 and peak < 45.0, (at, calls, peak)  # seen raised, pushed shut
     at, calls, _ = _door_after_a_blocked_try_leaving_it_at_a_quarter(shut=False)
     assert calls == [True] and at > 0.2, (at, calls)  # left raised
+
+
+def test_a_try_s_timeline_entry_says_whether_it_opened_or_closed_the_part():
+    # (a record did not say which way a part was tried)
+    spec = generate_chain(["slide", "wheel"], seed=1)  # the slide is free
+    with TwinSession(spec, seed=0) as session:
+        world = twin_world(session)
+        slide = world.markers.index(spec.components[0].marker)
+        assert world.try_toggle(slide).moved and world.try_toggle(slide).moved
+        assert [entry.to_dict()["opening"] for entry in world.log] == [True, False]
+        assert session.component_states()[0] == 0
