@@ -23,7 +23,8 @@ box alone (or with ``--with-robot`` in the whole scene), and compares what moved
 (``models.lock_check``), the parts not pushed resting at their end stops and at 10 % and 20 % of their travel inside
 their states' bands (the band check: the twin counts a part closed below 25 % and open above 75 %, and a locker
 anywhere there must hold or free as its state says; ``--stops-only``: at the stops alone): one line per box
-(transitions that agree, how far a held part moved at most [% of its travel], rules without a mechanism), one
+(transitions that agree, a held part's largest play, how far it went before its lock caught it [% of its travel;
+held: below 50 %], rules without a mechanism), one
 indented line per disagreement, then a total. Exit 1 if any transition disagrees, 2 if a spec is invalid (one line
 each) or a box cannot be built. ``--json FILE`` writes every box's result (moves as fractions of the travel).
 

@@ -137,9 +137,16 @@ def box_record(file: str, spec: PuzzleSpec, result: LockCheck, unrealized: list[
 
 
 def box_line(box: dict) -> str:
-    """A box's (or the total's) line: transitions that agree, how far a held part moved at most, rules without a
-    mechanism."""
+    """A box's (or the total's) line: transitions that agree, the largest play of a held part (how far it went before
+    its lock caught it: a part that went past ``HELD_FRACTION`` of its travel is no longer held, and its transition
+    disagrees), rules without a mechanism."""
+    from puzzlebox.models.lock_check import HELD_FRACTION  # (MuJoCo: the check has run)
+
     held = box["held_move_max"]
-    moved = "no part held" if held is None else f"held parts moved at most {100 * held:.1f} % of their travel"
+    moved = (
+        "no part held" if held is None
+        else f"a held part's play (before its lock caught it) up to {100 * held:.1f} % of its travel, "
+        f"held below {100 * HELD_FRACTION:.0f} %"
+    )  # fmt: skip
     agree = f"{box['agreeing']}/{box['total']} transitions agree"
     return f"{box['spec']}: {agree}; {moved}; {len(box['unrealized'])} rule(s) without a mechanism"
