@@ -82,7 +82,7 @@ loading), which would pinch a sliver of the union into edges of four faces."""
 _GREY = (0.5, 0.5, 0.5, 1.0)
 _JOINT = 1e-7
 """Capsule ends nearer than this [m] are one joint of a chain."""
-_JITTER = 1e-6
+UNION_JITTER = 1e-6
 """How far [m] each further chain of a mechanism part moves from its geoms (:func:`_mechanism_pieces`)."""
 _SKEWS = (np.array([0.28, 0.53, 0.8]), np.array([-0.62, 0.18, 0.76]), np.array([0.45, -0.71, 0.54]))
 """Directions in no plane of the lid frame's axes, added to a chain's own in its jitter, one per attempt."""
@@ -243,7 +243,7 @@ def _parts(spec: PuzzleSpec, lock_features: bool, locks: LockMode) -> list[_Part
         try:
             if name in pieces:
                 mesh = _solid(pieces[name])
-            else:  # a mechanism's chains are moved a little (_JITTER), each attempt otherwise
+            else:  # a mechanism's chains are moved a little (UNION_JITTER), each attempt otherwise
                 for attempt in range(len(_SKEWS)):
                     mesh = _solid(_mechanism_pieces(model, data, chains[mechanisms[name]], T_lid_world, attempt))
                     if mesh.is_watertight:
@@ -300,8 +300,8 @@ def _mechanism_pieces(
 ) -> list[tuple[trimesh.Trimesh, tuple]]:
     """A mechanism group's geoms as MuJoCo collides with them, in the export frame (``T``: world -> export):
     capsules joined end to end (a chain, in index order; a lone capsule is a chain of one) are one tube
-    (:func:`_tubes`; the k-th chain of the group moved by ``k (attempt + 1)`` :data:`_JITTER`), a mesh geom is
-    its convex hull (the k-th moved by ``(k + 1) attempt`` :data:`_JITTER` after the first attempt), any other geom
+    (:func:`_tubes`; the k-th chain of the group moved by ``k (attempt + 1)`` :data:`UNION_JITTER`), a mesh geom is
+    its convex hull (the k-th moved by ``(k + 1) attempt`` :data:`UNION_JITTER` after the first attempt), any other geom
     its :func:`geom_mesh`."""
     pieces: list[tuple[trimesh.Trimesh, tuple]] = []
     chain: list[np.ndarray] = []
@@ -314,11 +314,11 @@ def _mechanism_pieces(
         nonlocal made
         points = np.array(chain)
         # a wall's backing chains are copies of its axis chain, their rings in the same planes: each chain after
-        # the first moves by _JITTER more, mostly along itself, so no two rings are coplanar (the union of
+        # the first moves by UNION_JITTER more, mostly along itself, so no two rings are coplanar (the union of
         # near-coplanar rings leaves slivers that welding pinches)
         along = points[-1] - points[0]
         along = along / max(float(np.linalg.norm(along)), _JOINT) + _SKEWS[attempt]
-        shift = _JITTER * (attempt + 1) * made * along / np.linalg.norm(along)
+        shift = UNION_JITTER * (attempt + 1) * made * along / np.linalg.norm(along)
         pieces.extend((tube.apply_translation(shift), rgba) for tube in _tubes(points, radius))
         chain.clear()
         made += 1
@@ -349,7 +349,7 @@ def _mechanism_pieces(
             hull = trimesh.convex.convex_hull(vertices)
             if attempt:  # a row of teeth turned a little from one to the next: faces near-coplanar, as rings are
                 hull.apply_translation(
-                    _JITTER * attempt * (meshes + 1) * _SKEWS[attempt] / np.linalg.norm(_SKEWS[attempt])
+                    UNION_JITTER * attempt * (meshes + 1) * _SKEWS[attempt] / np.linalg.norm(_SKEWS[attempt])
                 )
             meshes += 1
             pieces.append((hull, tuple(model.geom_rgba[g])))

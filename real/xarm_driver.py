@@ -184,7 +184,7 @@ class XArmRobot:
         """4x4 TCP pose in the base frame [m], from the controller's kinematics."""
         x, y, z, roll, pitch, yaw = (float(v) for v in self._value("get_position", is_radian=True)[:6])
         T = np.eye(4)
-        T[:3, :3] = _rpy_matrix(roll, pitch, yaw)
+        T[:3, :3] = rpy_matrix(roll, pitch, yaw)
         T[:3, 3] = np.array([x, y, z]) / 1000.0  # the SDK reports [mm]
         return T
 
@@ -301,7 +301,7 @@ class XArmRobot:
         self.close()
 
 
-def _rpy_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
+def rpy_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
     """``Rz(yaw) @ Ry(pitch) @ Rx(roll)``: roll, pitch, yaw about the fixed base axes x, y, z [rad]."""
     cr, sr, cp, sp, cy, sy = (
         math.cos(roll),
@@ -320,4 +320,4 @@ def _rpy_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
     )
 
 
-__all__ = ["PROBE_TIMEOUT", "XARM7_JOINT_LIMITS", "XARM_CONTROL_PORT", "XArmRobot", "probe_controller"]
+__all__ = ["PROBE_TIMEOUT", "XARM7_JOINT_LIMITS", "XARM_CONTROL_PORT", "XArmRobot", "probe_controller", "rpy_matrix"]

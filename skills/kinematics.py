@@ -108,7 +108,7 @@ class ArmKinematics:
         closes, costs no IK); returns the arm joints and the position [m] and orientation [rad] errors left."""
         if not np.isfinite(T_base_tcp).all():
             raise IKFailure(f"IK target is not finite: {T_base_tcp}")
-        self.tcp.set_target(_se3(T_base_tcp))
+        self.tcp.set_target(se3(T_base_tcp))
         c = self.config
         position_error, orientation_error = self._errors()
         for _ in range(iterations):
@@ -153,7 +153,7 @@ class ArmKinematics:
         )
 
 
-def _se3(T: np.ndarray) -> mink.SE3:
+def se3(T: np.ndarray) -> mink.SE3:
     """``mink.SE3.from_matrix(T)`` (the same quaternion, from ``mju_mat2Quat``) without its Python layers."""
     wxyz_xyz = np.empty(7)
     mujoco.mju_mat2Quat(wxyz_xyz[:4], np.ascontiguousarray(T[:3, :3], dtype=np.float64).ravel())
@@ -172,4 +172,4 @@ def top_down(position: np.ndarray, yaw: float) -> np.ndarray:
     return T
 
 
-__all__ = ["ArmKinematics", "IKConfig", "top_down"]
+__all__ = ["ArmKinematics", "IKConfig", "se3", "top_down"]

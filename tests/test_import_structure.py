@@ -149,3 +149,14 @@ def test_every_third_party_package_the_library_imports_is_declared():
                 if not {d.lower().replace("_", "-") for d in dists} & declared:
                     undeclared.add(f"{path.relative_to(ROOT)}: {top} ({', '.join(dists)})")
     assert sorted(undeclared) == []
+
+
+def test_no_test_imports_a_private_name():
+    # (tests reached into modules for _median_rows, _se3, _snapshot...: what a test needs is a public name)
+    private = []
+    for path in ROOT.glob("tests/**/*.py"):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("puzzlebox"):
+                private += [f"{path.relative_to(ROOT)}: {node.module}.{a.name}" for a in node.names
+                            if a.name.startswith("_") and not a.name.startswith("__")]  # fmt: skip
+    assert private == []

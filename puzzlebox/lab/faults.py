@@ -161,7 +161,7 @@ def killed_trial(out: Path, config: FaultsConfig) -> FaultRow:
     )
 
 
-def _pool_workers(driver: int) -> list[int]:
+def pool_workers(driver: int) -> list[int]:
     """Process ids of the pool workers of process ``driver`` (its spawned children, not the resource tracker)."""
     workers = []
     for child in Path(f"/proc/{driver}/task/{driver}/children").read_text().split():
@@ -190,7 +190,7 @@ def killed_worker(out: Path, config: FaultsConfig) -> FaultRow:
                                 stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)  # fmt: skip
         workers: list[int] = []
         while proc.poll() is None and not (len(list((target / "runs").glob("*.json"))) >= at and workers):
-            workers = _pool_workers(proc.pid)
+            workers = pool_workers(proc.pid)
             time.sleep(0.01)
         if workers and proc.poll() is None:
             os.kill(workers[0], signal.SIGKILL)

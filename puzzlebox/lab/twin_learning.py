@@ -147,7 +147,7 @@ class TwinLearningConfig:
         return dataclasses.replace(self, eval_seed=seed, train_seed=seed + 10000)
 
 
-def _snapshot(store_path: Path, target: Path) -> None:
+def snapshot_memory(store_path: Path, target: Path) -> None:
     """A consistent copy of the SQLite memory at ``store_path``, written to ``target`` atomically."""
     fd, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     os.close(fd)
@@ -178,7 +178,7 @@ def _provenance(store: MemoryStore) -> dict[str, Any]:
     return cast("dict[str, Any]", store.provenance())
 
 
-def _checkpoint(copy: Path, hours: float) -> dict[str, Any]:
+def checkpoint_entry(copy: Path, hours: float) -> dict[str, Any]:
     """The record of the checkpoint at ``hours`` [h] whose memory is ``copy``: what that copy holds (a chain resumed
     after its copy was taken has a store that has grown since)."""
     store = MemoryStore.open_existing(copy)
@@ -226,8 +226,8 @@ def training_chain(settings: dict[str, Any], context: dict[str, Any]) -> dict[st
                     skipped.append({"episode": e, "spec": spec.name, "ended": result.ended})
             target = folder / f"{start}-s{seed}@{h:g}h.sqlite"
             if not target.exists():
-                _snapshot(path, target)
-            checkpoints.append(_checkpoint(target, h))
+                snapshot_memory(path, target)
+            checkpoints.append(checkpoint_entry(target, h))
         log = store.training_log()  # each run's "episodes": a list
     finally:
         store.close()

@@ -83,7 +83,7 @@ def test_the_quick_fault_suite_detects_survives_and_keeps_every_case(tmp_path):
 
 
 def test_a_killed_pool_worker_is_replaced_and_no_run_is_lost(specs, tmp_path):
-    from puzzlebox.lab.faults import _pool_workers
+    from puzzlebox.lab.faults import pool_workers
 
     def trial(out, *flags):
         return [sys.executable, ROOT / "scripts/trial.py", "--specs", *sorted(specs.glob("*.json")), "--sim",
@@ -96,7 +96,7 @@ def test_a_killed_pool_worker_is_replaced_and_no_run_is_lost(specs, tmp_path):
     )
     workers: list[int] = []
     while proc.poll() is None and not workers:
-        workers = _pool_workers(proc.pid)
+        workers = pool_workers(proc.pid)
         time.sleep(0.01)
     time.sleep(0.5)  # let it record a few runs
     assert proc.poll() is None, "the trial ended before a worker could be killed"

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from puzzlebox.lab.twin_learning import _snapshot
+from puzzlebox.lab.twin_learning import snapshot_memory
 from puzzlebox.learning.memory import MemoryStore
 from puzzlebox.models.atomic import current_umask, write_text_atomically
 from puzzlebox.twin.video import VideoWriter
@@ -42,7 +42,7 @@ def test_atomic_writes_videos_and_memory_files_follow_the_umask(umask, tmp_path)
     store = MemoryStore(tmp_path / "mem.sqlite")
     store.close()
     assert mode(tmp_path / "mem.sqlite") == expected
-    _snapshot(tmp_path / "mem.sqlite", tmp_path / "snapshot.sqlite")
+    snapshot_memory(tmp_path / "mem.sqlite", tmp_path / "snapshot.sqlite")
     assert mode(tmp_path / "snapshot.sqlite") == expected
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary left behind
 

@@ -21,9 +21,9 @@ import trimesh
 from puzzlebox.models.generator import RandomGraphConfig, generate_random, paper_family
 from puzzlebox.models.mechanism_mjcf import mechanism_layout
 from puzzlebox.models.mesh_export import (
-    _JITTER,
     BOX_PART,
     SAGITTA,
+    UNION_JITTER,
     MeshExportError,
     component_meshes,
     export_meshes,
@@ -311,10 +311,10 @@ def test_a_one_way_latch_exports_its_tooth_and_its_lug():
     meshes = component_meshes(spec, lock_features=False)
     assert list(meshes) == [BOX_PART, "door-a", "slide-b", "door-a-latches-slide-b-lug", "door-a-latches-slide-b-tooth"]
     assert_matches(meshes, expected, "latch")
-    # convex meshes both; a part whose union failed is exported again, each hull moved by _JITTER times the
+    # convex meshes both; a part whose union failed is exported again, each hull moved by UNION_JITTER times the
     # attempt (2 at most) times one more than the meshes before it (the teeth and the lug)
     meshes_in_box = len(mechanism_layout(spec).latches[0].tooth_shifts) + 1
-    jitter = 2 * _JITTER * (meshes_in_box + 1)
+    jitter = 2 * UNION_JITTER * (meshes_in_box + 1)
     for name in ("door-a-latches-slide-b-lug", "door-a-latches-slide-b-tooth"):
         assert np.abs(meshes[name].bounds - [expected[name].lo, expected[name].hi]).max() <= GROW + jitter, name
 

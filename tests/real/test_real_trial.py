@@ -18,7 +18,7 @@ from puzzlebox.models.cell_config import EXAMPLE, CellConfig, save_cell_config
 from puzzlebox.models.generator import paper_family
 from puzzlebox.models.spec import save_spec
 from puzzlebox.real import XArmRobot
-from puzzlebox.real.xarm_driver import XARM7_JOINT_LIMITS, _rpy_matrix
+from puzzlebox.real.xarm_driver import XARM7_JOINT_LIMITS, rpy_matrix
 from puzzlebox.scripts import trial
 from puzzlebox.skills.errors import MarkersNotFound
 from puzzlebox.skills.perception import MarkerDetector, PerceptionConfig
@@ -96,8 +96,8 @@ def test_the_double_gives_the_twins_readings_in_the_sdks_units_and_frames():
         assert np.linalg.norm(robot.wrench()[:3]) < 0.05
         image = robot.capture(cell.overview_camera)
         np.testing.assert_array_equal(image.rgb, twin.capture(cell.overview_camera).rgb)
-    R = _rpy_matrix(0.3, -0.4, 2.5)
-    np.testing.assert_allclose(_rpy_matrix(*rpy_of(R)), R, atol=1e-12)
+    R = rpy_matrix(0.3, -0.4, 2.5)
+    np.testing.assert_allclose(rpy_matrix(*rpy_of(R)), R, atol=1e-12)
     assert "emergency_stop" not in sdk.calls
 
 

@@ -12,9 +12,9 @@ import numpy as np
 from dm_control import mjcf
 
 from puzzlebox.models.xarm7 import build_xarm7
-from puzzlebox.skills.force_watch import _median_rows
+from puzzlebox.skills.force_watch import median_rows
 from puzzlebox.skills.joint_model import cross
-from puzzlebox.skills.kinematics import ArmKinematics, _se3, top_down
+from puzzlebox.skills.kinematics import ArmKinematics, se3, top_down
 
 
 def test_the_velocity_qp_gives_mink_solve_iks_velocities_with_and_without_binding_limits():
@@ -88,7 +88,7 @@ def test_the_target_pose_is_minks_from_matrix():
         T = top_down(rng.normal(size=3), rng.uniform(-np.pi, np.pi))
         if i % 2:
             T[:3, :3] = T[:3, :3] @ mink.SO3.exp(rng.normal(size=3)).as_matrix()
-        np.testing.assert_array_equal(_se3(T).wxyz_xyz, mink.SE3.from_matrix(T).wxyz_xyz)
+        np.testing.assert_array_equal(se3(T).wxyz_xyz, mink.SE3.from_matrix(T).wxyz_xyz)
 
 
 def test_the_force_median_and_cross_products_are_numpys_bit_for_bit():
@@ -96,6 +96,6 @@ def test_the_force_median_and_cross_products_are_numpys_bit_for_bit():
     for n in range(1, 7):
         for _ in range(300):
             rows = collections.deque(rng.normal(size=(n, 3)) * rng.uniform(0, 100), maxlen=5)
-            np.testing.assert_array_equal(_median_rows(rows), np.median(rows, axis=0))
+            np.testing.assert_array_equal(median_rows(rows), np.median(rows, axis=0))
     for a, b in rng.normal(size=(2000, 2, 3)) * 10:
         np.testing.assert_array_equal(cross(a, b), np.cross(a, b))
