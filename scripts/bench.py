@@ -1,6 +1,7 @@
 """Speed figures, measured in one run on this machine (ratios matter more than absolutes here).
 
-    python scripts/bench.py --out FILE [--quick] [--scale-trials T] [--only manipulation|soak|outputs] [--trials T]
+    python scripts/bench.py --out FILE [--quick] [--scale-trials T] [--only manipulation|soak|outputs|locks]
+                            [--trials T]
 
 - agent decision latency: median and 90th percentile milliseconds per dual-controller decision on
   random lock graphs of N = 5, 10, 16, 32 components (beliefs as they evolve during real episodes;
@@ -17,6 +18,8 @@
 - twin trial outputs (``--only outputs``: these alone): wall time of the same oracle trial plain, with ``--video``,
   with ``--record`` and with ``--state-log``, in turn (medians of 3), and the ratios to plain (and the state log's
   size); the rollout views' box visibility over every frame of 5 trials;
+- lock check (``--only locks``: these alone): ``generate.py check-locks``'s band check on the 12 paper boxes, push
+  after push against every push of a box as one ``mujoco.batch`` batch: times, ratio, whether identical;
 - manipulation (``puzzlebox/lab/manipulation_speed.py``): ``BoxManipulation-v0`` control steps per second (state
   observations) beside bare ``mj_step`` replaying the same run (the same simulated time), with their ratio, and
   ``make_vec`` async with 2 workers against 1 (``--only manipulation``: these figures alone);
@@ -43,6 +46,7 @@ from pathlib import Path  # noqa: E402
 from puzzlebox.lab.bench_figures import (  # noqa: E402
     bench_header,
     default_scale_trials,
+    lock_check_figures,
     manipulation_figures,
     measured_figures,
     output_figures,
@@ -83,7 +87,8 @@ def main(argv: list[str] | None = None) -> int:
         "--scale-trials", type=int, default=None,
         help="twin trials per executor for the scale figures (default 40; --quick 4; 0 skips them)",
     )  # fmt: skip
-    parser.add_argument("--only", choices=("manipulation", "soak", "outputs"), help="measure these figures alone")
+    parser.add_argument("--only", choices=("manipulation", "soak", "outputs", "locks"),
+                        help="measure these figures alone")  # fmt: skip
     parser.add_argument("--trials", type=int, default=None, help="twin trials of the soak (--only soak; default 200)")
     args = parser.parse_args(argv)
     if args.scale_trials is not None and not 0 <= args.scale_trials <= MAX_SCALE_TRIALS:
@@ -100,7 +105,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"-> {path}")
         lock.release()
         return 0
-    only = {"manipulation": manipulation_figures, "outputs": output_figures}.get(args.only or "", measured_figures)
+    only = {"manipulation": manipulation_figures, "outputs": output_figures, "locks": lock_check_figures}.get(
+        args.only or "", measured_figures
+    )
     for figure in only(args.quick):
         figure.keep(results)
         for line in figure.lines:

@@ -90,6 +90,7 @@ def measured_figures(quick: bool) -> Iterator[Figure]:
         )
     ])  # fmt: skip
     yield from output_figures(quick)
+    yield from lock_check_figures(quick)
     seen = box_visibility_figures(quick)
     yield Figure(("box_visibility",), seen, [
         f"rollout views: over {seen['frames']} frames of {seen['trials']} trials the best view showed at least "
@@ -108,6 +109,37 @@ def output_figures(quick: bool) -> Iterator[Figure]:
         f"{rollout['record_wall_s']:.2f} s (x{rollout['record_over_plain']:.2f}), --state-log "
         f"{rollout['state_log_wall_s']:.2f} s (x{rollout['state_log_over_plain']:.3f}, "
         f"{rollout['state_log_bytes'] / 1e6:.2f} MB)"
+    ])  # fmt: skip
+
+
+def lock_check_figures(quick: bool) -> Iterator[Figure]:
+    """``generate.py check-locks``'s check (the band check, box alone) on the 12 paper boxes (quick: 2), one push
+    after another against every push of a box as one batch (``mujoco.batch``), in turn per box: their times, the
+    ratio and whether every transition is the same."""
+    import time
+
+    from puzzlebox.lab.lock_checks import compiled_model
+    from puzzlebox.models.generator import paper_family
+    from puzzlebox.models.lock_check import BAND_OFFSETS, check_locks
+
+    times = {"one_by_one": 0.0, "batched": 0.0}
+    same, transitions = True, 0
+    for spec in paper_family("all")[: 2 if quick else 12]:
+        model, joints = compiled_model(spec, "contact", False)
+        checks = {}
+        for label in times:
+            start = time.perf_counter()
+            checks[label] = check_locks(spec, model, joints, offsets=BAND_OFFSETS, batched=label == "batched")
+            times[label] += time.perf_counter() - start
+        same = same and checks["batched"].transitions == checks["one_by_one"].transitions
+        transitions += len(checks["batched"].transitions)
+    out = {"boxes": 2 if quick else 12, "transitions": transitions, "one_by_one_s": times["one_by_one"],
+           "batched_s": times["batched"], "speedup": times["one_by_one"] / times["batched"],
+           "identical": same}  # fmt: skip
+    yield Figure(("lock_check",), out, [
+        f"check-locks, band check, {out['boxes']} paper boxes ({transitions} transitions): push after push "
+        f"{out['one_by_one_s']:.1f} s, batched {out['batched_s']:.1f} s (x{out['speedup']:.2f}), "
+        f"{'identical' if same else 'DIFFERENT'}"
     ])  # fmt: skip
 
 

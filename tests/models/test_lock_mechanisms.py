@@ -238,3 +238,13 @@ def test_the_design_ignores_where_the_box_stands():
     a, b = design_mechanisms(spec), design_mechanisms(moved)
     assert [i.name for i in a.interlocks] == [i.name for i in b.interlocks]
     assert all(np.allclose(x.wall, y.wall) for x, y in zip(a.interlocks, b.interlocks, strict=True))
+
+
+def test_the_check_batched_is_the_check_push_after_push_bit_for_bit():
+    # every push a simulation of one mujoco.batch.Batch: the same figures as one MjData stepped push after push
+    spec = generate_random(RandomGraphConfig(6, multi_locker=True, family=_all_kinds()), seed=7)
+    model, joints = compile_box(spec, locks="contact")
+    one_by_one = check_locks(spec, model, joints, limit=6, offsets=BAND_OFFSETS, batched=False)
+    batched = check_locks(spec, model, joints, limit=6, offsets=BAND_OFFSETS)
+    assert batched.transitions == one_by_one.transitions and len(batched.transitions) == 6 * 6 * len(BAND_OFFSETS)
+    assert any(t.moved >= 0.98 for t in batched.transitions) and any(t.moved < 0.5 for t in batched.transitions)
