@@ -363,9 +363,9 @@ class DoorPusher:
         # wall stands still there) slower still, closing in too, and at least ``blocked_progress`` past its start
         part_way = start >= c.judgement.blocked_progress  # (where a jam is read, :class:`SwingJudge`)
         slow_span = max(0.0, c.actuation.breakaway_fraction - start, c.judgement.blocked_progress if part_way else 0.0)
-        slow_pace = c.actuation.breakaway_pace * (p.plan.part_way_pace if part_way else 1.0)
+        slow_pace = c.actuation.breakaway_pace * (c.actuation.part_way_pace if part_way else 1.0)
         pacing = Pacing(pace, pace * slow_pace, slow_span)  # slow start, then a ramp up
-        approach_time = p.plan.approach_time * self.watch.slowdown / (p.plan.part_way_pace if part_way else 1.0)
+        approach_time = p.plan.approach_time * self.watch.slowdown / (c.actuation.part_way_pace if part_way else 1.0)
         last_tick = pacing.ticks_to(end - start)
         limits = SwingLimits(
             start, contact, p.judgement.held_turn / door.travel, p.judgement.slide_turn / door.travel,

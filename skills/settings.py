@@ -276,6 +276,12 @@ class ActuationConfig:
     (``toggle(careful=True)``: a part tried as a kind it was not told, whose path may meet a post or a stop where
     none was expected), as a fraction of the usual [-]: a force rising against it builds half as fast during the
     filtered reading's delay."""
+    part_way_pace: float = 0.3
+    """Pace of a push from part-way (a door that stood past ``blocked_progress``: a pinch lost it, a try left it), as
+    a fraction of the usual, while the pad closes in on the face and over its slow start [-]: such a door may stand
+    still at its lock's wall, where the pad meets a face that does not give. At the usual pace the true load rose
+    19, 26, 32, 47 N in four 10 ms ticks while the filtered reading showed 0-19 N (paper-test-1 seed 87038,
+    realistic)."""
 
     def __post_init__(self) -> None:
         if not (0.0 < self.breakaway_pace <= 1.0 and 0.0 <= self.breakaway_fraction < 1.0):
@@ -287,6 +293,8 @@ class ActuationConfig:
             raise ConfigError(
                 f"need 0 < careful_pace <= 1 and 0 < press_pace <= 1, got {self.careful_pace}, {self.press_pace}"
             )
+        if not 0.0 < self.part_way_pace <= 1.0:
+            raise ConfigError(f"need 0 < part_way_pace <= 1, got {self.part_way_pace}")
 
 
 @dataclass(frozen=True)
@@ -436,12 +444,6 @@ class DoorPushPlan:
     over it."""
     overtravel: float = 0.06
     """As the pinch's ``door_overtravel``, for a push (fraction of the travel): a pushed door follows the pad."""
-    part_way_pace: float = 0.3
-    """Pace of a push from part-way (a door that stood past ``blocked_progress``: a pinch lost it, a try left it), as
-    a fraction of the usual, while the pad closes in on the face and over its slow start [-]: such a door may stand
-    still at its lock's wall, where the pad meets a face that does not give. At the usual pace the true load rose
-    19, 26, 32, 47 N in four 10 ms ticks while the filtered reading showed 0-19 N (paper-test-1 seed 87038,
-    realistic)."""
     start_margin: float = 0.035
     """How far behind a door's seen angle a push after a pinch that lost its hold starts (fraction of the
     travel, 3 deg): a door let go part-way open falls back ~1 deg while the arm comes round. Behind the
@@ -683,6 +685,7 @@ _PHASE_OF: dict[str, str] = {
     "press_angle": "actuation",
     "back_off_force": "actuation",
     "careful_pace": "actuation",
+    "part_way_pace": "actuation",
     "moved_fraction": "judgement",
     "blocked_progress": "judgement",
     "push_force": "judgement",
@@ -724,7 +727,6 @@ _DOOR_PART_OF: dict[str, str] = {
     "lead": "plan",
     "overtravel": "plan",
     "start_margin": "plan",
-    "part_way_pace": "plan",
     "contact_force": "judgement",
     "contact_noise_margin": "judgement",
     "slide_turn": "judgement",
