@@ -58,7 +58,7 @@ lint: $(STAMP) $(MUJOCO_STUBS) $(PYRIGHT_ROOT)
 test: lint
 	$(BIN)/python -m pytest -q -n 2 --dist loadgroup --no-loadscope-reorder  # both cores, the longest work first (tests/_schedule.py)
 
-# The edit-test loop: the unit and physics tests, without lint and without the tests recorded at 2 CPU seconds or
+# The edit-test loop: the unit and physics tests, without lint and without the tests recorded at 1 CPU second or
 # more (end-to-end trials, experiments: marked slow by tests/_schedule.py). make test stays the whole suite.
 test-fast: $(STAMP)
 	$(BIN)/python -m pytest -q -n 2 --dist loadgroup --no-loadscope-reorder -m "not slow"

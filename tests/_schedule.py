@@ -54,7 +54,7 @@ GROUPED = (
 """Modules whose module-scoped fixtures take seconds (a twin trial, a calibration, a generated box...): kept on one
 worker so that the fixture is built once."""
 
-SLOW_FROM_S = 2.0
+SLOW_FROM_S = 1.0
 """A work unit (a test, or a :data:`GROUPED` module) recorded at this many CPU seconds or more is marked ``slow``
 (:func:`mark_slow`): ``make test-fast`` leaves those out (``pytest -m "not slow"``), for the edit-test loop."""
 
