@@ -12,7 +12,10 @@ wrist force the hand sensed over the plot window.
 from __future__ import annotations
 
 import collections
+import math
+from collections.abc import Callable
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
@@ -66,4 +69,38 @@ class FrameMaker:
         )  # fmt: skip
 
 
-__all__ = ["FrameMaker"]
+def hand_phase(world: Any) -> str:
+    """What the hand of ``world`` (a :class:`skills.robot_world.RobotWorld`, None before it exists) is doing: its
+    toggler's phase, or "surveying"."""
+    return "surveying" if world is None else world.toggler.phase
+
+
+def sensed_force(world: Any) -> float | None:
+    """The magnitude of the wrist force the hand of ``world`` sensed (filtered, in the base frame) [N]; None before
+    the world exists."""
+    if world is None:
+        return None
+    force_in_base = world.toggler.force_in_base
+    return math.sqrt(force_in_base @ force_in_base)  # np.linalg.norm, bit for bit, at a third of its cost
+
+
+class CapturedLooks:
+    """The looks a trial's pipeline takes, each with the simulator's joint positions at its capture: fed the captures
+    (:meth:`captured`) and told each look by the pipeline's detector (:meth:`look`)."""
+
+    def __init__(self, qpos: Callable[[], np.ndarray]) -> None:
+        self._qpos = qpos
+        self._captured: dict[str, tuple[float, np.ndarray]] = {}
+        """Camera -> time and joint positions of its latest capture."""
+
+    def captured(self, camera: str, time: float) -> None:
+        self._captured[camera] = (time, self._qpos().copy())
+
+    def look(self, camera: str, time: float, found: list[tuple[int, np.ndarray]]) -> Look:
+        """The look through ``camera`` at ``time`` that found ``found``, with the state of its capture (None: that
+        capture was not seen)."""
+        captured = self._captured.get(camera)
+        return Look(time, found, captured[1] if captured is not None and captured[0] == time else None)
+
+
+__all__ = ["CapturedLooks", "FrameMaker", "hand_phase", "sensed_force"]

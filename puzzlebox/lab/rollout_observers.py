@@ -5,18 +5,17 @@ marker detections (:class:`RecordingDetector`). Neither senses anything: the tri
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 from puzzlebox.lab.observers import TrialContext, TrialObserver
-from puzzlebox.lab.rollout_frames import FrameMaker
+from puzzlebox.lab.rollout_frames import CapturedLooks, FrameMaker, hand_phase, sensed_force
 from puzzlebox.models.kinds import get_kind
 from puzzlebox.skills import MarkerDetector
 from puzzlebox.twin.rerun_log import TrialRecording
-from puzzlebox.twin.rollout_video import BackgroundRollout, Caption, Look, SceneCameras
+from puzzlebox.twin.rollout_video import BackgroundRollout, Caption, SceneCameras
 from puzzlebox.twin.session import TwinSession
 
 __all__ = ["RecordingDetector", "RerunRecording", "RolloutVideo", "agent_belief", "scene_cameras"]
@@ -84,30 +83,24 @@ class RolloutVideo(TrialObserver):
         self._frames = FrameMaker([c.name for c in session.spec.components], rollout.config.period,
                                   rollout.config.plot_window)  # fmt: skip
         self._world: Any = None
-        self._captured: dict[str, tuple[float, np.ndarray]] = {}
-        """Camera -> time and joint positions of its latest capture."""
-        detector.listeners.append(self._look)
+        self._looks = CapturedLooks(lambda: session.data.qpos)
+        detector.listeners.append(
+            lambda camera, time, found: self._frames.look(camera, self._looks.look(camera, time, found))
+        )
 
     def sensed(self, what: str, value: Any) -> None:
         if what.startswith("capture:") and value is not None:
-            self._captured[value.camera] = (value.time, self._session.data.qpos.copy())
+            self._looks.captured(value.camera, value.time)
 
     def _look(self, camera: str, time: float, found: list[tuple[int, np.ndarray]]) -> None:
-        captured = self._captured.get(camera)
-        qpos = captured[1] if captured is not None and captured[0] == time else None
-        self._frames.look(camera, Look(time, found, qpos))
+        self._frames.look(camera, self._looks.look(camera, time, found))
 
     def attach(self, trial: TrialContext) -> None:
         self._world = trial.world
 
     def waited(self, now: float) -> None:
         world = self._world
-        force = None
-        if world is not None:
-            force_in_base = world.toggler.force_in_base
-            force = math.sqrt(force_in_base @ force_in_base)
-        phase = "surveying" if world is None else world.toggler.phase
-        for frame in self._frames.waited(now, self._session.data.qpos, force, phase):
+        for frame in self._frames.waited(now, self._session.data.qpos, sensed_force(world), hand_phase(world)):
             self._rollout.add(frame)
 
     def action_begins(self, caption: Caption) -> None:
@@ -117,8 +110,7 @@ class RolloutVideo(TrialObserver):
         self._frames.action_ended(caption)
 
     def finish(self) -> None:  # the last frame, whatever the time: how the last action ended
-        phase = "surveying" if self._world is None else self._world.toggler.phase
-        self._rollout.add(self._frames.frame(self._session.time, self._session.data.qpos, phase))
+        self._rollout.add(self._frames.frame(self._session.time, self._session.data.qpos, hand_phase(self._world)))
 
 
 class RerunRecording(TrialObserver):

@@ -42,6 +42,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from puzzlebox.lab.observers import TrialContext, TrialObserver
+from puzzlebox.lab.rollout_frames import CapturedLooks, hand_phase, sensed_force
 from puzzlebox.models.atomic import write_atomically
 from puzzlebox.models.toggle_log import PHASES
 
@@ -57,9 +58,9 @@ FORMAT = "puzzlebox-state-log/1"
 """The ``format`` of a state log's ``meta``."""
 ARRAYS = ("time", "qpos", "qvel", "joint_command", "gripper_command", "wrench", "part_states", "action", "in_try",
           "phase", "force_sensed")  # fmt: skip
+"""The per-tick arrays of a state log (module docstring)."""
 SURVEYING = -1
 """The ``phase`` of a tick before the world existed (the survey of the scene)."""
-"""The per-tick arrays of a state log (module docstring)."""
 
 
 class StateLog(TrialObserver):
@@ -73,7 +74,7 @@ class StateLog(TrialObserver):
         self._world: RobotWorld | None = None
         self._events: list[dict[str, Any]] = []
         self._end_phase = "surveying"
-        self._captured: dict[str, tuple[float, np.ndarray]] = {}
+        self._looks = CapturedLooks(lambda: session.data.qpos)
         if detector is not None:
             detector.listeners.append(self._look)
         self._rows: dict[str, list[Any]] = {name: [] for name in ARRAYS}
@@ -95,11 +96,11 @@ class StateLog(TrialObserver):
         if what == "wrench":
             self._wrench = np.array(value, dtype=float)
         elif what.startswith("capture:") and value is not None:
-            self._captured[value.camera] = (value.time, self._session.data.qpos.copy())
+            self._looks.captured(value.camera, value.time)
 
     def _look(self, camera: str, time: float, found: list[tuple[int, np.ndarray]]) -> None:
-        captured = self._captured.get(camera)
-        qpos = captured[1].tolist() if captured is not None and captured[0] == time else None
+        look = self._looks.look(camera, time, found)
+        qpos = None if look.qpos is None else look.qpos.tolist()
         self._event("look", camera=camera, time=time, found=[[int(m), c.tolist()] for m, c in found], qpos=qpos)
 
     def _event(self, event: str, **fields: Any) -> None:
@@ -124,15 +125,12 @@ class StateLog(TrialObserver):
         rows["part_states"].append(self._session.component_states())
         rows["action"].append(len(world.log) if world is not None else 0)
         rows["in_try"].append(self._in_try)
-        rows["phase"].append(SURVEYING if world is None else PHASES.index(world.toggler.phase))
-        if world is None:
-            rows["force_sensed"].append(np.nan)
-        else:
-            force_in_base = world.toggler.force_in_base
-            rows["force_sensed"].append(math.sqrt(force_in_base @ force_in_base))  # (as the rollout's plot)
+        rows["phase"].append(SURVEYING if world is None else PHASES.index(hand_phase(world)))
+        force = sensed_force(world)  # (as the rollout's force plot)
+        rows["force_sensed"].append(np.nan if force is None else force)
 
     def finish(self) -> None:
-        self._end_phase = "surveying" if self._world is None else self._world.toggler.phase
+        self._end_phase = hand_phase(self._world)
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The log so far, one array per name of :data:`ARRAYS` (``n`` rows each)."""

@@ -16,6 +16,7 @@ from world_fixtures import TrueForceWatch
 from puzzlebox.lab.observers import ObservedRobot, TrialObserver
 from puzzlebox.lab.twin_trial import evaluation_world
 from puzzlebox.models.generator import generate_chain, paper_family
+from puzzlebox.models.kinds import get_kind
 from puzzlebox.models.placement import placed
 from puzzlebox.models.try_outcome import Cause
 from puzzlebox.skills.primitives import PrimitiveConfig
@@ -199,28 +200,35 @@ def test_a_free_lever_pressed_along_its_post_is_actuated_at_press_pace_and_opens
     )  # 6.95 s (4.08 at the usual pace)
 
 
+@contextlib.contextmanager
+def _door_standing_at(angle: float, sticky: bool):
+    """Door-0 of paper-test-0 (placed at (0.38, 0.12, -0.9)) standing at ``angle`` [rad] under the late reading, held
+    wherever it stands (``sticky``: it jams at every move) or free: the session, the watched robot (``peak`` counted
+    from here), the world, the door's marker and its joint's qpos address."""
+    reality = dataclasses.replace(
+        LATE_READING, name="late F/T, sticky door", physics=PhysicsReality(jam_probability=1.0 if sticky else 0.0)
+    )
+    spec = placed(paper_family("test", seed=0)[0], (0.38, 0.12, -0.9))
+    door = spec.index_of("door-0")
+    with TwinSession(spec, seed=0, reality=reality) as session:
+        robot = TrueForceWatch(session.robot, session)
+        world = evaluation_world(session, robot)
+        angle_adr = session.component_qpos[door]
+        session.data.qpos[angle_adr] = angle
+        session.robot.wait(1.0)
+        robot.peak = 0.0
+        yield session, robot, world, spec.components[door].marker, angle_adr
+
+
 @pytest.mark.parametrize("held_at", [64.0, None], ids=["held at 64 deg", "in its end stop"])
 def test_a_top_up_push_against_a_door_that_does_not_turn_stops_at_a_light_touch(held_at):
     # the top-up pushes a door it cannot see on up into its stop from under its plate, wherever it stands; one held
     # where it stands (a jam, a latch: here it jams at every move) or already in its stop presses back at once, and
     # under the harsh profile's late reading (F/T 30 ms late, a 5-tick median, commands 10 ms late) the push went on
     # to 40-50 N true before it was felt (paper-test-2 seeds 100 and 101): here 48 N held, 40 N in the stop
-    late_and_sticky = dataclasses.replace(
-        LATE_READING,
-        name="late F/T, sticky door",
-        physics=PhysicsReality(jam_probability=0.0 if held_at is None else 1.0),
-    )
-    spec = placed(paper_family("test", seed=0)[0], (0.38, 0.12, -0.9))
-    door = spec.index_of("door-0")
-    with TwinSession(spec, seed=0, reality=late_and_sticky) as session:
-        robot = TrueForceWatch(session.robot, session)
-        world = evaluation_world(session, robot)
-        angle = session.component_qpos[door]
-        session.data.qpos[angle] = session.travel[door] if held_at is None else math.radians(held_at)
-        session.robot.wait(1.0)
-        robot.peak = 0.0
-        jm = world.joint_models[spec.components[door].marker]
-        result = world.toggler.toggle(jm, opening=True, raised=True)
+    standing = get_kind("door").travel if held_at is None else math.radians(held_at)
+    with _door_standing_at(standing, sticky=held_at is not None) as (session, robot, world, marker, angle):
+        result = world.toggler.toggle(world.joint_models[marker], opening=True, raised=True)
         assert robot.peak < 30.0, robot.peak_during  # two thirds of the margin: a reading may be later still
         if held_at is None:
             assert result.outcome == "moved" and math.degrees(session.data.qpos[angle]) > 83.0, result
@@ -274,21 +282,10 @@ def test_a_door_pushed_on_from_part_way_where_it_is_held_stops_at_a_light_force(
     # 46 N at 40 deg at the usual pace and ``blocked_force``; closed in on and pushed at ``part_way_pace`` and read
     # jammed at ``jam_force``, 30 and 23 N. A free door pushed on from there still goes to its stop.
     held = stands_at is not None
-    sticky = dataclasses.replace(
-        LATE_READING, name="late F/T, sticky door", physics=PhysicsReality(jam_probability=1.0 if held else 0.0)
-    )
-    spec = placed(paper_family("test", seed=0)[0], (0.38, 0.12, -0.9))
-    door = spec.index_of("door-0")
-    with TwinSession(spec, seed=0, reality=sticky) as session:
-        robot = TrueForceWatch(session.robot, session)
-        world = evaluation_world(session, robot)
-        angle = session.component_qpos[door]
-        session.data.qpos[angle] = math.radians(stands_at or 30.0)
-        session.robot.wait(1.0)
-        marker = spec.components[door].marker
+    with _door_standing_at(math.radians(stands_at or 30.0), sticky=held) as (session, robot, world, marker, angle):
         seen = world._fraction_open(marker)
         assert seen is not None and seen > world.toggler.config.judgement.blocked_progress, seen
-        robot.peak = 0.0
+        robot.peak = 0.0  # (the look is not the push)
         result = world.toggler.toggle(world.joint_models[marker], opening=True, door_at=seen)
         if held:
             assert (result.outcome, result.cause) == ("failed", Cause.JAMMED), result
